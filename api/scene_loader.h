@@ -1,0 +1,59 @@
+#pragma once
+// JSON scene (format v1) -> validated renderer input. The single entry point used by the CLI,
+// the HTTP service and the tests. Every problem is reported with the JSON pointer of the field.
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "renderer/scene_input.h"
+
+namespace penumbra::api {
+
+struct Diagnostic {
+  std::string pointer;  // RFC 6901 JSON pointer, "" for the document root
+  std::string message;
+  std::string to_string() const { return (pointer.empty() ? std::string("/") : pointer) + ": " + message; }
+};
+
+// Caps on what one scene may ask for; each documented in docs/scene-format.md.
+struct Limits {
+  int max_width = 8192;
+  int max_height = 8192;
+  int64_t max_pixels = int64_t(4096) * 4096;
+  int max_spp = 1 << 20;
+  int max_depth = 1024;
+  int64_t max_triangles = 4'000'000;
+  int max_objects = 100'000;
+  int max_materials = 10'000;
+  int max_lights = 10'000;
+  int max_json_depth = 64;
+  double max_time_limit = 24 * 3600.0;  // seconds
+};
+
+enum class LoadErrorKind {
+  kNone,
+  kSyntax,   // not JSON at all (or nested deeper than max_json_depth): HTTP 400
+  kInvalid,  // JSON, but not a valid scene: HTTP 422
+};
+
+struct SceneRequest {
+  SceneInput scene;
+  RenderSettings settings;
+};
+
+struct LoadResult {
+  std::optional<SceneRequest> request;  // set iff errors is empty
+  LoadErrorKind kind = LoadErrorKind::kNone;
+  std::vector<Diagnostic> errors;
+  std::vector<Diagnostic> warnings;
+  bool ok() const { return errors.empty(); }
+};
+
+LoadResult load_scene(std::string_view json_text, const Limits& limits = {});
+// Reads the file (a read failure is reported as an error on pointer "") and calls load_scene.
+LoadResult load_scene_file(const std::string& path, const Limits& limits = {});
+
+}  // namespace penumbra::api

@@ -1,0 +1,35 @@
+#pragma once
+// Basic math vocabulary of the renderer: GLM vectors, RGB spectra and a few constants.
+#include <glm/glm.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+namespace penumbra {
+
+using glm::vec2;
+using glm::vec3;
+using glm::mat4;
+using glm::dvec3;
+
+// Linear RGB radiometric quantity (radiance, reflectance, throughput, ...).
+using Spectrum = glm::vec3;
+
+inline constexpr float kPi = 3.14159265358979323846f;
+inline constexpr float kInvPi = 0.31830988618379067154f;
+inline constexpr float kInv2Pi = 0.15915494309189533577f;
+inline constexpr float kInv4Pi = 0.07957747154594766788f;
+inline constexpr float kOneMinusEpsilon = 0x1.fffffep-1f;
+inline constexpr float kInfinity = INFINITY;
+
+inline float luminance(const Spectrum& s) { return 0.2126f * s.x + 0.7152f * s.y + 0.0722f * s.z; }
+inline float max_component(const Spectrum& s) { return std::max(s.x, std::max(s.y, s.z)); }
+inline bool is_black(const Spectrum& s) { return s.x == 0.f && s.y == 0.f && s.z == 0.f; }
+inline bool is_finite(const Spectrum& s) {
+  return std::isfinite(s.x) && std::isfinite(s.y) && std::isfinite(s.z);
+}
+inline float safe_sqrt(float x) { return std::sqrt(std::max(0.f, x)); }
+inline float sqr(float x) { return x * x; }
+
+}  // namespace penumbra
