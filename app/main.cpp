@@ -1,0 +1,54 @@
+// penumbra: render, validate, serve, bench.
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <string>
+
+#include "app/commands.h"
+#ifdef PENUMBRA_HAVE_SERVER
+#include "server/serve_command.h"
+#endif
+
+namespace {
+void print_usage(std::FILE* out) {
+  std::fprintf(out,
+               "usage: penumbra <command> [options]\n"
+               "\n"
+               "commands:\n"
+               "  render SCENE.json -o OUT.{png,exr}   render a scene to an image\n"
+               "  validate SCENE.json...               check scenes, print every error with its JSON pointer\n"
+#ifdef PENUMBRA_HAVE_SERVER
+               "  serve                                run the HTTP render service\n"
+#endif
+               "  bench                                measure renderer rays/s against Embree alone\n"
+               "\n"
+               "Run 'penumbra <command> --help' for the options of a command.\n");
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h") ||
+      !std::strcmp(argv[1], "help")) {
+    print_usage(argc < 2 ? stderr : stdout);
+    return argc < 2 ? 2 : 0;
+  }
+  const std::string command = argv[1];
+  try {
+    if (command == "render") return penumbra::app::run_render(argc - 1, argv + 1);
+    if (command == "validate") return penumbra::app::run_validate(argc - 1, argv + 1);
+    if (command == "bench") return penumbra::app::run_bench(argc - 1, argv + 1);
+#ifdef PENUMBRA_HAVE_SERVER
+    if (command == "serve") return penumbra::server::run_serve(argc - 1, argv + 1);
+#endif
+    if (command == "--version") {
+      std::printf("penumbra 0.1.0\n");
+      return 0;
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "penumbra %s: error: %s\n", command.c_str(), e.what());
+    return 1;
+  }
+  std::fprintf(stderr, "penumbra: unknown command '%s'\n\n", command.c_str());
+  print_usage(stderr);
+  return 2;
+}
