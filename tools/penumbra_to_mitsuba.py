@@ -1,0 +1,422 @@
+#!/usr/bin/env python3
+"""Convert a penumbra scene (format v1, JSON) into a Mitsuba 3 scene.
+
+The conversion keeps every semantic of the format (issue 2, docs/accuracy.md has the table):
+
+* camera: ``perspective`` (or ``thinlens`` when ``aperture_radius > 0``) with ``fov_axis: 'y'``
+  and a ``look_at`` transform; an ``hdrfilm`` with a box pixel filter and linear RGB float output.
+* opaque materials (diffuse, conductor, plastic) are wrapped in ``twosided``; GGX with
+  alpha = roughness^2 and visible-normal sampling; conductor = constant reflectance
+  (``material: 'none'`` scaled by ``specular_reflectance``); plastic is not ``nonlinear``.
+* ``dielectric.absorption`` becomes an interior ``homogeneous`` medium with albedo 0 and
+  sigma_t = absorption, rendered with ``volpath``; other scenes use ``path``. Both with the
+  scene's ``max_depth`` and Russian roulette from depth 5.
+* emission is an ``area`` emitter on the shape (one-sided: quad front = u x v, sphere outside,
+  mesh counter-clockwise); point lights, directional lights and the constant environment map
+  onto ``point``, ``directional`` and ``constant``.
+
+Mitsuba 3.9 has no moving shapes. :func:`to_mitsuba` therefore builds the scene at one instant
+``time``; a motion-blurred reference is the average of renders at many instants spread over the
+shutter (see :func:`shutter_instants` and tools/make_references.py).
+
+Usage as a script (writes a quick preview EXR)::
+
+    python tools/penumbra_to_mitsuba.py scene.json -o out.exr --spp 64
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import sys
+from typing import Any
+
+import numpy as np
+
+#: Where Debian 12's libllvm19 puts the library; llvm_ad_rgb needs LLVM >= 16 here.
+DEBIAN_LIBLLVM = "/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1"
+
+#: Russian roulette starts at this depth, as in penumbra's RenderSettings and Mitsuba's default.
+RR_DEPTH = 5
+
+
+def import_mitsuba(variant: str):
+    """Import mitsuba and select ``variant``, pointing Dr.Jit at libLLVM 19 when it is present.
+
+    Dr.Jit would otherwise pick Debian's LLVM 15, with which llvm_ad_rgb renders abort.
+    """
+    if "DRJIT_LIBLLVM_PATH" not in os.environ and os.path.exists(DEBIAN_LIBLLVM):
+        os.environ["DRJIT_LIBLLVM_PATH"] = DEBIAN_LIBLLVM
+    import mitsuba as mi
+
+    mi.set_variant(variant)
+    return mi
+
+
+# --------------------------------------------------------------------------------------------
+# Small geometry helpers (numpy, double precision)
+# --------------------------------------------------------------------------------------------
+
+def vec(values, n: int = 3) -> np.ndarray:
+    """A float64 vector of length ``n`` from a JSON list (a scalar is broadcast)."""
+    a = np.asarray(values, dtype=np.float64)
+    if a.ndim == 0:
+        a = np.full(n, float(a))
+    if a.shape != (n,):
+        raise ValueError(f"expected {n} numbers, got {values!r}")
+    return a
+
+
+def rotation_matrix(axis, degrees: float) -> np.ndarray:
+    """3x3 right-handed rotation by ``degrees`` about ``axis`` (Rodrigues' formula)."""
+    k = vec(axis)
+    k = k / np.linalg.norm(k)
+    theta = math.radians(degrees)
+    kx = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+    return np.eye(3) + math.sin(theta) * kx + (1 - math.cos(theta)) * (kx @ kx)
+
+
+def object_matrix(transform: dict | None) -> np.ndarray:
+    """4x4 object-to-world matrix of a penumbra ``transform``.
+
+    Either ``matrix`` (16 numbers, row-major) or scale, then rotate, then translate:
+    M = T * R * S applied to column vectors.
+    """
+    m = np.eye(4)
+    if not transform:
+        return m
+    if "matrix" in transform:
+        return np.asarray(transform["matrix"], dtype=np.float64).reshape(4, 4)
+    if "scale" in transform:
+        m[:3, :3] = np.diag(vec(transform["scale"])) @ m[:3, :3]
+    if "rotate" in transform:
+        r = transform["rotate"]
+        m[:3, :3] = rotation_matrix(r["axis"], r["degrees"]) @ m[:3, :3]
+    if "translate" in transform:
+        m[:3, 3] += vec(transform["translate"])
+    return m
+
+
+def apply_point(m: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """Transform points (..., 3) by the affine 4x4 matrix ``m``."""
+    return p @ m[:3, :3].T + m[:3, 3]
+
+
+def apply_vector(m: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Transform direction vectors (..., 3) by the linear part of ``m``."""
+    return v @ m[:3, :3].T
+
+
+def apply_normal(m: np.ndarray, n: np.ndarray) -> np.ndarray:
+    """Transform normals (..., 3) by the inverse transpose of ``m``, renormalised."""
+    out = n @ np.linalg.inv(m[:3, :3])
+    return out / np.linalg.norm(out, axis=-1, keepdims=True)
+
+
+def motion_offset(obj: dict, time: float) -> np.ndarray:
+    """Displacement of an object at ``time``: v*t + a*t^2/2 (zero at t = 0)."""
+    v = vec(obj.get("velocity", [0, 0, 0]))
+    a = vec(obj.get("acceleration", [0, 0, 0]))
+    return v * time + 0.5 * a * time * time
+
+
+def shutter_instants(scene: dict, count: int) -> list[float]:
+    """``count`` instants at the midpoints of equal strata of the camera shutter.
+
+    Penumbra draws the time of each camera sample uniformly in [open, close]; the image is the
+    time average of the instantaneous images. For a box-filtered pixel the instantaneous value
+    is continuous and piecewise smooth in t, so the midpoint rule converges fast (O(1/n^2) away
+    from kinks). A scene without blur (open == close, the default) gets one instant.
+    """
+    t0, t1 = scene.get("camera", {}).get("shutter", [0.0, 0.0])
+    if t0 == t1 or not has_motion(scene):
+        return [float(t0)]
+    return [t0 + (i + 0.5) * (t1 - t0) / count for i in range(count)]
+
+
+def has_motion(scene: dict) -> bool:
+    """True if any object has a non-zero velocity or acceleration."""
+    for obj in scene.get("objects", []):
+        if np.any(vec(obj.get("velocity", [0, 0, 0]))) or np.any(vec(obj.get("acceleration", [0, 0, 0]))):
+            return True
+    return False
+
+
+def uses_absorption(scene: dict) -> bool:
+    """True if any dielectric material has a non-zero absorption coefficient."""
+    return any(
+        m.get("type") == "dielectric" and np.any(vec(m.get("absorption", [0, 0, 0])))
+        for m in scene.get("materials", {}).values()
+    )
+
+
+# --------------------------------------------------------------------------------------------
+# Scene pieces -> Mitsuba dictionaries
+# --------------------------------------------------------------------------------------------
+
+def rgb(values) -> dict:
+    """A Mitsuba RGB spectrum dictionary."""
+    return {"type": "rgb", "value": [float(x) for x in vec(values)]}
+
+
+def ggx(alpha: float) -> dict:
+    """Microfacet parameters shared by the rough plugins: GGX, visible-normal sampling."""
+    return {"distribution": "ggx", "alpha": float(alpha), "sample_visible": True}
+
+
+def convert_material(mat: dict) -> dict:
+    """A penumbra material -> Mitsuba BSDF dictionary (opaque ones wrapped in ``twosided``).
+
+    The interior medium of an absorbing dielectric is attached to the shape, not the BSDF
+    (see :func:`convert_medium`).
+    """
+    kind = mat["type"]
+    roughness = float(mat.get("roughness", 0.0))
+    alpha = roughness * roughness  # glTF convention, as in penumbra
+    if kind == "diffuse":
+        bsdf = {"type": "diffuse", "reflectance": rgb(mat["color"])}
+    elif kind == "conductor":
+        # material 'none' = a perfect reflector (F = 1) that specular_reflectance scales:
+        # a constant Fresnel reflectance equal to the colour.
+        bsdf = {"type": "conductor", "material": "none", "specular_reflectance": rgb(mat["color"])}
+        if alpha > 0:
+            bsdf.update(type="roughconductor", **ggx(alpha))
+    elif kind == "plastic":
+        bsdf = {
+            "type": "plastic",
+            "diffuse_reflectance": rgb(mat["color"]),
+            "int_ior": float(mat.get("ior", 1.5)),
+            "ext_ior": 1.0,
+            "nonlinear": False,
+        }
+        if alpha > 0:
+            bsdf.update(type="roughplastic", **ggx(alpha))
+    elif kind == "dielectric":
+        bsdf = {"type": "dielectric", "int_ior": float(mat.get("ior", 1.5)), "ext_ior": 1.0}
+        if alpha > 0:
+            bsdf.update(type="roughdielectric", **ggx(alpha))
+        return bsdf  # transmissive: the surface orientation matters, no twosided
+    else:
+        raise ValueError(f"unknown material type {kind!r}")
+    return {"type": "twosided", "material": bsdf}
+
+
+def convert_medium(mat: dict) -> dict | None:
+    """The interior medium of a dielectric with absorption, or None.
+
+    Beer-Lambert absorption = a homogeneous medium that only absorbs: albedo 0 and
+    sigma_t = sigma_a. Mitsuba's 'rgb' spectrum must lie in [0, 1], so the coefficient is
+    normalised and its maximum goes into ``scale``.
+    """
+    if mat.get("type") != "dielectric":
+        return None
+    sigma_a = vec(mat.get("absorption", [0, 0, 0]))
+    peak = float(sigma_a.max())
+    if peak <= 0:
+        return None
+    return {"type": "homogeneous", "albedo": 0.0, "sigma_t": rgb(sigma_a / peak), "scale": peak}
+
+
+def quad_to_world(origin: np.ndarray, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """4x4 matrix mapping Mitsuba's rectangle ([-1,1]^2 at z = 0, normal +z) onto the
+    parallelogram origin + s*u + t*v, s,t in [0,1], with its normal along u x v.
+
+    Columns: x -> u/2, y -> v/2, z -> unit(u x v), translation = the centre. For orthogonal
+    u, v this is what Mitsuba's rectangle expects; see :func:`convert_object` for the rest.
+    """
+    n = np.cross(u, v)
+    m = np.eye(4)
+    m[:3, 0] = 0.5 * u
+    m[:3, 1] = 0.5 * v
+    m[:3, 2] = n / np.linalg.norm(n)
+    m[:3, 3] = origin + 0.5 * u + 0.5 * v
+    return m
+
+
+def mesh_arrays(obj: dict, matrix: np.ndarray, offset: np.ndarray):
+    """World-space (positions, faces, normals or None) of a mesh object as numpy arrays."""
+    positions = np.asarray(obj["positions"], dtype=np.float64).reshape(-1, 3)
+    faces = np.asarray(obj["indices"], dtype=np.uint32).reshape(-1, 3)
+    positions = apply_point(matrix, positions) + offset
+    normals = None
+    if obj.get("normals"):
+        normals = apply_normal(matrix, np.asarray(obj["normals"], dtype=np.float64).reshape(-1, 3))
+    return positions, faces, normals
+
+
+def build_mesh(mi, name: str, positions, faces, normals, children: dict):
+    """A Mitsuba mesh from numpy arrays; ``children`` are instantiated plugins (bsdf, emitter,
+    interior) attached through the mesh's Properties. Without normals Mitsuba uses face normals.
+    """
+    props = mi.Properties()
+    for key, value in children.items():
+        props[key] = value
+    mesh = mi.Mesh(name, len(positions), len(faces), props, has_vertex_normals=normals is not None)
+    params = mi.traverse(mesh)
+    params["vertex_positions"] = mi.Float(positions.astype(np.float32).ravel())
+    params["faces"] = mi.UInt32(faces.ravel())
+    if normals is not None:
+        params["vertex_normals"] = mi.Float(normals.astype(np.float32).ravel())
+    params.update()
+    return mesh
+
+
+def convert_object(mi, index: int, obj: dict, materials: dict, time: float):
+    """One penumbra object at ``time`` -> a Mitsuba shape (a dict, or a Mesh instance)."""
+    matrix = object_matrix(obj.get("transform"))
+    offset = motion_offset(obj, time)
+    mat = materials[obj["material"]]
+    children: dict[str, Any] = {"bsdf": convert_material(mat)}
+    medium = convert_medium(mat)
+    if medium is not None:
+        children["interior"] = medium
+    emission = vec(obj.get("emission", [0, 0, 0]))
+    if np.any(emission > 0):
+        children["emitter"] = {"type": "area", "radiance": rgb(emission)}
+
+    kind = obj["type"]
+    if kind == "sphere":
+        linear = matrix[:3, :3]
+        scales = np.linalg.svd(linear, compute_uv=False)
+        if not np.allclose(scales, scales[0], rtol=1e-6):
+            raise ValueError(f"object {index}: a sphere's transform must scale uniformly")
+        center = apply_point(matrix, vec(obj["center"])) + offset
+        return {"type": "sphere", "center": center.tolist(), "radius": float(obj["radius"]) * float(scales[0]),
+                **children}
+    if kind == "quad":
+        origin = apply_point(matrix, vec(obj["origin"])) + offset
+        u = apply_vector(matrix, vec(obj["u"]))
+        v = apply_vector(matrix, vec(obj["v"]))
+        if abs(np.dot(u, v)) <= 1e-9 * np.linalg.norm(u) * np.linalg.norm(v):
+            return {"type": "rectangle", "to_world": mi.ScalarTransform4f(quad_to_world(origin, u, v)), **children}
+        # Mitsuba's rectangle builds its shading frame from the transformed axes, which assumes
+        # they are orthogonal; a sheared parallelogram is two triangles instead (same surface,
+        # same area sampling, same front side).
+        positions = np.array([origin, origin + u, origin + u + v, origin + v])
+        faces = np.array([[0, 1, 2], [0, 2, 3]], dtype=np.uint32)
+        return build_mesh(mi, f"quad{index}", positions, faces, None, instantiate(mi, children))
+    if kind == "mesh":
+        positions, faces, normals = mesh_arrays(obj, matrix, offset)
+        return build_mesh(mi, f"mesh{index}", positions, faces, normals, instantiate(mi, children))
+    raise ValueError(f"object {index}: unknown type {kind!r}")
+
+
+def instantiate(mi, children: dict) -> dict:
+    """Load plugin dictionaries into objects (what a Mesh's Properties need)."""
+    return {key: mi.load_dict(value) for key, value in children.items()}
+
+
+def convert_light(light: dict) -> dict:
+    """A penumbra point or directional light -> a Mitsuba emitter dictionary."""
+    if light["type"] == "point":
+        return {"type": "point", "position": vec(light["position"]).tolist(), "intensity": rgb(light["intensity"])}
+    if light["type"] == "directional":
+        # Both formats: 'direction' is where the light travels, irradiance on a facing surface.
+        return {"type": "directional", "direction": vec(light["direction"]).tolist(),
+                "irradiance": rgb(light["irradiance"])}
+    raise ValueError(f"unknown light type {light['type']!r}")
+
+
+def convert_sensor(mi, scene: dict, spp: int, width: int | None = None, height: int | None = None) -> dict:
+    """Camera, film (box filter, linear float RGB) and sampler."""
+    cam = scene["camera"]
+    render = scene.get("render", {})
+    to_world = mi.ScalarTransform4f().look_at(
+        origin=vec(cam["position"]).tolist(), target=vec(cam["look_at"]).tolist(),
+        up=vec(cam.get("up", [0, 1, 0])).tolist())
+    sensor = {"type": "perspective", "fov": float(cam["fov"]), "fov_axis": "y", "to_world": to_world}
+    aperture = float(cam.get("aperture_radius", 0.0))
+    if aperture > 0:
+        sensor.update(type="thinlens", aperture_radius=aperture,
+                      focus_distance=float(cam.get("focus_distance", 1.0)))
+    sensor["film"] = {
+        "type": "hdrfilm",
+        "width": int(width or render.get("width", 256)),
+        "height": int(height or render.get("height", 256)),
+        "rfilter": {"type": "box"},
+        "pixel_format": "rgb",
+        "component_format": "float32",
+    }
+    sensor["sampler"] = {"type": "independent", "sample_count": int(spp), "seed": int(render.get("seed", 0))}
+    return sensor
+
+
+def convert_integrator(scene: dict) -> dict:
+    """``path``, or ``volpath`` when a dielectric absorbs; same max_depth, RR from depth 5."""
+    render = scene.get("render", {})
+    if render.get("integrator", "path") != "path":
+        raise ValueError("references are path traced: set render.integrator to 'path'")
+    return {
+        "type": "volpath" if uses_absorption(scene) else "path",
+        "max_depth": int(render.get("max_depth", 8)),
+        "rr_depth": RR_DEPTH,
+    }
+
+
+def to_mitsuba(mi, scene: dict, time: float = 0.0, spp: int | None = None,
+               width: int | None = None, height: int | None = None) -> dict:
+    """The Mitsuba scene dictionary of a penumbra scene at instant ``time``.
+
+    ``spp``, ``width`` and ``height`` override the scene's render settings.
+    """
+    if scene.get("version") != 1:
+        raise ValueError("only penumbra scene format version 1 is supported")
+    render = scene.get("render", {})
+    out: dict[str, Any] = {
+        "type": "scene",
+        "integrator": convert_integrator(scene),
+        "sensor": convert_sensor(mi, scene, spp or render.get("spp", 64), width, height),
+    }
+    materials = scene.get("materials", {})
+    for i, obj in enumerate(scene.get("objects", [])):
+        out[f"object{i}"] = convert_object(mi, i, obj, materials, time)
+    for i, light in enumerate(scene.get("lights", [])):
+        out[f"light{i}"] = convert_light(light)
+    env = scene.get("environment")
+    if env is not None and np.any(vec(env.get("radiance", [0, 0, 0])) > 0):
+        out["environment"] = {"type": "constant", "radiance": rgb(env["radiance"])}
+    return out
+
+
+def load_json(path: str) -> dict:
+    """Read a penumbra scene file."""
+    with open(path, encoding="utf-8") as f:
+        return json.load(f)
+
+
+def render_average(mi, scene: dict, spp: int, instants: int = 64, seed: int = 0,
+                   width: int | None = None, height: int | None = None) -> np.ndarray:
+    """Render ``scene`` with ``spp`` samples per pixel in total, as the mean over the shutter
+    instants (one instant without motion blur), and return an (h, w, 3) float64 array.
+
+    Each instant gets spp / instants samples (at least 1) and its own sampler seed.
+    """
+    times = shutter_instants(scene, instants)
+    per_instant = max(1, spp // len(times))
+    total = None
+    for k, t in enumerate(times):
+        mscene = mi.load_dict(to_mitsuba(mi, scene, time=t, spp=per_instant, width=width, height=height))
+        img = np.asarray(mi.render(mscene, spp=per_instant, seed=seed * len(times) + k), dtype=np.float64)
+        total = img if total is None else total + img
+    return total / len(times)
+
+
+def main(argv: list[str]) -> int:
+    """Command line: convert and render one scene (a quick preview, or a reference by hand)."""
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("scene", help="penumbra scene v1 JSON")
+    ap.add_argument("-o", "--output", required=True, help="output EXR (linear RGB float)")
+    ap.add_argument("--spp", type=int, default=64)
+    ap.add_argument("--instants", type=int, default=64, help="shutter instants for motion blur")
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--variant", default="llvm_ad_rgb")
+    args = ap.parse_args(argv)
+    mi = import_mitsuba(args.variant)
+    img = render_average(mi, load_json(args.scene), args.spp, args.instants, args.seed)
+    mi.Bitmap(img.astype(np.float32), mi.Bitmap.PixelFormat.RGB).write(args.output)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
