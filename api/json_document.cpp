@@ -1,0 +1,124 @@
+#include "api/json_document.h"
+
+#include <set>
+#include <string>
+#include <vector>
+
+namespace penumbra::api {
+
+namespace {
+
+struct DepthExceeded {};
+
+// Follows the parser's events to know the JSON pointer of the current position, which the
+// callback is not given, so a duplicate key can be reported where it is.
+class PathTracker {
+ public:
+  PathTracker(int max_depth, Diagnostics& diag) : max_depth_(max_depth), diag_(diag) {}
+
+  bool on_event(int depth, Json::parse_event_t event, const Json& parsed) {
+    switch (event) {
+      case Json::parse_event_t::object_start:
+      case Json::parse_event_t::array_start:
+        // `depth` counts the containers around this one; throwing is the only way to stop the
+        // parser from a callback (returning false merely discards the value).
+        if (depth >= max_depth_) throw DepthExceeded{};
+        enter_value();
+        frames_.push_back({event == Json::parse_event_t::array_start, 0, {}, {}});
+        break;
+      case Json::parse_event_t::key: {
+        Frame& frame = frames_.back();
+        frame.last_key = parsed.get<std::string>();
+        if (!frame.keys.insert(frame.last_key).second)
+          diag_.error(pointer() + "/" + escape_pointer_token(frame.last_key),
+                      "duplicate key: an object must not name the same member twice");
+        break;
+      }
+      case Json::parse_event_t::value:
+        enter_value();
+        break;
+      case Json::parse_event_t::object_end:
+      case Json::parse_event_t::array_end:
+        frames_.pop_back();
+        if (!tokens_.empty() && tokens_.size() > frames_.size()) tokens_.pop_back();
+        break;
+    }
+    return true;
+  }
+
+ private:
+  struct Frame {
+    bool is_array;
+    std::size_t next_index;
+    std::string last_key;
+    std::set<std::string> keys;
+  };
+
+  // A value begins inside the current container: remember its token if it is a container.
+  void enter_value() {
+    if (frames_.empty()) return;
+    Frame& parent = frames_.back();
+    pending_token_ = parent.is_array ? std::to_string(parent.next_index++)
+                                     : escape_pointer_token(parent.last_key);
+    // Only containers become part of the path; scalar values are leaves.
+    tokens_.resize(frames_.size() - 1);
+    tokens_.push_back(pending_token_);
+  }
+
+  std::string pointer() const {
+    std::string result;
+    // tokens_[i] is the token of frames_[i + 1] inside frames_[i].
+    for (std::size_t i = 0; i + 1 < frames_.size() && i < tokens_.size(); ++i)
+      result += "/" + tokens_[i];
+    return result;
+  }
+
+  int max_depth_;
+  Diagnostics& diag_;
+  std::vector<Frame> frames_;
+  std::vector<std::string> tokens_;
+  std::string pending_token_;
+};
+
+// nlohmann's messages start with "[json.exception.parse_error.101] " and may quote raw input
+// bytes; keep them readable and valid UTF-8.
+std::string clean_message(const std::string& what) {
+  std::string text = what;
+  if (!text.empty() && text[0] == '[') {
+    const auto end = text.find("] ");
+    if (end != std::string::npos) text.erase(0, end + 2);
+  }
+  constexpr std::size_t kMaxLength = 300;
+  if (text.size() > kMaxLength) text = text.substr(0, kMaxLength) + "...";
+  for (char& c : text) {
+    const unsigned char u = static_cast<unsigned char>(c);
+    if (u >= 0x80 || u < 0x20) c = '?';
+  }
+  return text;
+}
+
+}  // namespace
+
+JsonDocument parse_json_document(std::string_view text, int max_depth, Diagnostics& diag) {
+  JsonDocument document;
+  PathTracker tracker(max_depth, diag);
+  try {
+    document.value = Json::parse(
+        text.begin(), text.end(),
+        [&tracker](int depth, Json::parse_event_t event, Json& parsed) {
+          return tracker.on_event(depth, event, parsed);
+        },
+        /*allow_exceptions=*/true, /*ignore_comments=*/false);
+  } catch (const DepthExceeded&) {
+    document.syntax_error = true;
+    diag.error("", "JSON is nested deeper than the limit of " + std::to_string(max_depth) +
+                       " levels (max_json_depth)");
+  } catch (const Json::exception& e) {
+    document.syntax_error = true;
+    diag.error("", "invalid JSON: " + clean_message(e.what()));
+  }
+  if (document.syntax_error) document.value.reset();
+  return document;
+}
+
+}  // namespace penumbra::api

@@ -1,0 +1,81 @@
+#include "api/material_parser.h"
+
+namespace penumbra::api {
+
+namespace {
+
+// Reflectances: energy conservation needs each channel in [0, 1].
+const Range kReflectance = Range::closed(0, 1);
+const Range kRoughness = Range::closed(0, 1);
+// ior == 1 (an invisible interface) is allowed on purpose: the stress suite renders it.
+const Range kIor = Range::greater_than(0);
+
+Spectrum to_spectrum(const glm::dvec3& v) { return Spectrum(float(v.x), float(v.y), float(v.z)); }
+
+std::optional<MaterialParams> parse_material(const Json& value, const std::string& pointer,
+                                             Diagnostics& diag) {
+  ObjectReader reader(value, pointer, diag);
+  if (!reader.valid()) return std::nullopt;
+  const std::size_t errors_before = diag.error_count();
+  const auto type = reader.string("type", Presence::kRequired);
+  if (!type) return std::nullopt;
+
+  MaterialParams result;
+  if (*type == "diffuse") {
+    DiffuseParams p;
+    if (auto c = reader.vec3("color", kReflectance)) p.color = to_spectrum(*c);
+    result = p;
+  } else if (*type == "conductor") {
+    ConductorParams p;
+    if (auto c = reader.vec3("color", kReflectance)) p.color = to_spectrum(*c);
+    if (auto r = reader.number("roughness", kRoughness)) p.roughness = float(*r);
+    result = p;
+  } else if (*type == "dielectric") {
+    DielectricParams p;
+    if (auto ior = reader.number("ior", kIor)) p.ior = float(*ior);
+    if (auto r = reader.number("roughness", kRoughness)) p.roughness = float(*r);
+    if (auto a = reader.vec3("absorption", Range::at_least(0))) p.absorption = to_spectrum(*a);
+    result = p;
+  } else if (*type == "plastic") {
+    PlasticParams p;
+    if (auto c = reader.vec3("color", kReflectance)) p.color = to_spectrum(*c);
+    if (auto ior = reader.number("ior", kIor)) p.ior = float(*ior);
+    if (auto r = reader.number("roughness", kRoughness)) p.roughness = float(*r);
+    result = p;
+  } else {
+    reader.error("type", "unknown material type " + quote_user_string(*type) +
+                             did_you_mean(*type, {"diffuse", "conductor", "dielectric", "plastic"}) +
+                             "; expected diffuse, conductor, dielectric or plastic");
+    return std::nullopt;  // the other keys cannot be judged without a type
+  }
+  reader.report_unknown_keys();
+  if (diag.error_count() != errors_before) return std::nullopt;
+  return result;
+}
+
+}  // namespace
+
+ParsedMaterials parse_materials(const Json* materials, const std::string& pointer,
+                                const Limits& limits, Diagnostics& diag) {
+  ParsedMaterials parsed;
+  if (!materials) return parsed;
+  if (!materials->is_object()) {
+    diag.error(pointer, "must be an object mapping material names to materials");
+    return parsed;
+  }
+  if (materials->size() > std::size_t(limits.max_materials)) {
+    diag.error(pointer, std::to_string(materials->size()) + " materials exceed the limit of " +
+                            std::to_string(limits.max_materials) + " (max_materials)");
+    return parsed;
+  }
+  for (const auto& [name, value] : materials->items()) {
+    const auto material = parse_material(value, child_pointer(pointer, name), diag);
+    parsed.index[name] = uint32_t(parsed.names.size());
+    parsed.names.push_back(name);
+    // A placeholder keeps handles dense; it is never rendered because errors stop the load.
+    parsed.params.push_back(material.value_or(DiffuseParams{}));
+  }
+  return parsed;
+}
+
+}  // namespace penumbra::api

@@ -1,0 +1,160 @@
+#include "api/object_parser.h"
+
+#include <cmath>
+
+#include "api/mesh_parser.h"
+#include "api/transform.h"
+
+namespace penumbra::api {
+
+namespace {
+
+vec3 to_float(const glm::dvec3& v) { return vec3(float(v.x), float(v.y), float(v.z)); }
+
+bool within_coordinates(const glm::dvec3& v) {
+  for (int i = 0; i < 3; ++i)
+    if (!(std::abs(v[i]) <= kMaxCoordinate)) return false;
+  return true;
+}
+
+std::string coordinate_message() {
+  return "world-space coordinates must be within +-" + format_number(kMaxCoordinate);
+}
+
+// Reports on "transform" when the transform is what pushed values out of range.
+std::string_view blame(const ObjectReader& reader, std::string_view field) {
+  return reader.has("transform") ? std::string_view("transform") : field;
+}
+
+std::optional<SphereShape> parse_sphere(ObjectReader& reader, const AffineTransform& transform) {
+  const auto center = reader.vec3("center", Range::any(), Presence::kRequired);
+  const auto radius = reader.number("radius", Range::greater_than(0), Presence::kRequired);
+  if (!center || !radius) return std::nullopt;
+  const auto scale = transform.similarity_scale();
+  if (!scale) {
+    reader.error("transform",
+                 "a sphere's transform must be a similarity (uniform scale, rotation, "
+                 "translation): non-uniform scale or shear would make an ellipsoid");
+    return std::nullopt;
+  }
+  const glm::dvec3 world_center = transform.point(*center);
+  const double world_radius = *radius * *scale;
+  if (!within_coordinates(world_center) || !(world_radius <= kMaxCoordinate)) {
+    reader.error(blame(reader, "center"), coordinate_message());
+    return std::nullopt;
+  }
+  if (!(float(world_radius) > 0.f)) {
+    reader.error(blame(reader, "radius"), "the radius is too small for single precision");
+    return std::nullopt;
+  }
+  return SphereShape{to_float(world_center), float(world_radius)};
+}
+
+std::optional<QuadShape> parse_quad(ObjectReader& reader, const AffineTransform& transform) {
+  const auto origin = reader.vec3("origin", Range::any(), Presence::kRequired);
+  const auto u = reader.vec3("u", Range::any(), Presence::kRequired);
+  const auto v = reader.vec3("v", Range::any(), Presence::kRequired);
+  if (!origin || !u || !v) return std::nullopt;
+  const glm::dvec3 world_origin = transform.point(*origin);
+  const glm::dvec3 world_u = transform.vector(*u), world_v = transform.vector(*v);
+  if (!within_coordinates(world_origin) || !within_coordinates(world_origin + world_u) ||
+      !within_coordinates(world_origin + world_v) ||
+      !within_coordinates(world_origin + world_u + world_v)) {
+    reader.error(blame(reader, "origin"), coordinate_message());
+    return std::nullopt;
+  }
+  QuadShape quad{to_float(world_origin), to_float(world_u), to_float(world_v)};
+  // Judge the area on the single-precision vectors the renderer will use.
+  const double area = glm::length(glm::cross(glm::dvec3(quad.u), glm::dvec3(quad.v)));
+  if (!(area > 0) || float(area) == 0.f) {
+    reader.diagnostics().error(reader.pointer(),
+                               "zero-area quad: |u x v| must be > 0 (u and v nonzero and not "
+                               "parallel)");
+    return std::nullopt;
+  }
+  return quad;
+}
+
+}  // namespace
+
+ParsedObjects parse_objects(const Json* objects, const std::string& pointer,
+                            const ParsedMaterials& materials, double shutter_extent,
+                            const Limits& limits, Diagnostics& diag) {
+  ParsedObjects parsed;
+  parsed.material_used.assign(materials.names.size(), false);
+  if (!objects) return parsed;
+  if (!objects->is_array()) {
+    diag.error(pointer, "must be an array of objects");
+    return parsed;
+  }
+  if (objects->size() > std::size_t(limits.max_objects)) {
+    diag.error(pointer, std::to_string(objects->size()) + " objects exceed the limit of " +
+                            std::to_string(limits.max_objects) + " (max_objects)");
+    return parsed;
+  }
+
+  for (std::size_t i = 0; i < objects->size(); ++i) {
+    ObjectReader reader((*objects)[i], child_pointer(pointer, i), diag);
+    if (!reader.valid()) continue;
+    const std::size_t errors_before = diag.error_count();
+    ObjectDesc object;
+
+    const auto type = reader.string("type", Presence::kRequired);
+    if (const auto name = reader.string("material", Presence::kRequired)) {
+      const auto it = materials.index.find(*name);
+      if (it != materials.index.end()) {
+        object.material = it->second;
+        parsed.material_used[it->second] = true;
+      } else {
+        reader.error("material", "unknown material " + quote_user_string(*name) +
+                                     (materials.names.empty()
+                                          ? std::string(": /materials defines none")
+                                          : did_you_mean(*name, materials.names)));
+      }
+    }
+    if (auto e = reader.vec3("emission", Range::at_least(0))) object.emission = to_float(*e);
+    const glm::dvec3 velocity = reader.vec3("velocity").value_or(glm::dvec3(0.0));
+    const glm::dvec3 acceleration = reader.vec3("acceleration").value_or(glm::dvec3(0.0));
+    object.velocity = to_float(velocity);
+    object.acceleration = to_float(acceleration);
+    // position(t) = p + v t + a t^2 / 2 must stay representable over the whole shutter.
+    const double drift = glm::length(velocity) * shutter_extent +
+                         0.5 * glm::length(acceleration) * shutter_extent * shutter_extent;
+    if (!(drift <= kMaxCoordinate))
+      reader.error(glm::length(acceleration) > 0 ? "acceleration" : "velocity",
+                   "moves the object beyond +-" + format_number(kMaxCoordinate) +
+                       " within the shutter interval");
+
+    AffineTransform transform;
+    if (const Json* t = reader.get("transform")) {
+      const auto parsed_transform = parse_transform(*t, reader.pointer_of("transform"), diag);
+      if (!parsed_transform) continue;  // shape checks would only repeat the problem
+      transform = *parsed_transform;
+    }
+    if (!type) continue;
+
+    if (*type == "sphere") {
+      if (auto sphere = parse_sphere(reader, transform)) object.shape = *sphere;
+    } else if (*type == "quad") {
+      if (auto quad = parse_quad(reader, transform)) object.shape = *quad;
+    } else if (*type == "mesh") {
+      const int64_t budget = limits.max_triangles - parsed.triangles;
+      if (auto mesh = parse_mesh(reader, transform, budget, limits.max_triangles)) {
+        parsed.triangles += int64_t(mesh->indices.size() / 3);
+        object.shape = std::move(*mesh);
+      }
+    } else {
+      reader.error("type", "unknown object type " + quote_user_string(*type) +
+                               did_you_mean(*type, {"sphere", "quad", "mesh"}) +
+                               "; expected sphere, quad or mesh");
+      continue;  // the shape's keys cannot be judged without a type
+    }
+    reader.report_unknown_keys();
+    if (diag.error_count() != errors_before) continue;
+    if (!is_black(object.emission)) parsed.any_emission = true;
+    parsed.objects.push_back(std::move(object));
+  }
+  return parsed;
+}
+
+}  // namespace penumbra::api

@@ -1,0 +1,31 @@
+#pragma once
+// "objects": spheres, quads and triangle meshes with material, emission, motion and transform,
+// converted to world-space renderer shapes.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "api/json_reader.h"
+#include "api/material_parser.h"
+#include "api/scene_loader.h"
+#include "renderer/scene_input.h"
+
+namespace penumbra::api {
+
+// World-space coordinates (after transforms and motion) must stay within this magnitude: the
+// renderer squares distances in single precision (max ~3.4e38), and (2e18)^2 still fits.
+inline constexpr double kMaxCoordinate = 1e18;
+
+struct ParsedObjects {
+  std::vector<ObjectDesc> objects;
+  int64_t triangles = 0;             // mesh triangles kept, after dropping degenerate ones
+  std::vector<bool> material_used;   // per material handle
+  bool any_emission = false;
+};
+
+// `shutter_extent` = max(|open|, |close|): motion must not carry objects out of range by then.
+ParsedObjects parse_objects(const Json* objects, const std::string& pointer,
+                            const ParsedMaterials& materials, double shutter_extent,
+                            const Limits& limits, Diagnostics& diag);
+
+}  // namespace penumbra::api

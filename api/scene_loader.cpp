@@ -1,0 +1,57 @@
+#include "api/scene_loader.h"
+
+#include <filesystem>
+#include <fstream>
+#include <new>
+#include <sstream>
+
+#include "api/diagnostics.h"
+#include "api/json_document.h"
+#include "api/scene_parser.h"
+
+namespace penumbra::api {
+
+LoadResult load_scene(std::string_view json_text, const Limits& limits) {
+  LoadResult result;
+  Diagnostics diag;
+  try {
+    JsonDocument document = parse_json_document(json_text, limits.max_json_depth, diag);
+    if (document.syntax_error) {
+      result.kind = LoadErrorKind::kSyntax;
+    } else {
+      // Duplicate keys were reported by the document parser; keep checking everything else.
+      auto request = parse_scene(*document.value, limits, diag);
+      if (!diag.has_errors()) result.request = std::move(request);
+    }
+  } catch (const std::bad_alloc&) {
+    diag.error("", "the scene is too large to load (out of memory)");
+  } catch (const std::exception& e) {
+    // Reaching this is a bug in api/, but a caller (the HTTP service) must still get an answer.
+    diag.error("", std::string("internal error while loading the scene: ") + e.what());
+  }
+  if (diag.has_errors() && result.kind == LoadErrorKind::kNone) result.kind = LoadErrorKind::kInvalid;
+  if (!diag.has_errors() && !result.request) {  // cannot happen; never report success without one
+    diag.error("", "internal error: no scene was produced");
+    result.kind = LoadErrorKind::kInvalid;
+  }
+  result.errors = diag.take_errors();
+  result.warnings = diag.take_warnings();
+  return result;
+}
+
+LoadResult load_scene_file(const std::string& path, const Limits& limits) {
+  std::error_code ec;
+  std::ifstream file;
+  if (!std::filesystem::is_directory(path, ec)) file.open(path, std::ios::binary);
+  std::ostringstream text;
+  if (file.is_open()) text << file.rdbuf();
+  if (!file.is_open() || file.bad()) {
+    LoadResult result;
+    result.kind = LoadErrorKind::kInvalid;
+    result.errors.push_back({"", "cannot read file '" + path + "'"});
+    return result;
+  }
+  return load_scene(text.str(), limits);
+}
+
+}  // namespace penumbra::api

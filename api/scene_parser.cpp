@@ -1,0 +1,233 @@
+#include "api/scene_parser.h"
+
+#include <cmath>
+
+#include "api/material_parser.h"
+#include "api/object_parser.h"
+
+namespace penumbra::api {
+
+namespace {
+
+constexpr int64_t kSupportedVersion = 1;
+
+vec3 to_float(const glm::dvec3& v) { return vec3(float(v.x), float(v.y), float(v.z)); }
+
+std::string limit_text(int64_t value, const char* name) {
+  return "must be <= " + std::to_string(value) + " (" + name + ")";
+}
+
+void parse_render(const Json* value, const Limits& limits, RenderSettings& settings,
+                  Diagnostics& diag) {
+  if (!value) return;
+  ObjectReader r(*value, "/render", diag);
+  if (!r.valid()) return;
+  if (auto w = r.integer("width", Range::at_least(1))) {
+    if (*w > limits.max_width) r.error("width", limit_text(limits.max_width, "max_width"));
+    else settings.width = int(*w);
+  }
+  if (auto h = r.integer("height", Range::at_least(1))) {
+    if (*h > limits.max_height) r.error("height", limit_text(limits.max_height, "max_height"));
+    else settings.height = int(*h);
+  }
+  if (int64_t(settings.width) * settings.height > limits.max_pixels)
+    diag.error("/render", "width x height = " +
+                              std::to_string(int64_t(settings.width) * settings.height) +
+                              " pixels exceeds the limit of " + std::to_string(limits.max_pixels) +
+                              " (max_pixels)");
+  if (auto spp = r.integer("spp", Range::at_least(1))) {
+    if (*spp > limits.max_spp) r.error("spp", limit_text(limits.max_spp, "max_spp"));
+    else settings.spp = int(*spp);
+  }
+  if (auto depth = r.integer("max_depth")) {
+    if (*depth != -1 && *depth < 1)
+      r.error("max_depth", "must be >= 1, or -1 for unlimited");
+    else if (*depth > limits.max_depth)
+      r.error("max_depth", limit_text(limits.max_depth, "max_depth"));
+    else
+      settings.max_depth = int(*depth);
+  }
+  if (auto rr = r.integer("rr_depth", Range::at_least(1))) {
+    if (*rr > limits.max_depth) r.error("rr_depth", limit_text(limits.max_depth, "max_depth"));
+    else settings.rr_depth = int(*rr);
+  }
+  if (auto name = r.string("integrator")) {
+    if (*name == "path")
+      settings.integrator = IntegratorKind::kPath;
+    else if (*name == "distributed")
+      settings.integrator = IntegratorKind::kDistributed;
+    else
+      r.error("integrator", "unknown integrator " + quote_user_string(*name) +
+                                did_you_mean(*name, {"path", "distributed"}) +
+                                "; expected \"path\" or \"distributed\"");
+  }
+  if (auto seed = r.unsigned_integer("seed")) settings.seed = *seed;
+  if (auto t = r.number("noise_threshold", Range::at_least(0))) settings.noise_threshold = float(*t);
+  if (auto t = r.number("time_limit", Range::at_least(0))) {
+    if (*t > limits.max_time_limit)
+      r.error("time_limit", "must be <= " + format_number(limits.max_time_limit) +
+                                " seconds (max_time_limit)");
+    else
+      settings.time_limit = *t;
+  }
+  r.report_unknown_keys();
+}
+
+void parse_camera(const Json* value, CameraDesc& camera, Diagnostics& diag) {
+  if (!value) {
+    diag.error("/camera", "required field is missing");
+    return;
+  }
+  ObjectReader r(*value, "/camera", diag);
+  if (!r.valid()) return;
+  const Range coordinate = Range::closed(-kMaxCoordinate, kMaxCoordinate);
+  const auto position = r.vec3("position", coordinate, Presence::kRequired);
+  const auto look_at = r.vec3("look_at", coordinate, Presence::kRequired);
+  const auto up = r.vec3("up");
+  const auto fov = r.number("fov", Range::open(0, 180));
+  const auto aperture = r.number("aperture_radius", Range::at_least(0));
+  const auto focus = r.number("focus_distance", Range::greater_than(0));
+  if (const Json* shutter = r.get("shutter")) {
+    if (shutter->is_array() && shutter->size() == 2) {
+      const auto open = read_number((*shutter)[0], r.pointer_of("shutter") + "/0", diag);
+      const auto close = read_number((*shutter)[1], r.pointer_of("shutter") + "/1", diag);
+      if (open && close && *open > *close) {
+        r.error("shutter", "must be [open, close] with open <= close");
+      } else if (open && close) {
+        camera.shutter_open = float(*open);
+        camera.shutter_close = float(*close);
+      }
+    } else {
+      r.error("shutter", "must be an array of 2 numbers [open, close]");
+    }
+  }
+  r.report_unknown_keys();
+
+  if (fov) camera.fov_degrees = float(*fov);
+  if (aperture) camera.aperture_radius = float(*aperture);
+  if (!position || !look_at) return;
+  camera.position = to_float(*position);
+  camera.look_at = to_float(*look_at);
+  // Judge degeneracy in single precision: that is where the renderer builds its frame.
+  const glm::dvec3 view = glm::dvec3(camera.look_at) - glm::dvec3(camera.position);
+  const double distance = glm::length(view);
+  if (!(distance > 0) || float(distance) == 0.f) {
+    r.error("look_at", "must differ from position (the view direction would be undefined)");
+    return;
+  }
+  if (up) {
+    if (!(glm::length(*up) > 0)) {
+      r.error("up", "must be a nonzero vector");
+      return;
+    }
+    camera.up = to_float(glm::normalize(*up));
+  }
+  // sin of the angle between up and the view direction; below ~1e-4 the camera frame is
+  // numerically meaningless in single precision.
+  const double sine = glm::length(glm::cross(glm::normalize(view), glm::dvec3(camera.up)));
+  if (!(sine > 1e-4)) {
+    r.error(up ? "up" : "look_at",
+            "is parallel to the view direction (look_at - position); the camera's roll is undefined");
+    return;
+  }
+  camera.focus_distance = focus ? float(*focus) : float(distance);
+}
+
+void parse_lights(const Json* value, const Limits& limits, std::vector<LightDesc>& lights,
+                  bool& any_power, Diagnostics& diag) {
+  if (!value) return;
+  if (!value->is_array()) {
+    diag.error("/lights", "must be an array of lights");
+    return;
+  }
+  if (value->size() > std::size_t(limits.max_lights)) {
+    diag.error("/lights", std::to_string(value->size()) + " lights exceed the limit of " +
+                              std::to_string(limits.max_lights) + " (max_lights)");
+    return;
+  }
+  const Range coordinate = Range::closed(-kMaxCoordinate, kMaxCoordinate);
+  for (std::size_t i = 0; i < value->size(); ++i) {
+    ObjectReader r((*value)[i], child_pointer("/lights", i), diag);
+    if (!r.valid()) continue;
+    const auto type = r.string("type", Presence::kRequired);
+    if (!type) continue;
+    if (*type == "point") {
+      const auto position = r.vec3("position", coordinate, Presence::kRequired);
+      const auto intensity = r.vec3("intensity", Range::at_least(0), Presence::kRequired);
+      if (position && intensity) {
+        lights.push_back(PointLightDesc{to_float(*position), to_float(*intensity)});
+        any_power |= !is_black(to_float(*intensity));
+      }
+    } else if (*type == "directional") {
+      const auto direction = r.vec3("direction", Range::any(), Presence::kRequired);
+      const auto irradiance = r.vec3("irradiance", Range::at_least(0), Presence::kRequired);
+      if (direction && !(glm::length(*direction) > 0)) {
+        r.error("direction", "must be a nonzero vector");
+      } else if (direction && irradiance) {
+        lights.push_back(
+            DirectionalLightDesc{to_float(glm::normalize(*direction)), to_float(*irradiance)});
+        any_power |= !is_black(to_float(*irradiance));
+      }
+    } else {
+      r.error("type", "unknown light type " + quote_user_string(*type) +
+                          did_you_mean(*type, {"point", "directional"}) +
+                          "; expected point or directional");
+      continue;
+    }
+    r.report_unknown_keys();
+  }
+}
+
+}  // namespace
+
+std::optional<SceneRequest> parse_scene(const Json& document, const Limits& limits,
+                                        Diagnostics& diag) {
+  ObjectReader root(document, "", diag);
+  if (!root.valid()) return std::nullopt;
+  SceneRequest request;
+
+  if (const auto version = root.integer("version", Range::any(), Presence::kRequired);
+      version && *version != kSupportedVersion)
+    root.error("version", "unsupported scene format version " + std::to_string(*version) +
+                              "; this program reads version 1");
+  // "$schema" lets editors find scene.schema.json; it has no meaning for rendering.
+  root.string("$schema");
+
+  parse_render(root.get("render"), limits, request.settings, diag);
+  parse_camera(root.get("camera"), request.scene.camera, diag);
+
+  bool environment_lit = false;
+  if (const Json* environment = root.get("environment")) {
+    ObjectReader r(*environment, "/environment", diag);
+    if (auto radiance = r.vec3("radiance", Range::at_least(0), Presence::kRequired)) {
+      request.scene.environment = to_float(*radiance);
+      environment_lit = !is_black(request.scene.environment);
+    }
+    r.report_unknown_keys();
+  }
+
+  ParsedMaterials materials = parse_materials(root.get("materials"), "/materials", limits, diag);
+  const auto& camera = request.scene.camera;
+  const double shutter_extent =
+      std::max(std::abs(double(camera.shutter_open)), std::abs(double(camera.shutter_close)));
+  ParsedObjects objects =
+      parse_objects(root.get("objects"), "/objects", materials, shutter_extent, limits, diag);
+
+  bool lights_lit = false;
+  parse_lights(root.get("lights"), limits, request.scene.lights, lights_lit, diag);
+  root.report_unknown_keys();
+  if (diag.has_errors()) return std::nullopt;
+
+  for (std::size_t m = 0; m < materials.names.size(); ++m)
+    if (!objects.material_used[m])
+      diag.warning(child_pointer("/materials", materials.names[m]), "material is never used");
+  if (!objects.any_emission && !lights_lit && !environment_lit)
+    diag.warning("", "the scene has no light source (no emission, no lights with power, black "
+                     "environment): the image will be black");
+
+  request.scene.materials = std::move(materials.params);
+  request.scene.objects = std::move(objects.objects);
+  return request;
+}
+
+}  // namespace penumbra::api
