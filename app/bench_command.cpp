@@ -1,0 +1,86 @@
+// penumbra bench: the renderer's rays/s against Embree alone on the same scene, in one run.
+#include <algorithm>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "api/scene_loader.h"
+#include "app/commands.h"
+#include "app/option_parsing.h"
+#include "renderer/embree_baseline.h"
+#include "renderer/render.h"
+
+namespace penumbra::app {
+namespace {
+
+const char* kUsage =
+    "usage: penumbra bench [SCENE.json] [options]\n"
+    "\n"
+    "Renders the scene with the path integrator and traces the same kind of rays with Embree\n"
+    "alone (camera, shadow and bounce rays, no shading), alternating the two REPEAT times, and\n"
+    "prints both rays/s and their ratio (median of the runs). Default scene: scenes/cornell_box.json.\n"
+    "  --repeat N      alternating runs of each (default 5)\n"
+    "  --spp, --width, --height, --threads, --max-depth, --seed   as for render\n";
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0.0 : v[v.size() / 2];
+}
+
+}  // namespace
+
+int run_bench(int argc, char** argv) {
+  std::string scene_path = "scenes/cornell_box.json";
+  long long repeat = 5;
+  OptionalOverrides ov;
+  OptionParser p(argc, argv);
+  bool scene_given = false;
+  while (p.next()) {
+    if (p.is("-h") || p.is("--help")) {
+      std::fputs(kUsage, stdout);
+      return 0;
+    } else if (p.is("--repeat")) {
+      if (!p.int_value(1, 1000, &repeat)) return p.fail(kUsage);
+    } else if (ov.parse(p)) {
+      if (p.failed()) return p.fail(kUsage);
+    } else if (p.positional() && !scene_given) {
+      scene_path = p.arg();
+      scene_given = true;
+    } else {
+      return p.fail(kUsage, "unexpected argument " + std::string(p.arg()));
+    }
+  }
+  api::LoadResult loaded = api::load_scene_file(scene_path);
+  if (!loaded.ok()) {
+    for (const auto& e : loaded.errors) std::fprintf(stderr, "%s: %s\n", scene_path.c_str(), e.to_string().c_str());
+    return 1;
+  }
+  RenderSettings settings = loaded.request->settings;
+  settings.integrator = IntegratorKind::kPath;
+  if (const std::string err = ov.apply(&settings); !err.empty()) {
+    std::fprintf(stderr, "penumbra bench: %s\n", err.c_str());
+    return 2;
+  }
+  const auto scene = Scene::build(loaded.request->scene);
+
+  std::vector<double> renderer_mrays, embree_mrays, ratios;
+  for (long long i = 0; i < repeat; ++i) {
+    const RenderResult r = render(*scene, settings);
+    const BaselineResult b = trace_embree_baseline(*scene, settings);
+    renderer_mrays.push_back(r.stats.mrays_per_second());
+    embree_mrays.push_back(b.mrays_per_second());
+    ratios.push_back(r.stats.mrays_per_second() / b.mrays_per_second());
+    std::printf("run %lld: renderer %.2f Mrays/s (%.3f s, %.2f rays/sample)  embree-only %.2f Mrays/s (%.3f s)  ratio %.3f\n",
+                i + 1, renderer_mrays.back(), r.stats.seconds,
+                double(r.stats.rays) / double(std::max<uint64_t>(1, r.stats.camera_samples)),
+                embree_mrays.back(), b.seconds, ratios.back());
+  }
+  std::printf("scene %s, %dx%d, %d spp, max_depth %d, threads %s\n", scene_path.c_str(), settings.width,
+              settings.height, settings.spp, settings.max_depth,
+              settings.threads > 0 ? std::to_string(settings.threads).c_str() : "all");
+  std::printf("median: renderer %.2f Mrays/s, embree-only %.2f Mrays/s, ratio %.3f\n",
+              median(renderer_mrays), median(embree_mrays), median(ratios));
+  return 0;
+}
+
+}  // namespace penumbra::app

@@ -1,0 +1,89 @@
+#pragma once
+// Owen-scrambled Sobol sampler, padded in 2D pairs (Burley 2020, "Practical Hash-based Owen
+// Scrambling", JCGT 9(4)). Every value is a pure function of (seed, pixel, sample index,
+// dimension), so images do not depend on threads, tiles or the order samples are taken in.
+#include <cstdint>
+
+#include "renderer/math.h"
+
+namespace penumbra {
+
+inline uint32_t reverse_bits32(uint32_t x) {
+  x = ((x & 0x55555555u) << 1) | ((x >> 1) & 0x55555555u);
+  x = ((x & 0x33333333u) << 2) | ((x >> 2) & 0x33333333u);
+  x = ((x & 0x0f0f0f0fu) << 4) | ((x >> 4) & 0x0f0f0f0fu);
+  x = ((x & 0x00ff00ffu) << 8) | ((x >> 8) & 0x00ff00ffu);
+  return (x << 16) | (x >> 16);
+}
+
+// 64-bit finaliser of SplitMix64 (Steele et al. 2014); used to derive independent seeds.
+inline uint64_t mix64(uint64_t x) {
+  x ^= x >> 30;
+  x *= 0xbf58476d1ce4e5b9ull;
+  x ^= x >> 27;
+  x *= 0x94d049bb133111ebull;
+  x ^= x >> 31;
+  return x;
+}
+inline uint64_t hash_combine(uint64_t a, uint64_t b) { return mix64(a ^ (mix64(b) + 0x9e3779b97f4a7c15ull)); }
+
+// Laine-Karras style permutation (only lower bits influence higher ones), with the constants
+// proposed by N. Vegdahl (2021) as an improvement on Burley's. Applied to bit-reversed values it
+// is a nested uniform (Owen) scramble.
+inline uint32_t laine_karras_permutation(uint32_t x, uint32_t seed) {
+  x ^= x * 0x3d20adeau;
+  x += seed;
+  x *= (seed >> 16) | 1u;
+  x ^= x * 0x05526c56u;
+  x ^= x * 0x53a22864u;
+  return x;
+}
+inline uint32_t nested_uniform_scramble(uint32_t x, uint32_t seed) {
+  return reverse_bits32(laine_karras_permutation(reverse_bits32(x), seed));
+}
+
+// First two Sobol dimensions, as 0.32 fixed point. Dimension 0 is van der Corput; dimension 1
+// uses the direction numbers of the primitive polynomial x + 1 (v_{k+1} = v_k ^ (v_k >> 1)).
+inline uint32_t sobol_dimension0(uint32_t index) { return reverse_bits32(index); }
+inline uint32_t sobol_dimension1(uint32_t index) {
+  uint32_t result = 0;
+  for (uint32_t v = 1u << 31; index; index >>= 1, v ^= v >> 1)
+    if (index & 1u) result ^= v;
+  return result;
+}
+
+inline float fixed_to_unit_float(uint32_t x) { return float(x >> 8) * 0x1p-24f; }
+
+class Sampler {
+ public:
+  explicit Sampler(uint64_t seed) : seed_(mix64(seed + 0x51ed270b27c3a4f1ull)) {}
+
+  void start_pixel_sample(int x, int y, uint32_t sample_index) {
+    pixel_seed_ = hash_combine(seed_, (uint64_t(uint32_t(y)) << 32) | uint32_t(x));
+    index_ = sample_index;
+    dimension_ = 0;
+  }
+
+  float get_1d() {
+    const uint64_t h = hash_combine(pixel_seed_, dimension_++);
+    const uint32_t shuffled = nested_uniform_scramble(index_, uint32_t(h));
+    return fixed_to_unit_float(nested_uniform_scramble(sobol_dimension0(shuffled), uint32_t(h >> 32)));
+  }
+
+  vec2 get_2d() {
+    const uint64_t h = hash_combine(pixel_seed_, dimension_++);
+    const uint64_t h2 = mix64(h);
+    const uint32_t shuffled = nested_uniform_scramble(index_, uint32_t(h));
+    return vec2(
+        fixed_to_unit_float(nested_uniform_scramble(sobol_dimension0(shuffled), uint32_t(h >> 32))),
+        fixed_to_unit_float(nested_uniform_scramble(sobol_dimension1(shuffled), uint32_t(h2))));
+  }
+
+ private:
+  uint64_t seed_;
+  uint64_t pixel_seed_ = 0;
+  uint32_t index_ = 0;
+  uint64_t dimension_ = 0;
+};
+
+}  // namespace penumbra
