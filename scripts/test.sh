@@ -1,0 +1,8 @@
+#!/usr/bin/env bash
+# The test command: installs the dependencies, builds, and runs the whole test suite (ctest).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+./scripts/install-deps.sh
+./scripts/build.sh
+BUILD_DIR=${BUILD_DIR:-build}
+ctest --test-dir "$BUILD_DIR" --output-on-failure -j"$(nproc)" --timeout 300 "$@"
