@@ -104,7 +104,13 @@ std::string closest_match(std::string_view word, const std::vector<std::string>&
   const std::size_t allowed = std::clamp<std::size_t>(std::max(word.size(), best.size()) / 3, 1, 3);
   // Replacing every character is no typo ("x" is not a misspelt "g").
   const bool plausible = best_distance < std::max(word.size(), best.size());
-  return best_distance <= allowed && plausible ? best : "";
+  if (best_distance <= allowed && plausible) return best;
+  // A shortened name ("aperture" for "aperture_radius") is far in edits but obvious.
+  if (word.size() >= 3)
+    for (const std::string& candidate : candidates)
+      if (candidate.size() > word.size() && candidate.compare(0, word.size(), word) == 0)
+        return candidate;
+  return "";
 }
 
 std::string did_you_mean(std::string_view word, const std::vector<std::string>& candidates) {

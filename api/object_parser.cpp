@@ -125,23 +125,35 @@ ParsedObjects parse_objects(const Json* objects, const std::string& pointer,
                    "moves the object beyond +-" + format_number(kMaxCoordinate) +
                        " within the shutter interval");
 
+    bool transform_ok = true;
     AffineTransform transform;
     if (const Json* t = reader.get("transform")) {
       const auto parsed_transform = parse_transform(*t, reader.pointer_of("transform"), diag);
-      if (!parsed_transform) continue;  // shape checks would only repeat the problem
-      transform = *parsed_transform;
+      // Without a valid transform, shape checks would only repeat the problem; the shape's keys
+      // are still declared so that typos next to it are reported.
+      transform_ok = parsed_transform.has_value();
+      if (parsed_transform) transform = *parsed_transform;
     }
     if (!type) continue;
 
     if (*type == "sphere") {
-      if (auto sphere = parse_sphere(reader, transform)) object.shape = *sphere;
+      reader.allow({"center", "radius"});
+      if (transform_ok) {
+        if (auto sphere = parse_sphere(reader, transform)) object.shape = *sphere;
+      }
     } else if (*type == "quad") {
-      if (auto quad = parse_quad(reader, transform)) object.shape = *quad;
+      reader.allow({"origin", "u", "v"});
+      if (transform_ok) {
+        if (auto quad = parse_quad(reader, transform)) object.shape = *quad;
+      }
     } else if (*type == "mesh") {
+      reader.allow({"positions", "indices", "normals"});
       const int64_t budget = limits.max_triangles - parsed.triangles;
-      if (auto mesh = parse_mesh(reader, transform, budget, limits.max_triangles)) {
-        parsed.triangles += int64_t(mesh->indices.size() / 3);
-        object.shape = std::move(*mesh);
+      if (transform_ok) {
+        if (auto mesh = parse_mesh(reader, transform, budget, limits.max_triangles)) {
+          parsed.triangles += int64_t(mesh->indices.size() / 3);
+          object.shape = std::move(*mesh);
+        }
       }
     } else {
       reader.error("type", "unknown object type " + quote_user_string(*type) +
