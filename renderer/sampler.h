@@ -45,11 +45,26 @@ inline uint32_t nested_uniform_scramble(uint32_t x, uint32_t seed) {
 // First two Sobol dimensions, as 0.32 fixed point. Dimension 0 is van der Corput; dimension 1
 // uses the direction numbers of the primitive polynomial x + 1 (v_{k+1} = v_k ^ (v_k >> 1)).
 inline uint32_t sobol_dimension0(uint32_t index) { return reverse_bits32(index); }
-inline uint32_t sobol_dimension1(uint32_t index) {
+inline uint32_t sobol_dimension1_reference(uint32_t index) {
   uint32_t result = 0;
   for (uint32_t v = 1u << 31; index; index >>= 1, v ^= v >> 1)
     if (index & 1u) result ^= v;
   return result;
+}
+// The same, a byte at a time: the generator matrix is linear over GF(2), so the image of each
+// index byte is looked up in a 4 x 256 table and the four parts XORed (scrambled indices use all
+// 32 bits, which made the bit loop the sampler's main cost).
+struct SobolDimension1Table {
+  uint32_t entries[4][256];
+  SobolDimension1Table() {
+    for (int k = 0; k < 4; ++k)
+      for (uint32_t b = 0; b < 256; ++b) entries[k][b] = sobol_dimension1_reference(b << (8 * k));
+  }
+};
+inline uint32_t sobol_dimension1(uint32_t index) {
+  static const SobolDimension1Table table;
+  return table.entries[0][index & 0xffu] ^ table.entries[1][(index >> 8) & 0xffu] ^
+         table.entries[2][(index >> 16) & 0xffu] ^ table.entries[3][index >> 24];
 }
 
 inline float fixed_to_unit_float(uint32_t x) { return float(x >> 8) * 0x1p-24f; }
@@ -67,7 +82,8 @@ class Sampler {
   float get_1d() {
     const uint64_t h = hash_combine(pixel_seed_, dimension_++);
     const uint32_t shuffled = nested_uniform_scramble(index_, uint32_t(h));
-    return fixed_to_unit_float(nested_uniform_scramble(sobol_dimension0(shuffled), uint32_t(h >> 32)));
+    // nested_uniform_scramble(reverse(i)) = reverse(LK(i)): two reversals cancel.
+    return fixed_to_unit_float(reverse_bits32(laine_karras_permutation(shuffled, uint32_t(h >> 32))));
   }
 
   vec2 get_2d() {
@@ -75,7 +91,7 @@ class Sampler {
     const uint64_t h2 = mix64(h);
     const uint32_t shuffled = nested_uniform_scramble(index_, uint32_t(h));
     return vec2(
-        fixed_to_unit_float(nested_uniform_scramble(sobol_dimension0(shuffled), uint32_t(h >> 32))),
+        fixed_to_unit_float(reverse_bits32(laine_karras_permutation(shuffled, uint32_t(h >> 32)))),
         fixed_to_unit_float(nested_uniform_scramble(sobol_dimension1(shuffled), uint32_t(h2))));
   }
 

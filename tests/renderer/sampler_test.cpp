@@ -77,3 +77,17 @@ TEST(Sampler, PixelsAndDimensionsAreDecorrelated) {
 
 }  // namespace
 }  // namespace penumbra
+
+namespace penumbra {
+namespace {
+TEST(Sampler, TableDrivenSobolMatchesBitLoop) {
+  uint32_t x = 12345;
+  for (int i = 0; i < 100000; ++i) {
+    x = x * 1664525u + 1013904223u;
+    ASSERT_EQ(sobol_dimension1(x), sobol_dimension1_reference(x)) << x;
+  }
+  EXPECT_EQ(nested_uniform_scramble(sobol_dimension0(77u), 991u),
+            reverse_bits32(laine_karras_permutation(77u, 991u)));
+}
+}  // namespace
+}  // namespace penumbra
