@@ -1,0 +1,274 @@
+#include "server/server_config.h"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <thread>
+
+namespace penumbra::server {
+namespace {
+
+std::optional<long long> parse_int(const std::string& s, long long lo, long long hi) {
+  if (s.empty()) return std::nullopt;
+  char* end = nullptr;
+  errno = 0;
+  const long long v = std::strtoll(s.c_str(), &end, 10);
+  if (errno || *end != '\0' || v < lo || v > hi) return std::nullopt;
+  return v;
+}
+
+std::optional<double> parse_number(const std::string& s) {
+  if (s.empty()) return std::nullopt;
+  char* end = nullptr;
+  errno = 0;
+  const double v = std::strtod(s.c_str(), &end);
+  if (errno || *end != '\0' || !std::isfinite(v)) return std::nullopt;
+  return v;
+}
+
+bool parse_bool(const std::string& s) { return s == "1" || s == "true" || s == "yes" || s == "on"; }
+
+// One setting: its flag, its environment variable, and how a text value is applied.
+struct Setting {
+  const char* flag;
+  const char* env;
+  bool takes_value;
+  std::function<std::string(ServerConfig&, const std::string&)> apply;  // returns an error or ""
+};
+
+std::string bad(const char* flag, const std::string& value, const char* expected) {
+  return std::string("invalid value '") + value + "' for " + flag + " (expected " + expected + ")";
+}
+
+std::vector<Setting> settings() {
+  auto int_setting = [](const char* flag, const char* env, long long lo, long long hi,
+                        auto member) {
+    return Setting{flag, env, true, [=](ServerConfig& c, const std::string& v) -> std::string {
+                     const auto n = parse_int(v, lo, hi);
+                     if (!n) return bad(flag, v, ("an integer in [" + std::to_string(lo) + ", " +
+                                                  std::to_string(hi) + "]").c_str());
+                     c.*member = static_cast<std::remove_reference_t<decltype(c.*member)>>(*n);
+                     return "";
+                   }};
+  };
+  auto duration_setting = [](const char* flag, const char* env, double lo, auto member) {
+    return Setting{flag, env, true, [=](ServerConfig& c, const std::string& v) -> std::string {
+                     const auto d = parse_duration(v);
+                     if (!d || *d < lo) return bad(flag, v, "a duration such as 30s, 15m, 24h");
+                     c.*member = *d;
+                     return "";
+                   }};
+  };
+  return {
+      {"--host", "PENUMBRA_HOST", true,
+       [](ServerConfig& c, const std::string& v) -> std::string {
+         if (v.empty()) return "empty --host";
+         c.host = v;
+         return "";
+       }},
+      int_setting("--port", "PENUMBRA_PORT", 0, 65535, &ServerConfig::port),
+      {"--data-dir", "PENUMBRA_DATA_DIR", true,
+       [](ServerConfig& c, const std::string& v) -> std::string {
+         if (v.empty()) return "empty --data-dir";
+         c.data_dir = v;
+         return "";
+       }},
+      int_setting("--workers", "PENUMBRA_WORKERS", 1, 256, &ServerConfig::workers),
+      int_setting("--render-threads", "PENUMBRA_RENDER_THREADS", 0, 4096,
+                  &ServerConfig::render_threads),
+      int_setting("--max-queue", "PENUMBRA_MAX_QUEUE", 0, 1'000'000, &ServerConfig::max_queue),
+      {"--max-body", "PENUMBRA_MAX_BODY", true,
+       [](ServerConfig& c, const std::string& v) -> std::string {
+         const auto b = parse_byte_size(v);
+         if (!b || *b == 0) return bad("--max-body", v, "a size such as 16M");
+         c.max_body_bytes = *b;
+         return "";
+       }},
+      int_setting("--max-pixels", "PENUMBRA_MAX_PIXELS", 1, int64_t(1) << 40,
+                  &ServerConfig::max_pixels),
+      int_setting("--max-spp", "PENUMBRA_MAX_SPP", 1, 1 << 20, &ServerConfig::max_spp),
+      int_setting("--max-triangles", "PENUMBRA_MAX_TRIANGLES", 0, int64_t(1) << 32,
+                  &ServerConfig::max_triangles),
+      duration_setting("--max-render-time", "PENUMBRA_MAX_RENDER_TIME", 0.001,
+                       &ServerConfig::max_render_seconds),
+      duration_setting("--retention", "PENUMBRA_RETENTION", 0.001, &ServerConfig::retention_seconds),
+      {"--token", "PENUMBRA_TOKEN", true,
+       [](ServerConfig& c, const std::string& v) -> std::string {
+         c.token = v;
+         return "";
+       }},
+      {"--insecure", "PENUMBRA_INSECURE", false,
+       [](ServerConfig& c, const std::string& v) -> std::string {
+         c.insecure = parse_bool(v);
+         return "";
+       }},
+      int_setting("--http-threads", "PENUMBRA_HTTP_THREADS", 2, 1024, &ServerConfig::http_threads),
+      duration_setting("--read-timeout", "PENUMBRA_READ_TIMEOUT", 0.001,
+                       &ServerConfig::read_timeout_seconds),
+      duration_setting("--write-timeout", "PENUMBRA_WRITE_TIMEOUT", 0.001,
+                       &ServerConfig::write_timeout_seconds),
+      int_setting("--keep-alive", "PENUMBRA_KEEP_ALIVE", 0, 3600, &ServerConfig::keep_alive_seconds),
+      int_setting("--keep-alive-requests", "PENUMBRA_KEEP_ALIVE_REQUESTS", 1, 1'000'000,
+                  &ServerConfig::keep_alive_max_requests),
+      duration_setting("--drain", "PENUMBRA_DRAIN", 0.0, &ServerConfig::drain_seconds),
+      {"--access-log", "PENUMBRA_ACCESS_LOG", false,
+       [](ServerConfig& c, const std::string& v) -> std::string {
+         c.access_log = parse_bool(v);
+         return "";
+       }},
+  };
+}
+
+}  // namespace
+
+api::Limits ServerConfig::scene_limits() const {
+  api::Limits limits;
+  limits.max_pixels = max_pixels;
+  limits.max_spp = max_spp;
+  limits.max_triangles = max_triangles;
+  limits.max_time_limit = max_render_seconds;
+  return limits;
+}
+
+int ServerConfig::threads_per_job() const {
+  if (render_threads > 0) return render_threads;
+  const int cores = int(std::max(1u, std::thread::hardware_concurrency()));
+  return std::max(1, cores / std::max(1, workers));
+}
+
+std::optional<double> parse_duration(const std::string& text) {
+  if (text.empty()) return std::nullopt;
+  double unit = 1.0;
+  std::string number = text;
+  switch (text.back()) {
+    case 's': unit = 1; break;
+    case 'm': unit = 60; break;
+    case 'h': unit = 3600; break;
+    case 'd': unit = 86400; break;
+    default: unit = 0;
+  }
+  if (unit != 0) number.pop_back();
+  else unit = 1;
+  if (text.size() > 2 && text.substr(text.size() - 2) == "ms") {
+    number = text.substr(0, text.size() - 2);
+    unit = 0.001;
+  }
+  const auto v = parse_number(number);
+  if (!v || *v < 0) return std::nullopt;
+  return *v * unit;
+}
+
+std::optional<std::size_t> parse_byte_size(const std::string& text) {
+  if (text.empty()) return std::nullopt;
+  std::size_t unit = 1;
+  std::string number = text;
+  switch (text.back()) {
+    case 'k': case 'K': unit = std::size_t(1) << 10; break;
+    case 'M': unit = std::size_t(1) << 20; break;
+    case 'G': unit = std::size_t(1) << 30; break;
+    default: unit = 0;
+  }
+  if (unit) number.pop_back();
+  else unit = 1;
+  const auto v = parse_int(number, 0, (int64_t(1) << 40));
+  if (!v) return std::nullopt;
+  return std::size_t(*v) * unit;
+}
+
+bool is_loopback_host(const std::string& host) {
+  if (host == "localhost" || host == "::1" || host == "[::1]") return true;
+  return host.rfind("127.", 0) == 0;
+}
+
+ConfigParse parse_server_config(const std::vector<std::string>& args,
+                                const std::function<const char*(const char*)>& getenv) {
+  ConfigParse out;
+  ServerConfig config;
+  const auto all = settings();
+  for (const Setting& s : all) {
+    if (const char* v = getenv(s.env)) {
+      if (std::string err = s.apply(config, v); !err.empty()) {
+        out.error = err + " from " + s.env;
+        return out;
+      }
+    }
+  }
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& arg = args[i];
+    if (arg == "-h" || arg == "--help") {
+      out.help = true;
+      return out;
+    }
+    std::string name = arg, value;
+    bool has_inline = false;
+    if (const auto eq = arg.find('='); arg.rfind("--", 0) == 0 && eq != std::string::npos) {
+      name = arg.substr(0, eq);
+      value = arg.substr(eq + 1);
+      has_inline = true;
+    }
+    const auto it = std::find_if(all.begin(), all.end(),
+                                 [&](const Setting& s) { return name == s.flag; });
+    if (it == all.end()) {
+      out.error = "unknown option " + arg;
+      return out;
+    }
+    if (it->takes_value && !has_inline) {
+      if (i + 1 >= args.size()) {
+        out.error = "missing value for " + name;
+        return out;
+      }
+      value = args[++i];
+    } else if (!it->takes_value && !has_inline) {
+      value = "1";
+    }
+    if (std::string err = it->apply(config, value); !err.empty()) {
+      out.error = err;
+      return out;
+    }
+  }
+  out.config = config;
+  return out;
+}
+
+const char* serve_usage() {
+  return "usage: penumbra serve [options]\n"
+         "\n"
+         "Runs the HTTP render service (API under /v1, see docs/http-api.md). Every option can also\n"
+         "be set by the environment variable in brackets; a flag wins over the variable.\n"
+         "\n"
+         "  --host ADDR              listen address (default 127.0.0.1) [PENUMBRA_HOST]\n"
+         "  --port N                 listen port, 0 = ephemeral (default 8080) [PENUMBRA_PORT]\n"
+         "  --data-dir DIR           job database and result images (default ./penumbra-data)\n"
+         "                           [PENUMBRA_DATA_DIR]\n"
+         "  --workers N              jobs rendered side by side (default 1) [PENUMBRA_WORKERS]\n"
+         "  --render-threads N       threads per job, 0 = cores / workers (default 0)\n"
+         "                           [PENUMBRA_RENDER_THREADS]\n"
+         "  --max-queue N            queued jobs before POST answers 429 (default 64)\n"
+         "                           [PENUMBRA_MAX_QUEUE]\n"
+         "  --max-body SIZE          request body limit, e.g. 512k, 16M (default 16M) [PENUMBRA_MAX_BODY]\n"
+         "  --max-pixels N           width x height limit (default 16777216) [PENUMBRA_MAX_PIXELS]\n"
+         "  --max-spp N              samples per pixel limit (default 65536) [PENUMBRA_MAX_SPP]\n"
+         "  --max-triangles N        triangles per scene (default 2000000) [PENUMBRA_MAX_TRIANGLES]\n"
+         "  --max-render-time DUR    render time per job; longer renders stop there and keep\n"
+         "                           their image (default 10m) [PENUMBRA_MAX_RENDER_TIME]\n"
+         "  --retention DUR          finished jobs and results are deleted after this\n"
+         "                           (default 24h) [PENUMBRA_RETENTION]\n"
+         "  --token TOKEN            require 'Authorization: Bearer TOKEN' on every route but\n"
+         "                           /healthz (default: none) [PENUMBRA_TOKEN]\n"
+         "  --insecure               allow a non-loopback --host without a token [PENUMBRA_INSECURE=1]\n"
+         "  --http-threads N         HTTP connection threads (default 8) [PENUMBRA_HTTP_THREADS]\n"
+         "  --read-timeout DUR       socket read timeout (default 10s) [PENUMBRA_READ_TIMEOUT]\n"
+         "  --write-timeout DUR      socket write timeout (default 30s) [PENUMBRA_WRITE_TIMEOUT]\n"
+         "  --keep-alive SECONDS     idle keep-alive connection timeout (default 5)\n"
+         "                           [PENUMBRA_KEEP_ALIVE]\n"
+         "  --keep-alive-requests N  requests per connection (default 100)\n"
+         "                           [PENUMBRA_KEEP_ALIVE_REQUESTS]\n"
+         "  --drain DUR              after SIGTERM, /readyz answers 503 this long before the port\n"
+         "                           closes (default 1s) [PENUMBRA_DRAIN]\n"
+         "  --access-log             one line per request on stderr [PENUMBRA_ACCESS_LOG=1]\n"
+         "\n"
+         "Durations: 90, 90s, 15m, 24h, 7d, 250ms.\n";
+}
+
+}  // namespace penumbra::server
