@@ -1,6 +1,8 @@
 #include "renderer/integrator.h"
 
+#include <array>
 #include <climits>
+#include <utility>
 
 #include "renderer/frame.h"
 #include "renderer/sampling.h"
@@ -18,7 +20,19 @@ bool geometry_agrees(const vec3& wi_world, const vec3& wo_world, const vec3& ng,
   return geo != 0.f && (geo > 0.f) == (shade > 0.f);
 }
 
-template <bool kDistributed>
+// Feature bits an instantiation is compiled for. A bit that is off removes that code from the
+// loop entirely (Cycles compiles only the kernel features a scene uses); a bit that is on keeps
+// the run-time test, so the all-on instantiation is the generic integrator and any
+// instantiation gives bit-identical images on the scenes it is chosen for.
+enum IntegratorFeature : uint32_t {
+  kFeatureAbsorption = 1u << 0,    // Beer-Lambert attenuation inside dielectrics
+  kFeatureTransmission = 1u << 1,  // refraction: eta bookkeeping for Russian roulette
+  kFeatureEnvironment = 1u << 2,   // escaping rays gather the environment
+  kFeatureLights = 1u << 3,        // next-event estimation (any light at all)
+  kFeatureAll = (1u << 4) - 1,
+};
+
+template <bool kDistributed, uint32_t kFeatures>
 Spectrum integrate(const SceneImpl& scene, const IntegratorSettings& settings, Ray ray,
                    Sampler& sampler, PathCounters& counters) {
   Spectrum radiance(0.f), beta(1.f);
@@ -35,7 +49,8 @@ Spectrum integrate(const SceneImpl& scene, const IntegratorSettings& settings, R
     SurfaceHit hit;
     ++counters.rays;
     if (!scene.intersect(ray, &hit)) {
-      if (scene.features.environment) {
+      if constexpr ((kFeatures & kFeatureEnvironment) != 0) {
+        if (!scene.features.environment) break;
         const float w = prev_delta ? 1.f : power_heuristic(prev_pdf, lights.environment_pdf());
         radiance += beta * scene.environment * w;
       }
@@ -46,9 +61,11 @@ Spectrum integrate(const SceneImpl& scene, const IntegratorSettings& settings, R
     const bool front = glm::dot(ray.direction, hit.ng) < 0.f;
 
     // Beer-Lambert: a segment that ends on the back of an absorbing dielectric ran inside it.
-    if (scene.features.absorption && !front) {
-      const Spectrum sigma = material.absorption();
-      if (!is_black(sigma)) beta *= glm::exp(-sigma * hit.t);
+    if constexpr ((kFeatures & kFeatureAbsorption) != 0) {
+      if (scene.features.absorption && !front) {
+        const Spectrum sigma = material.absorption();
+        if (!is_black(sigma)) beta *= glm::exp(-sigma * hit.t);
+      }
     }
     if (obj.light >= 0 && front) {
       float w = 1.f;
@@ -64,7 +81,7 @@ Spectrum integrate(const SceneImpl& scene, const IntegratorSettings& settings, R
     const uint32_t lobes = material.lobes();
 
     // Next-event estimation.
-    if ((lobes & ~uint32_t(kLobeDelta)) && !lights.empty()) {
+    if ((kFeatures & kFeatureLights) != 0 && (lobes & ~uint32_t(kLobeDelta)) && !lights.empty()) {
       const float u_light = sampler.get_1d();
       const vec2 u_point = sampler.get_2d();
       LightSample ls;
@@ -118,7 +135,7 @@ Spectrum integrate(const SceneImpl& scene, const IntegratorSettings& settings, R
     prev_pdf = bs->pdf;
     prev_delta = (bs->lobe & kLobeDelta) != 0;
     prev_p = hit.p;
-    eta *= bs->eta;
+    if constexpr ((kFeatures & kFeatureTransmission) != 0) eta *= bs->eta;
     ray = Ray{offset_ray_origin(hit.p, hit.p_error, hit.ng, wo_world), wo_world, ray.time};
 
     const float beta_max = max_component(beta);
@@ -134,11 +151,33 @@ Spectrum integrate(const SceneImpl& scene, const IntegratorSettings& settings, R
   return radiance;
 }
 
+template <bool kDistributed, size_t... kMasks>
+constexpr std::array<IntegrateFn, sizeof...(kMasks)> make_table(std::index_sequence<kMasks...>) {
+  return {&integrate<kDistributed, uint32_t(kMasks)>...};
+}
+constexpr auto kPathTable = make_table<false>(std::make_index_sequence<kFeatureAll + 1>{});
+constexpr auto kDistributedTable = make_table<true>(std::make_index_sequence<kFeatureAll + 1>{});
+
 }  // namespace
 
+uint32_t integrator_feature_mask(const SceneFeatures& f) {
+  uint32_t mask = 0;
+  if (f.absorption) mask |= kFeatureAbsorption;
+  // An absorbing material is a dielectric, so absorption implies transmission.
+  if (f.transmission) mask |= kFeatureTransmission;
+  if (f.environment) mask |= kFeatureEnvironment;
+  if (f.area_lights || f.point_lights || f.directional_lights || f.environment) mask |= kFeatureLights;
+  return mask;
+}
+
 IntegrateFn select_integrator(IntegratorKind kind, const SceneFeatures& features) {
-  (void)features;
-  return kind == IntegratorKind::kDistributed ? &integrate<true> : &integrate<false>;
+  const uint32_t mask = integrator_feature_mask(features);
+  return kind == IntegratorKind::kDistributed ? kDistributedTable[mask] : kPathTable[mask];
+}
+
+IntegrateFn select_generic_integrator(IntegratorKind kind) {
+  return kind == IntegratorKind::kDistributed ? kDistributedTable[kFeatureAll]
+                                              : kPathTable[kFeatureAll];
 }
 
 }  // namespace penumbra

@@ -25,6 +25,12 @@ struct PathCounters {
 using IntegrateFn = Spectrum (*)(const SceneImpl& scene, const IntegratorSettings& settings,
                                  Ray ray, Sampler& sampler, PathCounters& counters);
 
+// The integrator specialised on the features the scene uses (chosen once per render): code for
+// an absent feature (absorption, refraction, environment, lights) is compiled out.
 IntegrateFn select_integrator(IntegratorKind kind, const SceneFeatures& features);
+// The instantiation with every feature compiled in (tests check the specialised ones against it).
+IntegrateFn select_generic_integrator(IntegratorKind kind);
+// The feature bits select_integrator compiles in for a scene (for tests and benchmarks).
+uint32_t integrator_feature_mask(const SceneFeatures& features);
 
 }  // namespace penumbra
