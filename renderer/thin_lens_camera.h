@@ -1,0 +1,33 @@
+#pragma once
+// Perspective camera with a thin lens (Cook, Porter & Carpenter 1984) and a shutter interval.
+#include "renderer/math.h"
+#include "renderer/scene_input.h"
+
+namespace penumbra {
+
+struct CameraRay {
+  vec3 origin;
+  vec3 direction;  // unit
+  float time;      // normalised shutter time in [0,1]
+};
+
+class ThinLensCamera {
+ public:
+  ThinLensCamera(const CameraDesc& desc, int width, int height);
+
+  // film: continuous pixel coordinates (x right, y down, [0,w)x[0,h)); lens, time: in [0,1).
+  CameraRay generate_ray(const vec2& film, const vec2& lens, float time) const;
+
+  bool has_lens() const { return aperture_radius_ > 0.f; }
+  const vec3& position() const { return position_; }
+  float tan_half_fov() const { return tan_half_fov_; }
+  int height() const { return height_; }
+
+ private:
+  vec3 position_, right_, up_, forward_;
+  float tan_half_fov_, aspect_;
+  float aperture_radius_, focus_distance_;
+  int width_, height_;
+};
+
+}  // namespace penumbra
