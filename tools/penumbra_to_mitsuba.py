@@ -254,10 +254,12 @@ def build_mesh(mi, name: str, positions, faces, normals, children: dict):
         props[key] = value
     mesh = mi.Mesh(name, len(positions), len(faces), props, has_vertex_normals=normals is not None)
     params = mi.traverse(mesh)
-    params["vertex_positions"] = mi.Float(positions.astype(np.float32).ravel())
-    params["faces"] = mi.UInt32(faces.ravel())
+    # The buffers' own types (dynamic arrays in every variant, scalar_rgb included).
+    float_buffer = type(params["vertex_positions"])
+    params["vertex_positions"] = float_buffer(positions.astype(np.float32).ravel())
+    params["faces"] = type(params["faces"])(faces.astype(np.uint32).ravel())
     if normals is not None:
-        params["vertex_normals"] = mi.Float(normals.astype(np.float32).ravel())
+        params["vertex_normals"] = float_buffer(normals.astype(np.float32).ravel())
     params.update()
     return mesh
 

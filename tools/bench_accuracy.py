@@ -1,0 +1,232 @@
+#!/usr/bin/env python3
+"""Run time against error: penumbra and Mitsuba 3 on the accuracy scenes.
+
+    .venv-mitsuba/bin/python tools/bench_accuracy.py --penumbra build/app/penumbra \
+        [--spp 4,16,64,256] [--seeds 3] [--mitsuba llvm_ad_rgb,scalar_rgb] [--only cornell]
+
+For each scene of tests/accuracy/scenes/, each renderer and each sample count of the ladder, over
+several seeds, it records the render's seconds, spp, RMSE, relMSE and mean FLIP against the
+Mitsuba reference (tests/accuracy/references/<scene>.exr, see docs/accuracy.md), and writes
+
+* ``<out>/bench.csv``   one row per render;
+* ``<out>/bench.png``   relMSE against seconds, log-log, one panel per scene, one line per renderer;
+* ``<out>/bench.md``    per scene the seconds each renderer needs to reach the same relMSE (fitted
+  on the ladder) and the ratio penumbra / fastest Mitsuba; also printed.
+
+Seconds are comparable work on both sides: for penumbra the scene build plus the render as its
+summary line reports them (not process start or JSON parsing); for Mitsuba ``load_dict`` plus
+``render`` (including Dr.Jit's kernel compilation, which its cache makes cheap after the first
+render). Motion-blurred scenes have no native Mitsuba equivalent: Mitsuba renders them as the
+average over shutter instants (at least one sample per instant), which inflates its time, so
+their ratio is marked.
+
+Error metrics (per render, against the reference):
+  RMSE   = sqrt(mean over pixels and channels of (x - r)^2)
+  relMSE = mean of (x - r)^2 / (r^2 + 0.01)
+  FLIP   = mean LDR-FLIP of the clamped sRGB images (flip-evaluator)
+"""
+from __future__ import annotations
+
+import argparse
+import csv
+import glob
+import math
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import penumbra_to_mitsuba as p2m  # noqa: E402
+
+REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ACCURACY = os.path.join(REPO, "tests", "accuracy")
+
+#: penumbra's closing line: "...: 64x64, 64.0 spp (...), 0.900 s (+0.345 s build), ..."
+SUMMARY = re.compile(r"([0-9.]+) spp .*?, ([0-9.]+) s \(\+([0-9.]+) s build\)")
+
+
+def srgb(linear: np.ndarray) -> np.ndarray:
+    """Clamp to [0, 1] and apply the sRGB transfer curve."""
+    x = np.clip(linear, 0.0, 1.0)
+    return np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(x, 1 / 2.4) - 0.055)
+
+
+def errors(image: np.ndarray, reference: np.ndarray) -> dict:
+    """RMSE, relMSE and mean FLIP of ``image`` against ``reference`` (both linear RGB)."""
+    import flip_evaluator
+
+    d2 = (image - reference) ** 2
+    _, flip, _ = flip_evaluator.evaluate(srgb(reference).astype(np.float32), srgb(image).astype(np.float32),
+                                         "LDR", inputsRGB=True, applyMagma=False)
+    return {"rmse": float(np.sqrt(d2.mean())), "relmse": float((d2 / (reference ** 2 + 0.01)).mean()),
+            "flip": float(flip)}
+
+
+def read_exr(mi, path: str) -> np.ndarray:
+    """Linear RGB float64 array of an EXR, read with Mitsuba's Bitmap (not flip's loader,
+    which misreads some PIZ-compressed files)."""
+    return np.array(mi.Bitmap(path), dtype=np.float64)[..., :3]
+
+
+def run_penumbra(binary: str, scene_path: str, spp: int, seed: int, mi) -> tuple[np.ndarray, float]:
+    """Render with the penumbra CLI; returns the image and build + render seconds."""
+    with tempfile.TemporaryDirectory() as tmp:
+        out = os.path.join(tmp, "out.exr")
+        proc = subprocess.run([binary, "render", scene_path, "-o", out, "--spp", str(spp), "--seed", str(seed), "-q"],
+                              capture_output=True, text=True, check=True)
+        match = SUMMARY.search(proc.stdout + proc.stderr)
+        if not match:
+            raise RuntimeError(f"no summary line from penumbra: {proc.stdout}{proc.stderr}")
+        return read_exr(mi, out), float(match.group(2)) + float(match.group(3))
+
+
+def run_mitsuba(variant: str, scene: dict, spp: int, seed: int, instants: int) -> tuple[np.ndarray, float]:
+    """Render with Mitsuba in this process; returns the image and load + render seconds."""
+    mi = p2m.import_mitsuba(variant)
+    times = p2m.shutter_instants(scene, instants)
+    per_instant = max(1, spp // len(times))
+    total, seconds = None, 0.0
+    for k, t in enumerate(times):
+        start = time.perf_counter()
+        mscene = mi.load_dict(p2m.to_mitsuba(mi, scene, time=t, spp=per_instant))
+        img = np.asarray(mi.render(mscene, spp=per_instant, seed=seed * len(times) + k), dtype=np.float64)
+        seconds += time.perf_counter() - start
+        total = img if total is None else total + img
+    return total / len(times), seconds
+
+
+def time_to_reach(rows: list[dict], target: float) -> float:
+    """Seconds to reach relMSE ``target``: a least-squares line through log(relMSE) against
+    log(seconds) over the ladder (seed means), evaluated at the target."""
+    by_spp: dict[int, list] = {}
+    for r in rows:
+        by_spp.setdefault(r["spp"], []).append(r)
+    pts = [(np.mean([r["seconds"] for r in rs]), np.mean([r["relmse"] for r in rs])) for rs in by_spp.values()]
+    if len(pts) < 2:
+        return math.nan
+    x = np.log([p[0] for p in pts])
+    y = np.log([p[1] for p in pts])
+    slope, intercept = np.polyfit(x, y, 1)
+    if slope >= 0:
+        return math.nan
+    return float(math.exp((math.log(target) - intercept) / slope))
+
+
+def summarise(rows: list[dict], scenes: list[str], renderers: list[str]) -> list[str]:
+    """Markdown table: per scene, seconds to the relMSE penumbra reaches at its largest spp, for
+    each renderer, and penumbra / fastest Mitsuba."""
+    lines = ["| scene | target relMSE | " + " | ".join(f"{r} (s)" for r in renderers) + " | penumbra / fastest Mitsuba |",
+             "| --- | ---: | " + " | ".join("---:" for _ in renderers) + " | ---: |"]
+    for scene in scenes:
+        pen = [r for r in rows if r["scene"] == scene and r["renderer"] == "penumbra"]
+        if not pen:
+            continue
+        top = max(r["spp"] for r in pen)
+        target = float(np.mean([r["relmse"] for r in pen if r["spp"] == top]))
+        secs = {name: time_to_reach([r for r in rows if r["scene"] == scene and r["renderer"] == name], target)
+                for name in renderers}
+        mitsuba = [v for k, v in secs.items() if k != "penumbra" and not math.isnan(v)]
+        ratio = secs["penumbra"] / min(mitsuba) if mitsuba else math.nan
+        moving = any(r["instants"] > 1 for r in rows if r["scene"] == scene)
+        lines.append(f"| {scene}{' (motion: Mitsuba averages instants)' if moving else ''} | {target:.2e} | "
+                     + " | ".join(f"{secs[n]:.2f}" for n in renderers) + f" | {ratio:.2f} |")
+    return lines
+
+
+def plot(rows: list[dict], scenes: list[str], renderers: list[str], path: str) -> None:
+    """relMSE against seconds, log-log, one panel per scene, one line per renderer."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    cols = 4
+    nrows = math.ceil(len(scenes) / cols)
+    fig, axes = plt.subplots(nrows, cols, figsize=(4 * cols, 3.2 * nrows), squeeze=False)
+    for ax, scene in zip(axes.ravel(), scenes):
+        for name in renderers:
+            rs = [r for r in rows if r["scene"] == scene and r["renderer"] == name]
+            spps = sorted({r["spp"] for r in rs})
+            xs = [np.mean([r["seconds"] for r in rs if r["spp"] == s]) for s in spps]
+            ys = [np.mean([r["relmse"] for r in rs if r["spp"] == s]) for s in spps]
+            if xs:
+                ax.loglog(xs, ys, "o-", label=name)
+        ax.set_title(scene)
+        ax.set_xlabel("seconds")
+        ax.set_ylabel("relMSE")
+        ax.grid(True, which="both", alpha=0.3)
+    for ax in axes.ravel()[len(scenes):]:
+        ax.axis("off")
+    axes[0, 0].legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+
+
+def main(argv: list[str]) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--penumbra", required=True, help="the penumbra executable")
+    ap.add_argument("--spp", default="4,16,64,256", help="sample-count ladder")
+    ap.add_argument("--seeds", type=int, default=3)
+    ap.add_argument("--mitsuba", default="llvm_ad_rgb,scalar_rgb",
+                    help="Mitsuba variants to measure, comma-separated ('' for none)")
+    ap.add_argument("--instants", type=int, default=16, help="shutter instants for Mitsuba motion blur")
+    ap.add_argument("--only", default="", help="comma-separated scene names (default: all)")
+    ap.add_argument("--out", default=os.path.join(REPO, "bench", "out"))
+    args = ap.parse_args(argv)
+
+    ladder = [int(s) for s in args.spp.split(",")]
+    variants = [v for v in args.mitsuba.split(",") if v]
+    only = {s for s in args.only.split(",") if s}
+    scenes = [os.path.splitext(os.path.basename(p))[0] for p in sorted(glob.glob(os.path.join(ACCURACY, "scenes", "*.json")))]
+    scenes = [s for s in scenes if not only or s in only]
+    os.makedirs(args.out, exist_ok=True)
+    mi = p2m.import_mitsuba(variants[0] if variants else "scalar_rgb")
+
+    rows: list[dict] = []
+    renderers = ["penumbra"] + [f"mitsuba {v}" for v in variants]
+    for scene_name in scenes:
+        scene_path = os.path.join(ACCURACY, "scenes", f"{scene_name}.json")
+        scene = p2m.load_json(scene_path)
+        reference = read_exr(mi, os.path.join(ACCURACY, "references", f"{scene_name}.exr"))
+        instants = len(p2m.shutter_instants(scene, args.instants))
+        for renderer in renderers:
+            # One discarded warm-up render: Dr.Jit compiles its kernels on first use, and the
+            # first penumbra run pays for reading the scene file from a cold cache.
+            if renderer == "penumbra":
+                run_penumbra(args.penumbra, scene_path, ladder[0], 0, mi)
+            else:
+                run_mitsuba(renderer.split()[1], scene, max(ladder[0], instants), 0, instants)
+            for spp in ladder:
+                for seed in range(args.seeds):
+                    if renderer == "penumbra":
+                        image, seconds = run_penumbra(args.penumbra, scene_path, spp, seed, mi)
+                        used_instants = 1
+                    else:
+                        image, seconds = run_mitsuba(renderer.split()[1], scene, max(spp, instants), seed, instants)
+                        used_instants = instants
+                    used_spp = spp if renderer == "penumbra" else max(spp, instants)
+                    row = {"scene": scene_name, "renderer": renderer, "spp": used_spp, "seed": seed,
+                           "seconds": seconds, "instants": used_instants, **errors(image, reference)}
+                    rows.append(row)
+                    print(f"{scene_name:13s} {renderer:20s} spp {spp:5d} seed {seed}: {seconds:7.3f} s  "
+                          f"relMSE {row['relmse']:.3e}  FLIP {row['flip']:.4f}", flush=True)
+
+    with open(os.path.join(args.out, "bench.csv"), "w", newline="", encoding="utf-8") as f:
+        writer = csv.DictWriter(f, fieldnames=list(rows[0]))
+        writer.writeheader()
+        writer.writerows(rows)
+    plot(rows, scenes, renderers, os.path.join(args.out, "bench.png"))
+    table = summarise(rows, scenes, renderers)
+    with open(os.path.join(args.out, "bench.md"), "w", encoding="utf-8") as f:
+        f.write("\n".join(table) + "\n")
+    print("\n".join(table))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
