@@ -93,20 +93,6 @@ std::variant<ImageFormat, Problem> negotiate_format(const httplib::Request& req)
 const char* mime(ImageFormat f) { return f == ImageFormat::kPng ? "image/png" : "image/x-exr"; }
 const char* extension(ImageFormat f) { return f == ImageFormat::kPng ? "png" : "exr"; }
 
-// JSON scenes only. curl --data-binary sends application/x-www-form-urlencoded unless told
-// otherwise; it is taken as JSON too so the one-line curl of the README works.
-std::optional<Problem> check_content_type(const httplib::Request& req) {
-  if (!req.has_header("Content-Type")) return std::nullopt;
-  std::string type = lower(req.get_header_value("Content-Type"));
-  type = trim(type.substr(0, type.find(';')));
-  const bool json_like = type == "application/json" ||
-                         (type.rfind("application/", 0) == 0 && type.size() > 5 &&
-                          type.compare(type.size() - 5, 5, "+json") == 0);
-  if (json_like || type == "application/x-www-form-urlencoded") return std::nullopt;
-  return make_problem(415, "unsupported-media-type", "Unsupported Media Type",
-                      "the body must be a JSON scene (Content-Type: application/json), not " + type);
-}
-
 std::variant<std::string, Problem> idempotency_key(const httplib::Request& req) {
   if (!req.has_header("Idempotency-Key")) return std::string();
   std::string key = trim(req.get_header_value("Idempotency-Key"));
@@ -169,7 +155,7 @@ bool send_file(httplib::Response& res, const std::string& path, ImageFormat form
   std::error_code ec;
   const auto size = std::filesystem::file_size(path, ec);
   if (ec) return false;
-  res.status = 200;
+  // Status left unset: the library answers 206 for a (single) Range request, else 200.
   res.set_header("Content-Disposition",
                  std::string("inline; filename=\"") + id + "." + extension(format) + "\"");
   res.set_header("ETag", "\"" + id + "-" + extension(format) + "\"");
@@ -308,7 +294,6 @@ void HttpServer::install_routes() {
   });
 
   s.Post("/v1/jobs", [this](const httplib::Request& req, httplib::Response& res) {
-    if (auto p = check_content_type(req)) return problem(res, req, *p);
     auto key = idempotency_key(req);
     if (auto* p = std::get_if<Problem>(&key)) return problem(res, req, *p);
     const SubmitOutcome o = jobs_.submit(req.body, std::get<std::string>(key));
@@ -427,7 +412,6 @@ void HttpServer::install_routes() {
   });
 
   s.Post("/v1/render", [this](const httplib::Request& req, httplib::Response& res) {
-    if (auto p = check_content_type(req)) return problem(res, req, *p);
     auto format = negotiate_format(req);
     if (auto* p = std::get_if<Problem>(&format)) return problem(res, req, *p);
     auto key = idempotency_key(req);

@@ -69,9 +69,25 @@ std::optional<Problem> guard_request(const httplib::Request& req, const GuardSet
     }
   }
   if (req.has_header("Range") && req.get_header_value("Range").find(',') != std::string::npos) {
-    // One range at most: a many-range request multiplies the response size.
+    // One range at most: a many-range request multiplies the response size. The parsed ranges
+    // are dropped too, or the library would cut this very answer into a multipart response.
+    // (The Request object is not const in the library; only the handler's view of it is.)
+    const_cast<httplib::Request&>(req).ranges.clear();
     return make_problem(416, "multiple-ranges", "Range Not Satisfiable",
                         "only a single byte range is served");
+  }
+  if (req.method == "POST" && req.has_header("Content-Type")) {
+    // Checked before the body is read: the library would otherwise parse multipart bodies.
+    std::string type = lower(req.get_header_value("Content-Type"));
+    type = trim(type.substr(0, type.find(';')));
+    const bool json_like = type == "application/json" ||
+                           (type.rfind("application/", 0) == 0 && type.size() > 5 &&
+                            type.compare(type.size() - 5, 5, "+json") == 0);
+    // curl --data-binary sends application/x-www-form-urlencoded unless told otherwise; it is
+    // read as JSON too so the one-line curl of the README works.
+    if (!json_like && type != "application/x-www-form-urlencoded")
+      return make_problem(415, "unsupported-media-type", "Unsupported Media Type",
+                          "the body must be a JSON scene (Content-Type: application/json), not " + type);
   }
   return std::nullopt;
 }

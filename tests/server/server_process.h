@@ -245,3 +245,46 @@ inline Json wait_for_state(httplib::Client& client, const std::string& id,
 }
 
 }  // namespace penumbra::server::testing
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+
+namespace penumbra::server::testing {
+
+// Sends raw bytes on a fresh connection and returns whatever comes back within the timeout
+// (for framing tests the client library would not produce: chunked bodies, bad lengths).
+inline std::string raw_request(int port, const std::string& bytes, int timeout_ms = 3000) {
+  const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_port = htons(uint16_t(port));
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  if (::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) {
+    ::close(fd);
+    return "";
+  }
+  ::send(fd, bytes.data(), bytes.size(), MSG_NOSIGNAL);
+  std::string out;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms);
+  char buf[4096];
+  while (std::chrono::steady_clock::now() < deadline) {
+    pollfd p{fd, POLLIN, 0};
+    if (::poll(&p, 1, 50) <= 0) {
+      if (out.find("\r\n\r\n") != std::string::npos) break;  // a whole head and the body so far
+      continue;
+    }
+    const ssize_t n = ::recv(fd, buf, sizeof buf, 0);
+    if (n <= 0) break;
+    out.append(buf, size_t(n));
+  }
+  ::close(fd);
+  return out;
+}
+
+inline int raw_status(const std::string& response) {
+  if (response.size() < 12 || response.compare(0, 5, "HTTP/") != 0) return -1;
+  return std::stoi(response.substr(9, 3));
+}
+
+}  // namespace penumbra::server::testing
