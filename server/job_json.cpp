@@ -1,5 +1,6 @@
 #include "server/job_json.h"
 
+#include <algorithm>
 #include <cmath>
 #include <ctime>
 
@@ -40,6 +41,8 @@ nlohmann::ordered_json job_json(const JobView& v) {
     stats = json::parse(r.stats_json);
     if (r.state == JobState::kSucceeded || r.state == JobState::kCancelled)
       samples_done = stats.value("camera_samples", samples_done);
+    if (r.state == JobState::kCancelled && r.samples_total > 0)
+      progress = std::min(1.0, double(samples_done) / double(r.samples_total));  // how far it got
   }
   j["progress"] = progress;
   j["samples_done"] = samples_done;

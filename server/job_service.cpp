@@ -29,12 +29,12 @@ nlohmann::json diagnostics_json(const std::vector<api::Diagnostic>& ds) {
 }
 
 std::string error_json(const std::string& detail) {
-  return nlohmann::json{{"detail", detail}}.dump();
+  return nlohmann::ordered_json{{"detail", detail}}.dump();
 }
 
 std::string stats_json(const RenderOutcome& o, int threads) {
   const RenderStats& s = o.stats;
-  return nlohmann::json{{"seconds", s.seconds},
+  return nlohmann::ordered_json{{"seconds", s.seconds},
                         {"build_seconds", o.build_seconds},
                         {"rays", s.rays},
                         {"mrays_per_second", s.mrays_per_second()},
