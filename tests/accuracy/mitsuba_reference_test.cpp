@@ -1,0 +1,148 @@
+// Accuracy against Mitsuba 3: every scene in tests/accuracy/scenes/ is rendered with penumbra and
+// compared with its Mitsuba 3.9 reference (tests/accuracy/references/, made by
+// tools/make_references.py, see docs/accuracy.md).
+//
+// The test looks for bias, not likeness: a difference counts only if the Monte Carlo noise cannot
+// explain it. For the whole image and for every 16x16-pixel block and channel,
+//   z = (penumbra mean - reference mean) / sqrt(se_penumbra^2 + se_reference^2),
+// where se_penumbra comes from the film's per-pixel variance estimates (sample variance / n,
+// pixels independent) of several renders with different seeds, and se_reference from the
+// reference's own stderr image (spread of its independent batches). With a stratified or
+// low-discrepancy sampler the sample variance overestimates the error, so z is conservative.
+// Renders are seeded, so the outcome is deterministic.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "api/scene_loader.h"
+#include "renderer/image_io.h"
+#include "renderer/render.h"
+#include "renderer/scene.h"
+
+namespace penumbra {
+namespace {
+
+constexpr int kSeeds = 4;           // independent renders per scene
+constexpr int kSpp = 64;            // samples per pixel of each
+constexpr int kBlock = 16;          // block edge in pixels
+constexpr double kMaxImageZ = 4.0;  // whole-image mean, per channel
+constexpr double kMaxBlockZ = 5.0;  // every block and channel (~1000 of them over all scenes)
+constexpr double kMaxMeanZ2 = 2.0;  // mean of z^2 over a scene's blocks: catches small, spread bias
+
+const std::vector<std::string> kScenes = {"all_lights", "conductors",   "cornell",      "dof",
+                                          "furnace",    "glass_rough",  "glass_smooth", "kitchen_sink",
+                                          "mesh_100k",  "motion_blur",  "plastics"};
+
+std::string accuracy_dir() { return std::string(PENUMBRA_SOURCE_DIR) + "/tests/accuracy/"; }
+
+// A rectangle of pixels [x0, x1) x [y0, y1).
+struct Region {
+  int x0, y0, x1, y1;
+  int pixels() const { return (x1 - x0) * (y1 - y0); }
+};
+
+// Sum of one channel over a region.
+double region_sum(const Image& img, const Region& r, int c) {
+  double s = 0.0;
+  for (int y = r.y0; y < r.y1; ++y)
+    for (int x = r.x0; x < r.x1; ++x) s += img.pixel(x, y)[c];
+  return s;
+}
+
+// Blocks of kBlock x kBlock pixels covering the image; partial blocks at the right and bottom
+// edges are kept if at least half a block wide/high, otherwise merged into their neighbour.
+std::vector<Region> blocks(int width, int height) {
+  auto cuts = [](int n) {
+    std::vector<int> c;
+    for (int v = 0; v + kBlock <= n; v += kBlock) c.push_back(v);
+    if (n - c.back() - kBlock >= kBlock / 2) c.push_back(c.back() + kBlock);
+    c.push_back(n);
+    return c;
+  };
+  const std::vector<int> xs = cuts(width), ys = cuts(height);
+  std::vector<Region> out;
+  for (size_t j = 0; j + 1 < ys.size(); ++j)
+    for (size_t i = 0; i + 1 < xs.size(); ++i) out.push_back({xs[i], ys[j], xs[i + 1], ys[j + 1]});
+  return out;
+}
+
+struct Comparison {
+  double z = 0.0;
+  double penumbra = 0.0;
+  double reference = 0.0;
+};
+
+class MitsubaReference : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(MitsubaReference, NoBiasBeyondNoise) {
+  const std::string name = GetParam();
+  const api::LoadResult loaded = api::load_scene_file(accuracy_dir() + "scenes/" + name + ".json");
+  ASSERT_TRUE(loaded.ok()) << (loaded.errors.empty() ? "" : loaded.errors.front().to_string());
+  const Image reference = read_image_file(accuracy_dir() + "references/" + name + ".exr");
+  const Image reference_se = read_image_file(accuracy_dir() + "references/" + name + ".stderr.exr");
+  RenderSettings settings = loaded.request->settings;
+  ASSERT_EQ(reference.width, settings.width);
+  ASSERT_EQ(reference.height, settings.height);
+  const auto scene = Scene::build(loaded.request->scene);
+
+  // Mean image over the seeds and the variance of that mean.
+  const size_t n = reference.rgb.size();
+  Image mean(settings.width, settings.height), variance(settings.width, settings.height);
+  settings.spp = kSpp;
+  for (int seed = 0; seed < kSeeds; ++seed) {
+    settings.seed = 1000 + seed;
+    const RenderResult r = render(*scene, settings);
+    ASSERT_EQ(r.stats.nonfinite_samples, 0u);
+    for (size_t i = 0; i < n; ++i) {
+      mean.rgb[i] += r.image.rgb[i] / kSeeds;
+      variance.rgb[i] += r.variance.rgb[i] / (kSeeds * kSeeds);
+    }
+  }
+  Image reference_var = reference_se;
+  for (float& v : reference_var.rgb) v *= v;
+
+  auto compare = [&](const Region& r, int c) {
+    const double k = r.pixels();
+    const double var = (region_sum(variance, r, c) + region_sum(reference_var, r, c)) / (k * k);
+    Comparison cmp;
+    cmp.penumbra = region_sum(mean, r, c) / k;
+    cmp.reference = region_sum(reference, r, c) / k;
+    cmp.z = (cmp.penumbra - cmp.reference) / std::sqrt(std::max(var, 1e-20));
+    return cmp;
+  };
+
+  const Region whole{0, 0, settings.width, settings.height};
+  double max_image_z = 0.0, max_block_z = 0.0;
+  for (int c = 0; c < 3; ++c) {
+    const Comparison cmp = compare(whole, c);
+    max_image_z = std::max(max_image_z, std::abs(cmp.z));
+    EXPECT_LE(std::abs(cmp.z), kMaxImageZ) << name << " image mean, channel " << c << ": penumbra "
+                                           << cmp.penumbra << ", Mitsuba " << cmp.reference;
+  }
+  double sum_z2 = 0.0;
+  int count = 0;
+    for (const Region& r : blocks(settings.width, settings.height))
+    for (int c = 0; c < 3; ++c) {
+      const Comparison cmp = compare(r, c);
+      sum_z2 += cmp.z * cmp.z;
+      max_block_z = std::max(max_block_z, std::abs(cmp.z));
+      ++count;
+      EXPECT_LE(std::abs(cmp.z), kMaxBlockZ)
+          << name << " block x " << r.x0 << ".." << r.x1 << ", y " << r.y0 << ".." << r.y1 << ", channel " << c
+          << ": penumbra " << cmp.penumbra << ", Mitsuba " << cmp.reference << ", z = " << cmp.z;
+    }
+  EXPECT_LE(sum_z2 / count, kMaxMeanZ2) << name << ": mean z^2 over " << count << " block-channels";
+  // The margins, for the log: how far from the thresholds this scene is.
+  std::printf("%s: max |z| image %.2f (limit %.0f), block %.2f (limit %.0f), mean z^2 %.2f (limit %.0f)\n",
+              name.c_str(), max_image_z, kMaxImageZ, max_block_z, kMaxBlockZ, sum_z2 / count, kMaxMeanZ2);
+}
+
+INSTANTIATE_TEST_SUITE_P(Scenes, MitsubaReference, ::testing::ValuesIn(kScenes),
+                         [](const ::testing::TestParamInfo<std::string>& info) { return info.param; });
+
+}  // namespace
+}  // namespace penumbra
