@@ -269,11 +269,8 @@ for v in svc["volumes"]:
     assert name in (doc.get("volumes") or {}), f"volume {name} is not a named volume"
 print("   ok: YAML parses; only the proxy publishes a port; token from the environment; named data volume")
 EOF
-if command -v podman-compose >/dev/null 2>&1; then
-  PENUMBRA_TOKEN=x podman-compose -f docker/compose.yaml config >/dev/null 2>"$WORK/compose.err" ||
-    { cat "$WORK/compose.err" >&2; fail "podman-compose config"; }
-  ok "podman-compose config accepts it"
-fi
+# (Debian 12's podman-compose 1.0.3 has no `config` command, and its --dry-run still creates
+# the volume and network, so the YAML check above is all that runs here.)
 
 # ------------------------------------------------------------------------------------------------
 if [ "${SMOKE_PROXY:-1}" != 0 ]; then
@@ -330,7 +327,10 @@ s = socket.create_connection(("127.0.0.1", int(sys.argv[1])))
 s.sendall(b"GET /healthz HTTP/1.1\r\nHost: x\r\n")
 s.settimeout(30)
 start = time.time()
-data = s.recv(4096)  # nginx closes (or answers 408) once the header timeout passes
+try:
+    s.recv(4096)  # nginx resets the connection once client_header_timeout passes
+except ConnectionResetError:
+    pass
 took = time.time() - start
 if took > 20:
     sys.exit(f"slow header held the connection {took:.0f} s")
