@@ -71,6 +71,7 @@ int run_serve(int argc, char** argv) {
   jobs.start();
 
   std::atomic<bool> shutting_down{false};
+  std::atomic<bool> listen_returned{false};
   std::thread signal_thread([&] {
     int sig = 0;
     sigwait(&signals, &sig);
@@ -88,7 +89,12 @@ int run_serve(int argc, char** argv) {
     }
     std::this_thread::sleep_until(start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                                               std::chrono::duration<double>(config.drain_seconds)));
-    http.stop();
+    // stop() is a no-op until listen() has started running: a signal right after startup
+    // would otherwise leave listen() blocked for good. Repeat until it has returned.
+    while (!listen_returned) {
+      http.stop();
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
   });
 
   std::printf("listening on http://%s:%d\n", url_host(config.host).c_str(), port);
@@ -97,6 +103,7 @@ int run_serve(int argc, char** argv) {
               config.token.empty() ? "off" : "on");
   std::fflush(stdout);
   const bool ok = http.listen();
+  listen_returned = true;
   if (!shutting_down) {
     // listen() failed on its own: wake the signal thread so it shuts the jobs down.
     pthread_kill(signal_thread.native_handle(), SIGTERM);
