@@ -1,8 +1,10 @@
 // `penumbra validate SCENE.json...`: checks scenes without rendering them.
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <string>
 #include <variant>
+#include <vector>
 
 #include "api/scene_loader.h"
 #include "app/commands.h"
