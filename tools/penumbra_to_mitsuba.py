@@ -37,8 +37,12 @@ import numpy as np
 #: Where Debian 12's libllvm19 puts the library; llvm_ad_rgb needs LLVM >= 16 here.
 DEBIAN_LIBLLVM = "/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1"
 
-#: Russian roulette starts at this depth, as in penumbra's RenderSettings and Mitsuba's default.
+#: Russian roulette starts at this depth unless render.rr_depth says otherwise (penumbra's and
+#: Mitsuba's default).
 RR_DEPTH = 5
+
+#: Default reflectance of each material type when ``color`` is absent (docs/scene-format.md).
+DEFAULT_COLOR = {"diffuse": [0.5, 0.5, 0.5], "conductor": [1.0, 1.0, 1.0], "plastic": [0.5, 0.5, 0.5]}
 
 
 def import_mitsuba(variant: str):
@@ -172,20 +176,21 @@ def convert_material(mat: dict) -> dict:
     (see :func:`convert_medium`).
     """
     kind = mat["type"]
+    color = mat.get("color", DEFAULT_COLOR.get(kind))
     roughness = float(mat.get("roughness", 0.0))
     alpha = roughness * roughness  # glTF convention, as in penumbra
     if kind == "diffuse":
-        bsdf = {"type": "diffuse", "reflectance": rgb(mat["color"])}
+        bsdf = {"type": "diffuse", "reflectance": rgb(color)}
     elif kind == "conductor":
         # material 'none' = a perfect reflector (F = 1) that specular_reflectance scales:
         # a constant Fresnel reflectance equal to the colour.
-        bsdf = {"type": "conductor", "material": "none", "specular_reflectance": rgb(mat["color"])}
+        bsdf = {"type": "conductor", "material": "none", "specular_reflectance": rgb(color)}
         if alpha > 0:
             bsdf.update(type="roughconductor", **ggx(alpha))
     elif kind == "plastic":
         bsdf = {
             "type": "plastic",
-            "diffuse_reflectance": rgb(mat["color"]),
+            "diffuse_reflectance": rgb(color),
             "int_ior": float(mat.get("ior", 1.5)),
             "ext_ior": 1.0,
             "nonlinear": False,
@@ -241,8 +246,22 @@ def mesh_arrays(obj: dict, matrix: np.ndarray, offset: np.ndarray):
     positions = apply_point(matrix, positions) + offset
     normals = None
     if obj.get("normals"):
-        normals = apply_normal(matrix, np.asarray(obj["normals"], dtype=np.float64).reshape(-1, 3))
+        normals = np.asarray(obj["normals"], dtype=np.float64).reshape(-1, 3)
+        zero = np.linalg.norm(normals, axis=1) == 0
+        normals = apply_normal(matrix, np.where(zero[:, None], 1.0, normals))
+        if zero.any():  # as penumbra's loader: the area-weighted normal of the adjacent triangles
+            normals[zero] = area_weighted_normals(positions, faces)[zero]
     return positions, faces, normals
+
+
+def area_weighted_normals(positions: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """Per-vertex sums of the (area-weighted) normals of adjacent triangles, normalised."""
+    p = positions[faces]
+    face_n = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    n = np.zeros_like(positions)
+    for k in range(3):
+        np.add.at(n, faces[:, k], face_n)
+    return n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-30)
 
 
 def build_mesh(mi, name: str, positions, faces, normals, children: dict):
@@ -327,11 +346,13 @@ def convert_sensor(mi, scene: dict, spp: int, width: int | None = None, height: 
     to_world = mi.ScalarTransform4f().look_at(
         origin=vec(cam["position"]).tolist(), target=vec(cam["look_at"]).tolist(),
         up=vec(cam.get("up", [0, 1, 0])).tolist())
-    sensor = {"type": "perspective", "fov": float(cam["fov"]), "fov_axis": "y", "to_world": to_world}
+    sensor = {"type": "perspective", "fov": float(cam.get("fov", 40.0)), "fov_axis": "y", "to_world": to_world}
     aperture = float(cam.get("aperture_radius", 0.0))
     if aperture > 0:
+        # Default: the distance to look_at, as in penumbra.
+        default_focus = float(np.linalg.norm(vec(cam["look_at"]) - vec(cam["position"])))
         sensor.update(type="thinlens", aperture_radius=aperture,
-                      focus_distance=float(cam.get("focus_distance", 1.0)))
+                      focus_distance=float(cam.get("focus_distance", default_focus)))
     sensor["film"] = {
         "type": "hdrfilm",
         "width": int(width or render.get("width", 256)),
@@ -352,7 +373,7 @@ def convert_integrator(scene: dict) -> dict:
     return {
         "type": "volpath" if uses_absorption(scene) else "path",
         "max_depth": int(render.get("max_depth", 8)),
-        "rr_depth": RR_DEPTH,
+        "rr_depth": int(render.get("rr_depth", RR_DEPTH)),
     }
 
 
