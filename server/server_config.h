@@ -33,7 +33,6 @@ struct ServerConfig {
   int keep_alive_seconds = 5;
   int keep_alive_max_requests = 100;
   double drain_seconds = 1.0;  // after SIGTERM: /readyz answers 503 this long before the port closes
-  double shutdown_finish_fraction = 0.9;  // a running job this far along is finished at shutdown
   bool access_log = false;
 
   // The per-scene caps handed to the scene loader.
