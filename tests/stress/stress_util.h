@@ -1,0 +1,190 @@
+#pragma once
+// Helpers of the numerical-stability stress suite: scenes as plain SceneInput or JSON text,
+// renders, NaN/Inf counts, and noise-aware image comparisons.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "api/scene_loader.h"
+#include "renderer/render.h"
+#include "renderer/scene.h"
+#include "renderer/scene_input.h"
+
+namespace penumbra::stress {
+
+inline RenderSettings settings(int w, int h, int spp, int max_depth = -1, uint64_t seed = 0) {
+  RenderSettings s;
+  s.width = w;
+  s.height = h;
+  s.spp = spp;
+  s.max_depth = max_depth;
+  s.seed = seed;
+  return s;
+}
+
+inline RenderResult render_input(const SceneInput& input, const RenderSettings& s) {
+  const auto scene = Scene::build(input);
+  return render(*scene, s);
+}
+
+// Loads JSON scene text with the public loader (asserting it is valid) and renders it.
+inline RenderResult render_json(const std::string& json, const RenderSettings* override_settings = nullptr) {
+  const api::LoadResult loaded = api::load_scene(json);
+  if (!loaded.ok()) {
+    std::string all;
+    for (const auto& e : loaded.errors) all += e.to_string() + "\n";
+    ADD_FAILURE() << "scene does not load:\n" << all;
+    return {};
+  }
+  const auto scene = Scene::build(loaded.request->scene);
+  return render(*scene, override_settings ? *override_settings : loaded.request->settings);
+}
+
+// Pixels (channels) that are NaN or Inf in the image, plus samples the film dropped as such.
+inline int64_t nonfinite_count(const RenderResult& r) {
+  int64_t n = int64_t(r.stats.nonfinite_samples);
+  for (float v : r.image.rgb)
+    if (!std::isfinite(v)) ++n;
+  for (float v : r.variance.rgb)
+    if (!std::isfinite(v)) ++n;
+  return n;
+}
+
+inline double channel_mean(const Image& img, int c) {
+  double s = 0.0;
+  const size_t n = size_t(img.width) * img.height;
+  for (size_t i = 0; i < n; ++i) s += img.rgb[3 * i + c];
+  return n ? s / double(n) : 0.0;
+}
+
+// Mean of all channels and pixels and the standard error of that mean (from the film's
+// per-pixel variance of the mean).
+struct MeanAndError {
+  double mean = 0.0, stderr_of_mean = 0.0;
+};
+inline MeanAndError image_mean(const RenderResult& r, int x0 = 0, int y0 = 0, int x1 = -1, int y1 = -1) {
+  if (x1 < 0) x1 = r.image.width;
+  if (y1 < 0) y1 = r.image.height;
+  double sum = 0.0, var = 0.0;
+  int n = 0;
+  for (int y = y0; y < y1; ++y)
+    for (int x = x0; x < x1; ++x)
+      for (int c = 0; c < 3; ++c) {
+        sum += r.image.pixel(x, y)[c];
+        var += r.variance.pixel(x, y)[c];
+        ++n;
+      }
+  return {sum / n, std::sqrt(var) / n};
+}
+
+// Compares two renders of the same picture block by block: every block mean of `b` must lie
+// within k combined standard errors (plus a small relative slack for the box filter of slightly
+// shifted geometry) of the same block of `a`. Returns the number of blocks that do not.
+struct BlockComparison {
+  int blocks = 0, bad = 0;
+  double worst_sigma = 0.0;
+  std::string first_bad;
+};
+inline BlockComparison compare_blocks(const RenderResult& a, const RenderResult& b, int block, double k,
+                                      double rel_slack = 0.0) {
+  BlockComparison cmp;
+  for (int by = 0; by + block <= a.image.height; by += block)
+    for (int bx = 0; bx + block <= a.image.width; bx += block)
+      for (int c = 0; c < 3; ++c) {
+        double ma = 0, mb = 0, va = 0, vb = 0;
+        for (int y = by; y < by + block; ++y)
+          for (int x = bx; x < bx + block; ++x) {
+            ma += a.image.pixel(x, y)[c];
+            mb += b.image.pixel(x, y)[c];
+            va += a.variance.pixel(x, y)[c];
+            vb += b.variance.pixel(x, y)[c];
+          }
+        const double n = double(block) * block;
+        ma /= n;
+        mb /= n;
+        const double sigma = std::sqrt(va + vb) / n;
+        const double tol = k * sigma + rel_slack * std::max(std::abs(ma), 1e-3);
+        const double z = std::abs(ma - mb) / std::max(sigma, 1e-12);
+        ++cmp.blocks;
+        cmp.worst_sigma = std::max(cmp.worst_sigma, z);
+        if (!(std::abs(ma - mb) <= tol)) {
+          if (cmp.bad++ == 0)
+            cmp.first_bad = "block (" + std::to_string(bx) + "," + std::to_string(by) + ") channel " +
+                            std::to_string(c) + ": " + std::to_string(ma) + " vs " + std::to_string(mb) +
+                            " (sigma " + std::to_string(sigma) + ")";
+        }
+      }
+  return cmp;
+}
+
+inline CameraDesc camera_looking(const vec3& from, const vec3& to, float fov, const vec3& up = {0, 1, 0}) {
+  CameraDesc c;
+  c.position = from;
+  c.look_at = to;
+  c.up = up;
+  c.fov_degrees = fov;
+  c.focus_distance = glm::length(to - from);
+  return c;
+}
+
+inline ObjectDesc quad(const vec3& origin, const vec3& u, const vec3& v, uint32_t material,
+                       const Spectrum& emission = Spectrum(0.f)) {
+  ObjectDesc o;
+  o.shape = QuadShape{origin, u, v};
+  o.material = material;
+  o.emission = emission;
+  return o;
+}
+
+inline ObjectDesc sphere(const vec3& center, float radius, uint32_t material,
+                         const Spectrum& emission = Spectrum(0.f)) {
+  ObjectDesc o;
+  o.shape = SphereShape{center, radius};
+  o.material = material;
+  o.emission = emission;
+  return o;
+}
+
+// Axis-aligned box as a closed triangle mesh, faces counter-clockwise seen from outside (so its
+// front side, and a dielectric's outside, is outward).
+inline ObjectDesc box(const vec3& lo, const vec3& hi, uint32_t material) {
+  MeshShape m;
+  for (int i = 0; i < 8; ++i)
+    m.positions.push_back(vec3(i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z));
+  // Each face: four corners counter-clockwise seen from outside.
+  const uint32_t faces[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4},
+                                {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
+  for (const auto& f : faces) m.indices.insert(m.indices.end(), {f[0], f[1], f[2], f[0], f[2], f[3]});
+  ObjectDesc o;
+  o.shape = std::move(m);
+  o.material = material;
+  return o;
+}
+
+// Unit-radius UV sphere as a triangle mesh (counter-clockwise from outside), optional smooth
+// normals.
+inline MeshShape uv_sphere_mesh(const vec3& center, float radius, int rings, int segments, bool normals) {
+  MeshShape m;
+  for (int i = 0; i <= rings; ++i) {
+    const float theta = kPi * float(i) / float(rings);
+    for (int j = 0; j <= segments; ++j) {
+      const float phi = 2.f * kPi * float(j) / float(segments);
+      const vec3 n(std::sin(theta) * std::cos(phi), std::cos(theta), std::sin(theta) * std::sin(phi));
+      m.positions.push_back(center + radius * n);
+      if (normals) m.normals.push_back(n);
+    }
+  }
+  const int row = segments + 1;
+  for (int i = 0; i < rings; ++i)
+    for (int j = 0; j < segments; ++j) {
+      const uint32_t a = uint32_t(i * row + j), b = a + 1, c = a + uint32_t(row), d = c + 1;
+      if (i != 0) m.indices.insert(m.indices.end(), {a, b, c});
+      if (i != rings - 1) m.indices.insert(m.indices.end(), {b, d, c});
+    }
+  return m;
+}
+
+}  // namespace penumbra::stress
