@@ -12,11 +12,13 @@
 # and temporary files are always removed.
 #
 # Environment: SMOKE_IMAGE (default localhost/penumbra:smoke), SMOKE_PORT (host port, default:
-# any free one), SMOKE_PROXY=0 to skip the proxy part, SMOKE_KEEP=1 to keep containers on failure.
+# any free one), SMOKE_PROXY=0 to skip the proxy part, SMOKE_KEEP=1 to keep containers on failure,
+# SMOKE_PRUNE=1 to remove untagged images (old builds, the build stage) at the end: less disk,
+# but the next build installs the build dependencies again.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-if [ "$(id -u)" -ne 0 ]; then exec sudo --preserve-env=SMOKE_IMAGE,SMOKE_PORT,SMOKE_PROXY,SMOKE_KEEP "$0" "$@"; fi
+if [ "$(id -u)" -ne 0 ]; then exec sudo --preserve-env=SMOKE_IMAGE,SMOKE_PORT,SMOKE_PROXY,SMOKE_KEEP,SMOKE_PRUNE "$0" "$@"; fi
 
 IMAGE=${SMOKE_IMAGE:-localhost/penumbra:smoke}
 PROXY_IMAGE=${IMAGE%:*}-proxy:${IMAGE##*:}
@@ -57,9 +59,11 @@ cleanup() {
     echo "SMOKE_KEEP=1: left $NAME, $PROXY_NAME, $NETWORK, $VOLUME and $WORK" >&2
     exit "$rc"
   fi
-  podman rm -f -t 5 "$PROXY_NAME" "$NAME" >/dev/null 2>&1 || true
+  podman rm -f -v -t 5 "$PROXY_NAME" "$NAME" >/dev/null 2>&1 || true
   podman network rm -f "$NETWORK" >/dev/null 2>&1 || true
   podman volume rm -f "$VOLUME" >/dev/null 2>&1 || true
+  # Each build leaves its build stage behind as an untagged image (it is also the layer cache).
+  if [ "${SMOKE_PRUNE:-0}" = 1 ]; then podman image prune -f >/dev/null 2>&1 || true; fi
   rm -rf "$WORK"
   if [ "$rc" -eq 0 ]; then
     printf '\n== [%4ss] container smoke test passed\n' "$(( $(date +%s) - T0 ))"
@@ -136,7 +140,7 @@ t=$(date +%s)
 nice -n 10 podman build --pull=never --format docker -f docker/Dockerfile -t "$IMAGE" . \
   >"$WORK/build.log" 2>&1 || { tail -40 "$WORK/build.log" >&2; fail "image build"; }
 ok "built in $(( $(date +%s) - t )) s, $(podman image inspect --format '{{.Size}}' "$IMAGE" | awk '{printf "%.0f MB", $1/1e6}')"
-podman run --rm "$IMAGE" --version
+pm run --rm "$IMAGE" --version
 podman image inspect --format '{{json .Config.Healthcheck}}' "$IMAGE" | grep -q healthz ||
   fail "the image has no HEALTHCHECK on /healthz (was it built with --format docker?)"
 ok "HEALTHCHECK on /healthz in the image config"
