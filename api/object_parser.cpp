@@ -79,6 +79,7 @@ std::optional<QuadShape> parse_quad(ObjectReader& reader, const AffineTransform&
 
 ParsedObjects parse_objects(const Json* objects, const std::string& pointer,
                             const ParsedMaterials& materials, double shutter_extent,
+                            const glm::dvec3& origin,
                             const Limits& limits, Diagnostics& diag) {
   ParsedObjects parsed;
   parsed.material_used.assign(materials.names.size(), false);
@@ -134,6 +135,8 @@ ParsedObjects parse_objects(const Json* objects, const std::string& pointer,
       transform_ok = parsed_transform.has_value();
       if (parsed_transform) transform = *parsed_transform;
     }
+    // Positions are handed to the renderer relative to the camera (see parse_camera).
+    transform.translation -= origin;
     if (!type) continue;
 
     if (*type == "sphere") {

@@ -42,6 +42,10 @@ enum class LoadErrorKind {
 struct SceneRequest {
   SceneInput scene;
   RenderSettings settings;
+  // Positions in `scene` are relative to this point of the JSON's coordinate system (the camera
+  // position): single-precision rendering keeps its accuracy however far from the JSON origin
+  // the scene lies. Add it back to recover JSON coordinates.
+  glm::dvec3 world_origin{0.0};
 };
 
 struct LoadResult {

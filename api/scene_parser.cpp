@@ -73,7 +73,11 @@ void parse_render(const Json* value, const Limits& limits, RenderSettings& setti
   r.report_unknown_keys();
 }
 
-void parse_camera(const Json* value, CameraDesc& camera, Diagnostics& diag) {
+// The renderer computes in single precision. A scene placed far from the origin (1e5, 1e6)
+// would lose most of its float mantissa to the offset, so every position is expressed relative
+// to the camera position, subtracted here in double precision: rendering is invariant under
+// translation, and precision is then highest where the image is made. `origin` receives it.
+void parse_camera(const Json* value, CameraDesc& camera, glm::dvec3& origin, Diagnostics& diag) {
   if (!value) {
     diag.error("/camera", "required field is missing");
     return;
@@ -106,8 +110,9 @@ void parse_camera(const Json* value, CameraDesc& camera, Diagnostics& diag) {
   if (fov) camera.fov_degrees = float(*fov);
   if (aperture) camera.aperture_radius = float(*aperture);
   if (!position || !look_at) return;
-  camera.position = to_float(*position);
-  camera.look_at = to_float(*look_at);
+  origin = *position;
+  camera.position = vec3(0.f);
+  camera.look_at = to_float(*look_at - origin);
   // Judge degeneracy in single precision: that is where the renderer builds its frame.
   const glm::dvec3 view = glm::dvec3(camera.look_at) - glm::dvec3(camera.position);
   const double distance = glm::length(view);
@@ -133,7 +138,8 @@ void parse_camera(const Json* value, CameraDesc& camera, Diagnostics& diag) {
   camera.focus_distance = focus ? float(*focus) : float(distance);
 }
 
-void parse_lights(const Json* value, const Limits& limits, std::vector<LightDesc>& lights,
+void parse_lights(const Json* value, const Limits& limits, const glm::dvec3& origin,
+                  std::vector<LightDesc>& lights,
                   bool& any_power, Diagnostics& diag) {
   if (!value) return;
   if (!value->is_array()) {
@@ -155,7 +161,7 @@ void parse_lights(const Json* value, const Limits& limits, std::vector<LightDesc
       const auto position = r.vec3("position", coordinate, Presence::kRequired);
       const auto intensity = r.vec3("intensity", Range::at_least(0), Presence::kRequired);
       if (position && intensity) {
-        lights.push_back(PointLightDesc{to_float(*position), to_float(*intensity)});
+        lights.push_back(PointLightDesc{to_float(*position - origin), to_float(*intensity)});
         any_power |= !is_black(to_float(*intensity));
       }
     } else if (*type == "directional") {
@@ -194,7 +200,8 @@ std::optional<SceneRequest> parse_scene(const Json& document, const Limits& limi
   root.string("$schema");
 
   parse_render(root.get("render"), limits, request.settings, diag);
-  parse_camera(root.get("camera"), request.scene.camera, diag);
+  glm::dvec3 origin(0.0);
+  parse_camera(root.get("camera"), request.scene.camera, origin, diag);
 
   bool environment_lit = false;
   if (const Json* environment = root.get("environment")) {
@@ -211,10 +218,10 @@ std::optional<SceneRequest> parse_scene(const Json& document, const Limits& limi
   const double shutter_extent =
       std::max(std::abs(double(camera.shutter_open)), std::abs(double(camera.shutter_close)));
   ParsedObjects objects =
-      parse_objects(root.get("objects"), "/objects", materials, shutter_extent, limits, diag);
+      parse_objects(root.get("objects"), "/objects", materials, shutter_extent, origin, limits, diag);
 
   bool lights_lit = false;
-  parse_lights(root.get("lights"), limits, request.scene.lights, lights_lit, diag);
+  parse_lights(root.get("lights"), limits, origin, request.scene.lights, lights_lit, diag);
   root.report_unknown_keys();
   if (diag.has_errors()) return std::nullopt;
 
@@ -225,6 +232,7 @@ std::optional<SceneRequest> parse_scene(const Json& document, const Limits& limi
     diag.warning("", "the scene has no light source (no emission, no lights with power, black "
                      "environment): the image will be black");
 
+  request.world_origin = origin;
   request.scene.materials = std::move(materials.params);
   request.scene.objects = std::move(objects.objects);
   return request;

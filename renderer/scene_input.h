@@ -1,6 +1,8 @@
 #pragma once
 // The renderer's input: a scene as plain data, in world space, already validated.
-// api/ produces it from JSON (applying object transforms); tests may build it directly.
+// api/ produces it from JSON (applying object transforms) and places the origin at the camera
+// position, computed in double precision, so single-precision rendering keeps its accuracy for
+// scenes far from the JSON origin; tests may build it directly.
 #include <string>
 #include <variant>
 #include <vector>

@@ -23,8 +23,26 @@ inline Json base_scene() {
   })");
 }
 
+// The loader puts the renderer's origin at the camera (SceneRequest::world_origin); the tests
+// state positions in the JSON's coordinates, so add the origin back in double precision.
+inline void restore_json_coordinates(SceneRequest& r) {
+  auto add = [&](vec3& p) { p = vec3(glm::dvec3(p) + r.world_origin); };
+  add(r.scene.camera.position);
+  add(r.scene.camera.look_at);
+  for (ObjectDesc& o : r.scene.objects) {
+    if (auto* s = std::get_if<SphereShape>(&o.shape)) add(s->center);
+    if (auto* q = std::get_if<QuadShape>(&o.shape)) add(q->origin);
+    if (auto* m = std::get_if<MeshShape>(&o.shape))
+      for (vec3& p : m->positions) add(p);
+  }
+  for (LightDesc& l : r.scene.lights)
+    if (auto* p = std::get_if<PointLightDesc>(&l)) add(p->position);
+}
+
 inline LoadResult load(const Json& scene, const Limits& limits = {}) {
-  return load_scene(scene.dump(), limits);
+  LoadResult r = load_scene(scene.dump(), limits);
+  if (r.request) restore_json_coordinates(*r.request);
+  return r;
 }
 
 inline std::string describe(const std::vector<Diagnostic>& list) {
