@@ -1,9 +1,47 @@
 #include "renderer/plastic.h"
 
+#include <tbb/parallel_for.h>
+
+#include <map>
+#include <mutex>
+
 #include "renderer/fresnel.h"
 #include "renderer/sampling.h"
 
 namespace penumbra {
+namespace {
+
+struct RoughCoatingTables {
+  std::array<float, PlasticBsdf::kTransmittanceRes> transmittance;
+  float internal_reflectance;
+};
+
+// The tables cost ~10^6 microfacet evaluations; they depend only on (alpha, eta), so every
+// material (and every scene a long-running server builds) with the same coating shares them.
+const RoughCoatingTables& rough_coating_tables(const GgxDistribution& distr, float eta) {
+  static std::mutex mutex;
+  static std::map<std::pair<float, float>, std::unique_ptr<RoughCoatingTables>> cache;
+  const std::pair<float, float> key(distr.alpha(), eta);
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (auto it = cache.find(key); it != cache.end()) return *it->second;
+  }
+  auto tables = std::make_unique<RoughCoatingTables>();
+  std::array<double, PlasticBsdf::kTransmittanceRes> internal{};
+  tbb::parallel_for(0, PlasticBsdf::kTransmittanceRes, [&](int i) {
+    const float mu = std::max(1e-6f, float(i) / float(PlasticBsdf::kTransmittanceRes - 1));
+    tables->transmittance[i] = rough_dielectric_transmittance(distr, mu, eta);
+    internal[i] = rough_dielectric_reflectance(distr, mu, 1.f / eta) * mu;
+  });
+  double sum = 0.0;
+  for (double v : internal) sum += v;  // fixed order: the result does not depend on threads
+  tables->internal_reflectance = float(2.0 * sum / PlasticBsdf::kTransmittanceRes);
+  std::lock_guard<std::mutex> lock(mutex);
+  auto [it, inserted] = cache.emplace(key, std::move(tables));
+  return *it->second;
+}
+
+}  // namespace
 
 PlasticBsdf::PlasticBsdf(const PlasticParams& params)
     : color_(params.color),
@@ -24,13 +62,9 @@ PlasticBsdf::PlasticBsdf(const PlasticParams& params)
   // Rough coating: tabulate the external transmittance t(mu) on mu = linspace(0, 1) (clamped
   // away from 0) and average the internal reflectance 2 \int R_int(mu) mu dmu over the same
   // nodes -- the tables Mitsuba 3's roughplastic builds, so the diffuse part matches it.
-  double internal = 0.0;
-  for (int i = 0; i < kTransmittanceRes; ++i) {
-    const float mu = std::max(1e-6f, float(i) / float(kTransmittanceRes - 1));
-    transmittance_[i] = rough_dielectric_transmittance(distr_, mu, eta_);
-    internal += rough_dielectric_reflectance(distr_, mu, 1.f / eta_) * mu;
-  }
-  internal_reflectance_ = float(2.0 * internal / kTransmittanceRes);
+  const RoughCoatingTables& tables = rough_coating_tables(distr_, eta_);
+  transmittance_ = tables.transmittance;
+  internal_reflectance_ = tables.internal_reflectance;
 }
 
 float PlasticBsdf::external_transmittance(float cos_theta) const {
