@@ -43,6 +43,31 @@ std::vector<int> make_passes(int spp) {
   return passes;
 }
 
+// Adaptive sampling: a pixel stops when the estimated relative error of every pixel in its 3x3
+// neighbourhood is below the threshold. A single pixel's variance estimate from a few dozen
+// samples is itself noisy, and a pixel that has not yet met a rare bright path (a caustic, a
+// small light seen through glass) reports a low variance and would stop with a large error;
+// the neighbourhood test catches most of them, as Cycles' adaptive sampling does by judging
+// windows of pixels rather than single ones.
+void update_converged(const Film& film, float threshold, std::vector<uint8_t>* done) {
+  const int w = film.width(), h = film.height();
+  std::vector<float> err(size_t(w) * h);
+  tbb::parallel_for(0, h, [&](int y) {
+    for (int x = 0; x < w; ++x) err[size_t(y) * w + x] = float(film.relative_error(x, y));
+  });
+  tbb::parallel_for(0, h, [&](int y) {
+    for (int x = 0; x < w; ++x) {
+      uint8_t& d = (*done)[size_t(y) * w + x];
+      if (d) continue;
+      float worst = 0.f;
+      for (int yy = std::max(0, y - 1); yy <= std::min(h - 1, y + 1); ++yy)
+        for (int xx = std::max(0, x - 1); xx <= std::min(w - 1, x + 1); ++xx)
+          worst = std::max(worst, err[size_t(yy) * w + xx]);
+      if (worst < threshold) d = 1;
+    }
+  });
+}
+
 }  // namespace
 
 RenderResult render(const Scene& scene_handle, const RenderSettings& settings,
@@ -88,7 +113,9 @@ RenderResult render(const Scene& scene_handle, const RenderSettings& settings,
   for (size_t pass = 0; pass < passes.size() && !stop.load(); ++pass) {
     const int s0 = first_sample, s1 = first_sample + passes[pass];
     // Judge convergence only once a pixel has enough samples for a usable variance estimate.
-    const bool check_adaptive = adaptive && s0 >= 16;
+    // Decided here, between passes, so the result does not depend on threads or tile order.
+    if (adaptive && s0 >= 16)
+      arena.execute([&] { update_converged(film, settings.noise_threshold, &done_pixel); });
     arena.execute([&] {
       tbb::parallel_for(tbb::blocked_range<size_t>(0, tiles.size(), 1), [&](const auto& range) {
         for (size_t ti = range.begin(); ti != range.end(); ++ti) {
@@ -109,12 +136,7 @@ RenderResult render(const Scene& scene_handle, const RenderSettings& settings,
           uint64_t tile_samples = 0, tile_nonfinite = 0;
           for (int y = tile.y0; y < tile.y1; ++y) {
             for (int x = tile.x0; x < tile.x1; ++x) {
-              uint8_t& done = done_pixel[size_t(y) * width + x];
-              if (done) continue;
-              if (check_adaptive && film.relative_error(x, y) < settings.noise_threshold) {
-                done = 1;
-                continue;
-              }
+              if (done_pixel[size_t(y) * width + x]) continue;
               for (int s = s0; s < s1; ++s) {
                 sampler.start_pixel_sample(x, y, uint32_t(s));
                 const vec2 film_pos = vec2(float(x), float(y)) + sampler.get_2d();
