@@ -2,8 +2,7 @@
 
 namespace penumbra {
 
-vec3 ObjectRecord::displacement_at(float time, float shutter_open, float shutter_span) const {
-  if (motion.is_static()) return vec3(0.f);
+vec3 ObjectRecord::moving_displacement_at(float time, float shutter_open, float shutter_span) const {
   if (kind == Kind::kSphere) return motion.displacement(shutter_open + time * shutter_span);
   // Embree interpolates vertex buffers linearly between evenly spread time steps.
   const float f = std::clamp(time, 0.f, 1.f) * float(time_steps - 1);

@@ -53,7 +53,11 @@ struct ObjectRecord {
 
   // Displacement at normalised shutter time `time` as Embree interpolates it (triangles) or
   // exactly (spheres).
-  vec3 displacement_at(float time, float shutter_open, float shutter_span) const;
+  vec3 displacement_at(float time, float shutter_open, float shutter_span) const {
+    if (motion.is_static()) return vec3(0.f);
+    return moving_displacement_at(time, shutter_open, shutter_span);
+  }
+  vec3 moving_displacement_at(float time, float shutter_open, float shutter_span) const;
 };
 
 class SceneImpl;

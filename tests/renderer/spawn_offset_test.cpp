@@ -118,3 +118,14 @@ INSTANTIATE_TEST_SUITE_P(
 
 }  // namespace
 }  // namespace penumbra::testing
+
+namespace penumbra {
+namespace {
+TEST(NextFloat, MatchesNextafter) {
+  for (float v : {0.f, -0.f, 1.f, -1.f, 1e-40f, -1e-40f, 3.5e6f, -2.25e-3f, 1e38f, -1e38f}) {
+    EXPECT_EQ(next_float_up(v), std::nextafter(v, INFINITY)) << v;
+    EXPECT_EQ(next_float_down(v), std::nextafter(v, -INFINITY)) << v;
+  }
+}
+}  // namespace
+}  // namespace penumbra
