@@ -74,32 +74,62 @@ class Sampler {
   explicit Sampler(uint64_t seed) : seed_(mix64(seed + 0x51ed270b27c3a4f1ull)) {}
 
   void start_pixel_sample(int x, int y, uint32_t sample_index) {
-    pixel_seed_ = hash_combine(seed_, (uint64_t(uint32_t(y)) << 32) | uint32_t(x));
+    // The scrambling seeds depend on (pixel, dimension) only, so consecutive samples of one
+    // pixel reuse them.
+    if (x != pixel_x_ || y != pixel_y_ || cached_ == 0) {
+      pixel_x_ = x;
+      pixel_y_ = y;
+      pixel_seed_ = hash_combine(seed_, (uint64_t(uint32_t(y)) << 32) | uint32_t(x));
+      cached_ = 0;
+    }
     index_ = sample_index;
     dimension_ = 0;
   }
 
   float get_1d() {
-    const uint64_t h = hash_combine(pixel_seed_, dimension_++);
-    const uint32_t shuffled = nested_uniform_scramble(index_, uint32_t(h));
+    const DimensionSeeds& h = seeds(dimension_++);
+    const uint32_t shuffled = nested_uniform_scramble(index_, uint32_t(h.a));
     // nested_uniform_scramble(reverse(i)) = reverse(LK(i)): two reversals cancel.
-    return fixed_to_unit_float(reverse_bits32(laine_karras_permutation(shuffled, uint32_t(h >> 32))));
+    return fixed_to_unit_float(reverse_bits32(laine_karras_permutation(shuffled, uint32_t(h.a >> 32))));
   }
 
   vec2 get_2d() {
-    const uint64_t h = hash_combine(pixel_seed_, dimension_++);
-    const uint64_t h2 = mix64(h);
-    const uint32_t shuffled = nested_uniform_scramble(index_, uint32_t(h));
+    const DimensionSeeds& h = seeds(dimension_++);
+    const uint32_t shuffled = nested_uniform_scramble(index_, uint32_t(h.a));
     return vec2(
-        fixed_to_unit_float(reverse_bits32(laine_karras_permutation(shuffled, uint32_t(h >> 32)))),
-        fixed_to_unit_float(nested_uniform_scramble(sobol_dimension1(shuffled), uint32_t(h2))));
+        fixed_to_unit_float(reverse_bits32(laine_karras_permutation(shuffled, uint32_t(h.a >> 32)))),
+        fixed_to_unit_float(nested_uniform_scramble(sobol_dimension1(shuffled), uint32_t(h.b))));
   }
 
  private:
+  struct DimensionSeeds {
+    uint64_t a, b;
+  };
+  static constexpr uint64_t kCachedDimensions = 64;
+
+  const DimensionSeeds& seeds(uint64_t dimension) {
+    if (dimension < kCachedDimensions) {
+      DimensionSeeds& s = cache_[dimension];
+      if (!((cached_ >> dimension) & 1u)) {
+        s.a = hash_combine(pixel_seed_, dimension);
+        s.b = mix64(s.a);
+        cached_ |= uint64_t(1) << dimension;
+      }
+      return s;
+    }
+    overflow_.a = hash_combine(pixel_seed_, dimension);
+    overflow_.b = mix64(overflow_.a);
+    return overflow_;
+  }
+
   uint64_t seed_;
   uint64_t pixel_seed_ = 0;
+  int pixel_x_ = -1, pixel_y_ = -1;
   uint32_t index_ = 0;
   uint64_t dimension_ = 0;
+  uint64_t cached_ = 0;  // bit d set: cache_[d] holds the seeds of dimension d for this pixel
+  DimensionSeeds cache_[kCachedDimensions];
+  DimensionSeeds overflow_{};
 };
 
 }  // namespace penumbra
