@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Installs every Debian 12 package penumbra needs to build, test and run.
 # Idempotent; needs root (or sudo). Used by the README, .ci/run and docker/Dockerfile.
+#   scripts/install-deps.sh           build, test and run
+#   scripts/install-deps.sh --fuzz    also clang and its sanitizer/libFuzzer runtime (scripts/fuzz.sh)
 set -euo pipefail
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
@@ -10,6 +12,7 @@ PKGS=(
   libcpp-httplib-dev nlohmann-json3-dev libtbb-dev libsqlite3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
 )
+if [ "${1:-}" = "--fuzz" ]; then PKGS+=(clang libclang-rt-14-dev); fi
 missing=()
 for p in "${PKGS[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
