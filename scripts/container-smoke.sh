@@ -316,6 +316,22 @@ if [ "${SMOKE_PROXY:-1}" != 0 ]; then
   c=$(curl -sS -o "$WORK/proxy.png" -w '%{http_code}' --max-time 30 "${auth[@]}" "$PBASE$JOB/result?format=png")
   [ "$c" = 200 ] && cmp -s "$WORK/result.png" "$WORK/proxy.png" || fail "PNG via the proxy: $c"
   ok "PNG via the proxy is byte-identical"
+  # A new render through the proxy, with the service's root file system read-only and no
+  # capabilities (as in compose.yaml): it may write only to its data volume and /tmp.
+  c=$(curl -sS -D "$WORK/post2.headers" -o /dev/null -w '%{http_code}' --max-time 30 "${auth[@]}" \
+    -H 'Content-Type: application/json' --data-binary @"$WORK/scene.json" "$PBASE/v1/jobs")
+  [ "$c" = 202 ] || fail "POST /v1/jobs via the proxy: $c"
+  JOB2=$(tr -d '\r' <"$WORK/post2.headers" | sed -n 's/^[Ll]ocation: *//p' | head -1)
+  deadline=$(( $(date +%s) + 180 ))
+  until [ "$(curl -fsS --max-time 10 "${auth[@]}" "$PBASE$JOB2" |
+             python3 -c 'import json,sys; print(json.load(sys.stdin)["state"])')" = succeeded ]; do
+    [ "$(date +%s)" -lt "$deadline" ] || fail "job $JOB2 via the proxy did not succeed in 180 s"
+    sleep 1
+  done
+  curl -fsS --max-time 30 "${auth[@]}" -o "$WORK/proxy2.png" "$PBASE$JOB2/result?format=png" ||
+    fail "PNG of $JOB2 via the proxy"
+  check_png "$WORK/proxy2.png" "$W" "$H" || fail "the PNG of $JOB2"
+  ok "a new job rendered through the proxy on a read-only root file system"
   head -c $(( 16 * 1024 * 1024 + 1 )) /dev/zero >"$WORK/big.json"
   c=$(code "${auth[@]}" -H 'Content-Type: application/json' --data-binary @"$WORK/big.json" "$PBASE/v1/jobs")
   [ "$c" = 413 ] || fail "16 MiB + 1 body via the proxy: $c, expected 413"
