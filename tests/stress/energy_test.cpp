@@ -54,8 +54,11 @@ TEST_P(Furnace, NeverAboveOneAndOneWhereConserved) {
   const double noise = 4 * m.stderr_of_mean;
   const char* integrator = kind == IntegratorKind::kPath ? "path" : "distributed";
   EXPECT_LT(m.mean, 1.0 + 0.003 + noise) << c.name << " " << integrator;
-  if (c.conserves) EXPECT_NEAR(m.mean, 1.0, 0.005 + noise) << c.name << " " << integrator;
-  else EXPECT_GT(m.mean, c.lower) << c.name << " " << integrator;
+  if (c.conserves) {
+    EXPECT_NEAR(m.mean, 1.0, 0.005 + noise) << c.name << " " << integrator;
+  } else {
+    EXPECT_GT(m.mean, c.lower) << c.name << " " << integrator;
+  }
   // Per pixel as well: no pixel may gain energy beyond its own noise.
   int hot = 0;
   for (int y = 0; y < r.image.height; ++y)
