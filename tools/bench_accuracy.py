@@ -73,12 +73,16 @@ def read_exr(mi, path: str) -> np.ndarray:
     return np.array(mi.Bitmap(path), dtype=np.float64)[..., :3]
 
 
-def run_penumbra(binary: str, scene_path: str, spp: int, seed: int, mi) -> tuple[np.ndarray, float]:
-    """Render with the penumbra CLI; returns the image and build + render seconds."""
+def run_penumbra(binary: str, scene_path: str, spp: int, seed: int, mi,
+                 noise_threshold: float = 0.0) -> tuple[np.ndarray, float]:
+    """Render with the penumbra CLI (adaptive sampling when ``noise_threshold`` > 0, with ``spp``
+    as the per-pixel cap); returns the image and build + render seconds."""
     with tempfile.TemporaryDirectory() as tmp:
         out = os.path.join(tmp, "out.exr")
-        proc = subprocess.run([binary, "render", scene_path, "-o", out, "--spp", str(spp), "--seed", str(seed), "-q"],
-                              capture_output=True, text=True, check=True)
+        cmd = [binary, "render", scene_path, "-o", out, "--spp", str(spp), "--seed", str(seed), "-q"]
+        if noise_threshold > 0:
+            cmd += ["--noise-threshold", str(noise_threshold)]
+        proc = subprocess.run(cmd, capture_output=True, text=True, check=True)
         match = SUMMARY.search(proc.stdout + proc.stderr)
         if not match:
             raise RuntimeError(f"no summary line from penumbra: {proc.stdout}{proc.stderr}")
@@ -130,7 +134,7 @@ def summarise(rows: list[dict], scenes: list[str], renderers: list[str]) -> list
         target = float(np.mean([r["relmse"] for r in pen if r["spp"] == top]))
         secs = {name: time_to_reach([r for r in rows if r["scene"] == scene and r["renderer"] == name], target)
                 for name in renderers}
-        mitsuba = [v for k, v in secs.items() if k != "penumbra" and not math.isnan(v)]
+        mitsuba = [v for k, v in secs.items() if k.startswith("mitsuba") and not math.isnan(v)]
         ratio = secs["penumbra"] / min(mitsuba) if mitsuba else math.nan
         moving = any(r["instants"] > 1 for r in rows if r["scene"] == scene)
         lines.append(f"| {scene}{' (motion: Mitsuba averages instants)' if moving else ''} | {target:.2e} | "
@@ -176,6 +180,8 @@ def main(argv: list[str]) -> int:
                     help="Mitsuba variants to measure, comma-separated ('' for none)")
     ap.add_argument("--instants", type=int, default=16, help="shutter instants for Mitsuba motion blur")
     ap.add_argument("--only", default="", help="comma-separated scene names (default: all)")
+    ap.add_argument("--adaptive", type=float, default=0.01,
+                    help="also run penumbra with this render.noise_threshold (spp = cap); 0 to skip")
     ap.add_argument("--out", default=os.path.join(REPO, "bench", "out"))
     args = ap.parse_args(argv)
 
@@ -188,7 +194,7 @@ def main(argv: list[str]) -> int:
     mi = p2m.import_mitsuba(variants[0] if variants else "scalar_rgb")
 
     rows: list[dict] = []
-    renderers = ["penumbra"] + [f"mitsuba {v}" for v in variants]
+    renderers = ["penumbra"] + (["penumbra adaptive"] if args.adaptive > 0 else []) + [f"mitsuba {v}" for v in variants]
     for scene_name in scenes:
         scene_path = os.path.join(ACCURACY, "scenes", f"{scene_name}.json")
         scene = p2m.load_json(scene_path)
@@ -197,19 +203,20 @@ def main(argv: list[str]) -> int:
         for renderer in renderers:
             # One discarded warm-up render: Dr.Jit compiles its kernels on first use, and the
             # first penumbra run pays for reading the scene file from a cold cache.
-            if renderer == "penumbra":
+            threshold = args.adaptive if renderer == "penumbra adaptive" else 0.0
+            if renderer.startswith("penumbra"):
                 run_penumbra(args.penumbra, scene_path, ladder[0], 0, mi)
             else:
                 run_mitsuba(renderer.split()[1], scene, max(ladder[0], instants), 0, instants)
             for spp in ladder:
                 for seed in range(args.seeds):
-                    if renderer == "penumbra":
-                        image, seconds = run_penumbra(args.penumbra, scene_path, spp, seed, mi)
+                    if renderer.startswith("penumbra"):
+                        image, seconds = run_penumbra(args.penumbra, scene_path, spp, seed, mi, threshold)
                         used_instants = 1
                     else:
                         image, seconds = run_mitsuba(renderer.split()[1], scene, max(spp, instants), seed, instants)
                         used_instants = instants
-                    used_spp = spp if renderer == "penumbra" else max(spp, instants)
+                    used_spp = spp if renderer.startswith("penumbra") else max(spp, instants)
                     row = {"scene": scene_name, "renderer": renderer, "spp": used_spp, "seed": seed,
                            "seconds": seconds, "instants": used_instants, **errors(image, reference)}
                     rows.append(row)
