@@ -12,6 +12,7 @@
 #include "renderer/render.h"
 #include "renderer/scene.h"
 #include "renderer/scene_input.h"
+#include "tests/renderer/render_test_util.h"
 
 namespace penumbra::stress {
 
@@ -25,10 +26,7 @@ inline RenderSettings settings(int w, int h, int spp, int max_depth = -1, uint64
   return s;
 }
 
-inline RenderResult render_input(const SceneInput& input, const RenderSettings& s) {
-  const auto scene = Scene::build(input);
-  return render(*scene, s);
-}
+using testing::render_input;
 
 // Loads JSON scene text with the public loader (asserting it is valid) and renders it.
 inline RenderResult render_json(const std::string& json, const RenderSettings* override_settings = nullptr) {
@@ -120,36 +118,17 @@ inline BlockComparison compare_blocks(const RenderResult& a, const RenderResult&
   return cmp;
 }
 
-inline CameraDesc camera_looking(const vec3& from, const vec3& to, float fov, const vec3& up = {0, 1, 0}) {
-  CameraDesc c;
-  c.position = from;
-  c.look_at = to;
-  c.up = up;
-  c.fov_degrees = fov;
-  c.focus_distance = glm::length(to - from);
-  return c;
-}
-
+// Scene-building helpers shared with the renderer tests.
+using testing::camera_looking;
 inline ObjectDesc quad(const vec3& origin, const vec3& u, const vec3& v, uint32_t material,
                        const Spectrum& emission = Spectrum(0.f)) {
-  ObjectDesc o;
-  o.shape = QuadShape{origin, u, v};
-  o.material = material;
-  o.emission = emission;
-  return o;
+  return testing::quad_object(origin, u, v, material, emission);
 }
-
 inline ObjectDesc sphere(const vec3& center, float radius, uint32_t material,
                          const Spectrum& emission = Spectrum(0.f)) {
-  ObjectDesc o;
-  o.shape = SphereShape{center, radius};
-  o.material = material;
-  o.emission = emission;
-  return o;
+  return testing::sphere_object(center, radius, material, emission);
 }
 
-// Axis-aligned box as a closed triangle mesh, faces counter-clockwise seen from outside (so its
-// front side, and a dielectric's outside, is outward).
 inline ObjectDesc box(const vec3& lo, const vec3& hi, uint32_t material) {
   MeshShape m;
   for (int i = 0; i < 8; ++i)
