@@ -17,6 +17,7 @@
 #include "server/job_json.h"
 #include "server/problem.h"
 #include "server/request_guard.h"
+#include "server/text_util.h"
 
 namespace penumbra::server {
 namespace {
@@ -25,17 +26,6 @@ using json = nlohmann::ordered_json;
 constexpr const char* kIdPattern = "([0-9a-f]{24})";
 constexpr int kDefaultPageSize = 20;
 constexpr int kMaxPageSize = 100;
-
-std::string lower(std::string s) {
-  for (char& c : s) c = char(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
-
-std::string trim(const std::string& s) {
-  const auto b = s.find_first_not_of(" \t");
-  if (b == std::string::npos) return "";
-  return s.substr(b, s.find_last_not_of(" \t") - b + 1);
-}
 
 void send_json(httplib::Response& res, int status, const json& body) {
   res.status = status;
@@ -61,7 +51,7 @@ double retry_after(const JobView& v) {
 // format=png|exr wins; else the first acceptable type of Accept; else PNG.
 std::variant<ImageFormat, Problem> negotiate_format(const httplib::Request& req) {
   if (req.has_param("format")) {
-    const std::string f = lower(req.get_param_value("format"));
+    const std::string f = ascii_lower(req.get_param_value("format"));
     if (f == "png") return ImageFormat::kPng;
     if (f == "exr") return ImageFormat::kExr;
     Problem p = make_problem(400, "invalid-parameter", "Invalid query parameter",
@@ -70,7 +60,7 @@ std::variant<ImageFormat, Problem> negotiate_format(const httplib::Request& req)
     return p;
   }
   if (!req.has_header("Accept")) return ImageFormat::kPng;
-  const std::string accept = lower(req.get_header_value("Accept"));
+  const std::string accept = ascii_lower(req.get_header_value("Accept"));
   std::size_t start = 0;
   while (start <= accept.size()) {
     const std::size_t comma = std::min(accept.find(',', start), accept.size());
@@ -81,7 +71,7 @@ std::variant<ImageFormat, Problem> negotiate_format(const httplib::Request& req)
       params = range.substr(semi);
       range = range.substr(0, semi);
     }
-    range = trim(range);
+    range = trim_ows(range);
     if (std::regex_search(params, std::regex(R"(q\s*=\s*0(\.0*)?\s*($|;))"))) continue;  // q=0: refused
     if (range == "image/png" || range == "image/*" || range == "*/*") return ImageFormat::kPng;
     if (range == "image/x-exr" || range == "image/exr" || range == "image/aces") return ImageFormat::kExr;
@@ -95,7 +85,7 @@ const char* extension(ImageFormat f) { return f == ImageFormat::kPng ? "png" : "
 
 std::variant<std::string, Problem> idempotency_key(const httplib::Request& req) {
   if (!req.has_header("Idempotency-Key")) return std::string();
-  std::string key = trim(req.get_header_value("Idempotency-Key"));
+  std::string key = trim_ows(req.get_header_value("Idempotency-Key"));
   // draft-ietf-httpapi-idempotency-key-header sends it as a quoted structured-field string.
   if (key.size() >= 2 && key.front() == '"' && key.back() == '"') key = key.substr(1, key.size() - 2);
   const bool printable = std::all_of(key.begin(), key.end(), [](char c) { return c > 0x20 && c < 0x7f; });
@@ -386,7 +376,7 @@ void HttpServer::install_routes() {
     const ImageFormat f = std::get<ImageFormat>(format);
     const auto v = jobs_.view(id);
     if (!v) return problem(res, req, status_problem(404, "no job " + id));
-    const std::string preview_param = lower(req.get_param_value("preview"));
+    const std::string preview_param = ascii_lower(req.get_param_value("preview"));
     const bool preview = preview_param == "true" || preview_param == "1";
     if (v->record.state == JobState::kSucceeded) {
       if (send_file(res, jobs_.result_path(id, extension(f)), f, id)) return;

@@ -1,4 +1,5 @@
 #include "server/request_guard.h"
+#include "server/text_util.h"
 
 #include <cctype>
 #include <string>
@@ -7,17 +8,6 @@
 
 namespace penumbra::server {
 namespace {
-
-std::string lower(std::string s) {
-  for (char& c : s) c = char(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
-
-std::string trim(const std::string& s) {
-  const auto b = s.find_first_not_of(" \t");
-  if (b == std::string::npos) return "";
-  return s.substr(b, s.find_last_not_of(" \t") - b + 1);
-}
 
 bool is_digits(const std::string& s) {
   if (s.empty() || s.size() > 19) return false;
@@ -44,13 +34,13 @@ std::optional<Problem> guard_request(const httplib::Request& req, const GuardSet
   if (req.get_header_value_count("Content-Length") > 1)
     return make_problem(400, "bad-framing", "Bad Request", "more than one Content-Length header");
   if (req.has_header("Content-Encoding")) {
-    const std::string enc = lower(trim(req.get_header_value("Content-Encoding")));
+    const std::string enc = ascii_lower(trim_ows(req.get_header_value("Content-Encoding")));
     if (enc != "identity")
       return make_problem(415, "unsupported-content-encoding", "Unsupported Media Type",
                           "Content-Encoding '" + enc + "' is not accepted; send the body uncompressed");
   }
   const bool has_length = req.has_header("Content-Length");
-  const std::string length_text = trim(req.get_header_value("Content-Length"));
+  const std::string length_text = trim_ows(req.get_header_value("Content-Length"));
   if (has_length && !is_digits(length_text))
     return make_problem(400, "bad-framing", "Bad Request", "Content-Length is not a number");
   if (req.method == "POST" || req.method == "PUT" || req.method == "PATCH") {
@@ -78,8 +68,8 @@ std::optional<Problem> guard_request(const httplib::Request& req, const GuardSet
   }
   if (req.method == "POST" && req.has_header("Content-Type")) {
     // Checked before the body is read: the library would otherwise parse multipart bodies.
-    std::string type = lower(req.get_header_value("Content-Type"));
-    type = trim(type.substr(0, type.find(';')));
+    std::string type = ascii_lower(req.get_header_value("Content-Type"));
+    type = trim_ows(type.substr(0, type.find(';')));
     const bool json_like = type == "application/json" ||
                            (type.rfind("application/", 0) == 0 && type.size() > 5 &&
                             type.compare(type.size() - 5, 5, "+json") == 0);
