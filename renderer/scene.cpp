@@ -29,6 +29,13 @@ void sphere_bounds_fn(const RTCBoundsFunctionArguments* args) {
   b->upper_z = obj.center.z + hi.z + r.z;
 }
 
+vec3 ray_origin(RTCRayN* ray, unsigned n, unsigned i) {
+  return vec3(RTCRayN_org_x(ray, n, i), RTCRayN_org_y(ray, n, i), RTCRayN_org_z(ray, n, i));
+}
+vec3 ray_direction(RTCRayN* ray, unsigned n, unsigned i) {
+  return vec3(RTCRayN_dir_x(ray, n, i), RTCRayN_dir_y(ray, n, i), RTCRayN_dir_z(ray, n, i));
+}
+
 void sphere_intersect_fn(const RTCIntersectFunctionNArguments* args) {
   const auto* data = static_cast<const SphereGeometryData*>(args->geometryUserPtr);
   const SceneImpl& scene = *data->scene;
@@ -38,10 +45,7 @@ void sphere_intersect_fn(const RTCIntersectFunctionNArguments* args) {
   RTCHitN* hit = RTCRayHitN_HitN(rayhit, args->N);
   for (unsigned i = 0; i < args->N; ++i) {
     if (args->valid[i] == 0) continue;
-    const vec3 o(RTCRayN_org_x(ray, args->N, i), RTCRayN_org_y(ray, args->N, i),
-                 RTCRayN_org_z(ray, args->N, i));
-    const vec3 d(RTCRayN_dir_x(ray, args->N, i), RTCRayN_dir_y(ray, args->N, i),
-                 RTCRayN_dir_z(ray, args->N, i));
+    const vec3 o = ray_origin(ray, args->N, i), d = ray_direction(ray, args->N, i);
     const float time = RTCRayN_time(ray, args->N, i);
     const float t_near = RTCRayN_tnear(ray, args->N, i);
     float& t_far = RTCRayN_tfar(ray, args->N, i);
@@ -68,10 +72,7 @@ void sphere_occluded_fn(const RTCOccludedFunctionNArguments* args) {
   RTCRayN* ray = args->ray;
   for (unsigned i = 0; i < args->N; ++i) {
     if (args->valid[i] == 0) continue;
-    const vec3 o(RTCRayN_org_x(ray, args->N, i), RTCRayN_org_y(ray, args->N, i),
-                 RTCRayN_org_z(ray, args->N, i));
-    const vec3 d(RTCRayN_dir_x(ray, args->N, i), RTCRayN_dir_y(ray, args->N, i),
-                 RTCRayN_dir_z(ray, args->N, i));
+    const vec3 o = ray_origin(ray, args->N, i), d = ray_direction(ray, args->N, i);
     const float time = RTCRayN_time(ray, args->N, i);
     float& t_far = RTCRayN_tfar(ray, args->N, i);
     const vec3 c = obj.center + obj.displacement_at(time, scene.shutter_open, scene.shutter_span);
