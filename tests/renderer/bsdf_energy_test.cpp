@@ -127,7 +127,9 @@ TEST(BsdfEnergy, PlasticNeverGains) {
       // The smooth model conserves energy exactly for a white base up to the ~0.1-0.6% error of
       // the fdr polynomial fits Mitsuba uses; allow that.
       EXPECT_LE(a.mean, 1.0 + 4.0 * a.stderr_ + 6e-3) << "r " << r << " theta " << t;
-      if (r == 0.f) EXPECT_GT(a.mean, 0.98) << "theta " << t;
+      if (r == 0.f) {
+        EXPECT_GT(a.mean, 0.98) << "theta " << t;
+      }
     }
   }
 }
