@@ -1,4 +1,5 @@
 // `penumbra validate SCENE.json...`: checks scenes without rendering them.
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
@@ -71,9 +72,11 @@ int run_validate(int argc, char** argv) {
       continue;
     }
     const SceneInput& scene = result.request->scene;
-    std::printf("%s: OK (%zu objects, %lld triangles, %zu lights)\n", file.c_str(),
-                scene.objects.size(), static_cast<long long>(count_triangles(scene)),
-                scene.lights.size());
+    const auto emitters = std::count_if(scene.objects.begin(), scene.objects.end(),
+                                        [](const ObjectDesc& o) { return !is_black(o.emission); });
+    std::printf("%s: OK (%zu objects, %lld triangles, %zu lights, %lld emitting objects)\n",
+                file.c_str(), scene.objects.size(), static_cast<long long>(count_triangles(scene)),
+                scene.lights.size(), static_cast<long long>(emitters));
   }
   return all_valid ? 0 : 1;
 }
