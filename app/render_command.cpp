@@ -65,14 +65,13 @@ int run_render(int argc, char** argv) {
   }
   if (scene_path.empty() || output.empty())
     return p.fail(kUsage, scene_path.empty() ? "no scene given" : "no output given (-o)");
-  ImageFormat format;
+  // Reject an unsupported output name before spending time on the render.
   try {
-    format = image_format_from_path(output);
+    image_format_from_path(output);
   } catch (const ImageIoError& e) {
     std::fprintf(stderr, "penumbra render: %s\n", e.what());
     return 2;
   }
-  (void)format;
 
   api::LoadResult loaded = api::load_scene_file(scene_path);
   for (const auto& w : loaded.warnings)

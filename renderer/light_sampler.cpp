@@ -29,10 +29,9 @@ float area_to_solid_angle(const vec3& ref, const vec3& p, const vec3& n, float a
 
 }  // namespace
 
-void LightSampler::build(std::vector<Light> lights, const vec3& scene_center, float scene_radius,
+void LightSampler::build(std::vector<Light> lights, float scene_radius,
                          const std::vector<ObjectRecord>& objects) {
   lights_ = std::move(lights);
-  scene_radius_ = scene_radius;
   environment_ = -1;
   const size_t n = lights_.size();
   pmf_.assign(n, 0.f);
@@ -54,7 +53,6 @@ void LightSampler::build(std::vector<Light> lights, const vec3& scene_center, fl
     cdf_[i] = float(acc);
   }
   cdf_.back() = 1.f;
-  (void)scene_center;
 }
 
 float LightSampler::environment_pdf() const {

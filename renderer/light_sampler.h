@@ -31,7 +31,7 @@ class LightSampler {
  public:
   // Builds the selection distribution: half proportional to each light's power, half uniform,
   // so a dim but important light is never starved.
-  void build(std::vector<Light> lights, const vec3& scene_center, float scene_radius,
+  void build(std::vector<Light> lights, float scene_radius,
              const std::vector<ObjectRecord>& objects);
 
   bool empty() const { return lights_.empty(); }
@@ -51,7 +51,6 @@ class LightSampler {
   std::vector<Light> lights_;
   std::vector<float> pmf_, cdf_;
   int environment_ = -1;
-  float scene_radius_ = 1.f;
 };
 
 }  // namespace penumbra

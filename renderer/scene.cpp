@@ -253,9 +253,8 @@ std::unique_ptr<Scene> Scene::build(const SceneInput& input) {
     l.value = s.environment;
     lights.push_back(l);
   }
-  const vec3 center = 0.5f * (lo + hi);
   const float radius = std::max(0.5f * glm::length(hi - lo), 1e-6f);
-  s.lights.build(std::move(lights), center, radius, s.objects);
+  s.lights.build(std::move(lights), radius, s.objects);
 
   // Embree.
   RTCDevice device = embree_device();

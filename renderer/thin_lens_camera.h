@@ -18,10 +18,6 @@ class ThinLensCamera {
   // film: continuous pixel coordinates (x right, y down, [0,w)x[0,h)); lens, time: in [0,1).
   CameraRay generate_ray(const vec2& film, const vec2& lens, float time) const;
 
-  bool has_lens() const { return aperture_radius_ > 0.f; }
-  const vec3& position() const { return position_; }
-  float tan_half_fov() const { return tan_half_fov_; }
-  int height() const { return height_; }
 
  private:
   vec3 position_, right_, up_, forward_;
