@@ -28,7 +28,8 @@ const char* kUsage =
     "  --max-depth N            path segments (-1 = unlimited)\n"
     "  --integrator NAME        path | distributed\n"
     "  --time-limit SECONDS     stop at this budget with a correct (less converged) image\n"
-    "  --noise-threshold X      adaptive sampling: stop pixels below this relative error\n"
+    "  --noise-threshold X      adaptive sampling: aim for this relative RMS error (0.05 = 5%);\n"
+    "                           samples go where the noise is, spp is the per-pixel cap\n"
     "  -q, --quiet              no progress bar\n";
 
 std::string format_duration(double s) {

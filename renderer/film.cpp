@@ -1,23 +1,23 @@
 #include "renderer/film.h"
 
+#include <algorithm>
+#include <cmath>
+
 namespace penumbra {
 
 Film::Film(int width, int height)
     : width_(width), height_(height), pixels_(size_t(width) * size_t(height)) {}
 
-double Film::relative_error(int x, int y) const {
+double Film::relative_deviation(int x, int y) const {
   const Pixel& p = pixels_[size_t(y) * width_ + x];
   if (p.n < 2) return INFINITY;
-  const double w[3] = {0.2126, 0.7152, 0.0722};
-  double mean = 0.0, var = 0.0;
+  double sum = 0.0;
   for (int c = 0; c < 3; ++c) {
     const double m = p.sum[c] / p.n;
     const double v = std::max(0.0, (p.sum_sq[c] - p.n * m * m) / (p.n - 1));
-    mean += w[c] * m;
-    var += w[c] * w[c] * v;  // channels treated as independent: a conservative estimate
+    sum += v / (m * m + kRelativeFloor);
   }
-  // Cycles-style: error relative to the mean, with a floor so near-black pixels converge.
-  return std::sqrt(var / p.n) / std::max(mean, 1e-3);
+  return std::sqrt(sum / 3.0);
 }
 
 Image Film::resolve() const {

@@ -26,8 +26,13 @@ class Film {
     return true;
   }
   uint32_t samples(int x, int y) const { return pixels_[size_t(y) * width_ + x].n; }
-  // Relative standard error of the pixel's mean luminance (for adaptive sampling).
-  double relative_error(int x, int y) const;
+  // Relative standard deviation of one sample of the pixel (for adaptive sampling): the root of
+  // (1/3) sum_c var_c / (mean_c^2 + kRelativeFloor), so that the pixel's contribution to the
+  // image's relMSE after n samples is relative_deviation^2 / n. Infinite below two samples.
+  double relative_deviation(int x, int y) const;
+  // The floor of relMSE's denominator (mean^2 + 0.01), the usual convention: pixels darker than
+  // about 0.1 are judged by absolute rather than relative error.
+  static constexpr double kRelativeFloor = 1e-2;
 
   Image resolve() const;
   Image resolve_variance() const;  // variance of each pixel's mean, per channel

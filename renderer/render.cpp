@@ -7,6 +7,7 @@
 #include <chrono>
 #include <mutex>
 
+#include "renderer/adaptive_sampling.h"
 #include "renderer/film.h"
 #include "renderer/integrator.h"
 #include "renderer/scene_impl.h"
@@ -43,29 +44,14 @@ std::vector<int> make_passes(int spp) {
   return passes;
 }
 
-// Adaptive sampling: a pixel stops when the estimated relative error of every pixel in its 3x3
-// neighbourhood is below the threshold. A single pixel's variance estimate from a few dozen
-// samples is itself noisy, and a pixel that has not yet met a rare bright path (a caustic, a
-// small light seen through glass) reports a low variance and would stop with a large error;
-// the neighbourhood test catches most of them, as Cycles' adaptive sampling does by judging
-// windows of pixels rather than single ones.
-void update_converged(const Film& film, float threshold, std::vector<uint8_t>* done) {
+// Adaptive sampling: re-estimates every pixel's sample limit from the samples so far.
+void update_limits(const Film& film, const AdaptiveLimits& limits, std::vector<uint32_t>* out) {
   const int w = film.width(), h = film.height();
-  std::vector<float> err(size_t(w) * h);
+  std::vector<double> deviation(size_t(w) * h);
   tbb::parallel_for(0, h, [&](int y) {
-    for (int x = 0; x < w; ++x) err[size_t(y) * w + x] = float(film.relative_error(x, y));
+    for (int x = 0; x < w; ++x) deviation[size_t(y) * w + x] = film.relative_deviation(x, y);
   });
-  tbb::parallel_for(0, h, [&](int y) {
-    for (int x = 0; x < w; ++x) {
-      uint8_t& d = (*done)[size_t(y) * w + x];
-      if (d) continue;
-      float worst = 0.f;
-      for (int yy = std::max(0, y - 1); yy <= std::min(h - 1, y + 1); ++yy)
-        for (int xx = std::max(0, x - 1); xx <= std::min(w - 1, x + 1); ++xx)
-          worst = std::max(worst, err[size_t(yy) * w + xx]);
-      if (worst < threshold) d = 1;
-    }
-  });
+  *out = adaptive_sample_limits(deviation, w, h, limits);
 }
 
 }  // namespace
@@ -83,17 +69,20 @@ RenderResult render(const Scene& scene_handle, const RenderSettings& settings,
 
   Film film(width, height);
   const std::vector<Tile> tiles = make_tiles(width, height, std::max(1, settings.tile_size));
-  const std::vector<int> passes = make_passes(std::max(1, settings.spp));
-  // Adaptive sampling: pixels whose relative error fell below the threshold take no more samples.
-  std::vector<uint8_t> done_pixel(size_t(width) * height, 0);
+  const int spp = std::max(1, settings.spp);
+  const std::vector<int> passes = make_passes(spp);
+  // Per pixel: samples taken so far and the most it may take. Uniform sampling keeps every limit
+  // at spp; adaptive sampling (render.noise_threshold) re-estimates the limits after each pass
+  // from 16 samples on (renderer/adaptive_sampling.h). Sample indices stay consecutive per pixel
+  // so each pixel's samples are a prefix of its Sobol sequence.
+  std::vector<uint32_t> limit(size_t(width) * height, uint32_t(spp)), taken(size_t(width) * height, 0);
   const bool adaptive = settings.noise_threshold > 0.f;
+  const AdaptiveLimits adaptive_limits{settings.noise_threshold, 16, spp};
 
   std::atomic<uint64_t> rays{0}, samples_done{0}, nonfinite{0};
   std::atomic<bool> stop{false}, timed_out{false}, cancelled{false};
   std::mutex progress_mutex;
-  const uint64_t samples_total = uint64_t(width) * height * uint64_t(std::max(1, settings.spp));
-  RenderProgress progress;
-  progress.samples_total = samples_total;
+  uint64_t samples_total = uint64_t(width) * height * uint64_t(spp);
 
   auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
   auto make_progress = [&](int passes_done) {
@@ -112,10 +101,13 @@ RenderResult render(const Scene& scene_handle, const RenderSettings& settings,
   int passes_done = 0;
   for (size_t pass = 0; pass < passes.size() && !stop.load(); ++pass) {
     const int s0 = first_sample, s1 = first_sample + passes[pass];
-    // Judge convergence only once a pixel has enough samples for a usable variance estimate.
-    // Decided here, between passes, so the result does not depend on threads or tile order.
-    if (adaptive && s0 >= 16)
-      arena.execute([&] { update_converged(film, settings.noise_threshold, &done_pixel); });
+    // Limits are decided here, between passes, so the image does not depend on threads or tile
+    // order; the progress total follows them so the fraction and ETA stay meaningful.
+    if (adaptive && s0 >= adaptive_limits.min_samples) {
+      arena.execute([&] { update_limits(film, adaptive_limits, &limit); });
+      samples_total = 0;
+      for (size_t i = 0; i < limit.size(); ++i) samples_total += std::max(limit[i], taken[i]);
+    }
     arena.execute([&] {
       tbb::parallel_for(tbb::blocked_range<size_t>(0, tiles.size(), 1), [&](const auto& range) {
         for (size_t ti = range.begin(); ti != range.end(); ++ti) {
@@ -136,9 +128,12 @@ RenderResult render(const Scene& scene_handle, const RenderSettings& settings,
           uint64_t tile_samples = 0, tile_nonfinite = 0;
           for (int y = tile.y0; y < tile.y1; ++y) {
             for (int x = tile.x0; x < tile.x1; ++x) {
-              if (done_pixel[size_t(y) * width + x]) continue;
-              for (int s = s0; s < s1; ++s) {
-                sampler.start_pixel_sample(x, y, uint32_t(s));
+              const size_t pi = size_t(y) * width + x;
+              const uint32_t n0 = taken[pi], n1 = std::min(n0 + uint32_t(s1 - s0), limit[pi]);
+              if (n0 >= n1) continue;
+              taken[pi] = n1;
+              for (uint32_t s = n0; s < n1; ++s) {
+                sampler.start_pixel_sample(x, y, s);
                 const vec2 film_pos = vec2(float(x), float(y)) + sampler.get_2d();
                 const vec2 lens = sample_lens ? sampler.get_2d() : vec2(0.5f);
                 const float time = sample_time ? sampler.get_1d() : 0.f;

@@ -2,11 +2,13 @@
 """Run time against error: penumbra and Mitsuba 3 on the accuracy scenes.
 
     .venv-mitsuba/bin/python tools/bench_accuracy.py --penumbra build/app/penumbra \
-        [--spp 4,16,64,256] [--seeds 3] [--mitsuba llvm_ad_rgb,scalar_rgb] [--only cornell]
+        [--spp 4,16,64,256] [--seeds 3] [--mitsuba llvm_ad_rgb,scalar_rgb] [--only cornell] \
+        [--adaptive 0.1,0.05,0.03] [--adaptive-cap 1024]
 
 For each scene of tests/accuracy/scenes/, each renderer and each sample count of the ladder, over
 several seeds, it records the render's seconds, spp, RMSE, relMSE and mean FLIP against the
-Mitsuba reference (tests/accuracy/references/<scene>.exr, see docs/accuracy.md), and writes
+Mitsuba reference (and "penumbra adaptive": one point per render.noise_threshold of
+``--adaptive``, with ``--adaptive-cap`` as spp) (tests/accuracy/references/<scene>.exr, see docs/accuracy.md), and writes
 
 * ``<out>/bench.csv``   one row per render;
 * ``<out>/bench.png``   relMSE against seconds, log-log, one panel per scene, one line per renderer;
@@ -104,13 +106,21 @@ def run_mitsuba(variant: str, scene: dict, spp: int, seed: int, instants: int) -
     return total / len(times), seconds
 
 
+def curve(rows: list[dict]) -> list[tuple[float, float]]:
+    """(seconds, relMSE) seed means per point of a renderer's ladder (an spp, or for adaptive
+    sampling a threshold), in order of cost."""
+    by_point: dict[tuple, list] = {}
+    for r in rows:
+        by_point.setdefault((r["spp"], r["threshold"]), []).append(r)
+    pts = [(float(np.mean([r["seconds"] for r in rs])), float(np.mean([r["relmse"] for r in rs])))
+           for rs in by_point.values()]
+    return sorted(pts)
+
+
 def time_to_reach(rows: list[dict], target: float) -> float:
     """Seconds to reach relMSE ``target``: a least-squares line through log(relMSE) against
     log(seconds) over the ladder (seed means), evaluated at the target."""
-    by_spp: dict[int, list] = {}
-    for r in rows:
-        by_spp.setdefault(r["spp"], []).append(r)
-    pts = [(np.mean([r["seconds"] for r in rs]), np.mean([r["relmse"] for r in rs])) for rs in by_spp.values()]
+    pts = curve(rows)
     if len(pts) < 2:
         return math.nan
     x = np.log([p[0] for p in pts])
@@ -154,10 +164,8 @@ def plot(rows: list[dict], scenes: list[str], renderers: list[str], path: str) -
     fig, axes = plt.subplots(nrows, cols, figsize=(4 * cols, 3.2 * nrows), squeeze=False)
     for ax, scene in zip(axes.ravel(), scenes):
         for name in renderers:
-            rs = [r for r in rows if r["scene"] == scene and r["renderer"] == name]
-            spps = sorted({r["spp"] for r in rs})
-            xs = [np.mean([r["seconds"] for r in rs if r["spp"] == s]) for s in spps]
-            ys = [np.mean([r["relmse"] for r in rs if r["spp"] == s]) for s in spps]
+            pts = curve([r for r in rows if r["scene"] == scene and r["renderer"] == name])
+            xs, ys = [p[0] for p in pts], [p[1] for p in pts]
             if xs:
                 ax.loglog(xs, ys, "o-", label=name)
         ax.set_title(scene)
@@ -180,8 +188,9 @@ def main(argv: list[str]) -> int:
                     help="Mitsuba variants to measure, comma-separated ('' for none)")
     ap.add_argument("--instants", type=int, default=16, help="shutter instants for Mitsuba motion blur")
     ap.add_argument("--only", default="", help="comma-separated scene names (default: all)")
-    ap.add_argument("--adaptive", type=float, default=0.01,
-                    help="also run penumbra with this render.noise_threshold (spp = cap); 0 to skip")
+    ap.add_argument("--adaptive", default="0.1,0.05,0.03",
+                    help="render.noise_threshold values for the 'penumbra adaptive' curve ('' to skip)")
+    ap.add_argument("--adaptive-cap", type=int, default=1024, help="spp cap of the adaptive renders")
     ap.add_argument("--out", default=os.path.join(REPO, "bench", "out"))
     args = ap.parse_args(argv)
 
@@ -194,7 +203,8 @@ def main(argv: list[str]) -> int:
     mi = p2m.import_mitsuba(variants[0] if variants else "scalar_rgb")
 
     rows: list[dict] = []
-    renderers = ["penumbra"] + (["penumbra adaptive"] if args.adaptive > 0 else []) + [f"mitsuba {v}" for v in variants]
+    thresholds = [float(t) for t in args.adaptive.split(",") if t]
+    renderers = ["penumbra"] + (["penumbra adaptive"] if thresholds else []) + [f"mitsuba {v}" for v in variants]
     for scene_name in scenes:
         scene_path = os.path.join(ACCURACY, "scenes", f"{scene_name}.json")
         scene = p2m.load_json(scene_path)
@@ -203,12 +213,14 @@ def main(argv: list[str]) -> int:
         for renderer in renderers:
             # One discarded warm-up render: Dr.Jit compiles its kernels on first use, and the
             # first penumbra run pays for reading the scene file from a cold cache.
-            threshold = args.adaptive if renderer == "penumbra adaptive" else 0.0
+            adaptive = renderer == "penumbra adaptive"
+            # (spp, noise_threshold) of each point: the spp ladder, or the thresholds under a cap
+            points = [(args.adaptive_cap, t) for t in thresholds] if adaptive else [(s, 0.0) for s in ladder]
             if renderer.startswith("penumbra"):
                 run_penumbra(args.penumbra, scene_path, ladder[0], 0, mi)
             else:
                 run_mitsuba(renderer.split()[1], scene, max(ladder[0], instants), 0, instants)
-            for spp in ladder:
+            for spp, threshold in points:
                 for seed in range(args.seeds):
                     if renderer.startswith("penumbra"):
                         image, seconds = run_penumbra(args.penumbra, scene_path, spp, seed, mi, threshold)
@@ -217,10 +229,10 @@ def main(argv: list[str]) -> int:
                         image, seconds = run_mitsuba(renderer.split()[1], scene, max(spp, instants), seed, instants)
                         used_instants = instants
                     used_spp = spp if renderer.startswith("penumbra") else max(spp, instants)
-                    row = {"scene": scene_name, "renderer": renderer, "spp": used_spp, "seed": seed,
-                           "seconds": seconds, "instants": used_instants, **errors(image, reference)}
+                    row = {"scene": scene_name, "renderer": renderer, "spp": used_spp, "threshold": threshold,
+                           "seed": seed, "seconds": seconds, "instants": used_instants, **errors(image, reference)}
                     rows.append(row)
-                    print(f"{scene_name:13s} {renderer:20s} spp {spp:5d} seed {seed}: {seconds:7.3f} s  "
+                    print(f"{scene_name:13s} {renderer:20s} spp {spp:5d} t {threshold:g} seed {seed}: {seconds:7.3f} s  "
                           f"relMSE {row['relmse']:.3e}  FLIP {row['flip']:.4f}", flush=True)
 
     with open(os.path.join(args.out, "bench.csv"), "w", newline="", encoding="utf-8") as f:

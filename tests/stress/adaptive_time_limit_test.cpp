@@ -43,6 +43,33 @@ TEST(AdaptiveSampling, StopsEasyPixelsKeepsTheImageAndIsDeterministic) {
   EXPECT_EQ(render_input(in, one_thread).image.rgb, a.image.rgb);
 }
 
+// render.noise_threshold is the relative RMS error the image aims for (relMSE with the 0.01
+// floor, renderer/adaptive_sampling.h): the render's own estimate must meet it without spending
+// the whole cap, and the true error against a long render must not exceed it (the variance
+// estimate is conservative under QMC, so the true error is usually well below).
+TEST(AdaptiveSampling, TheImageReachesTheTargetRelativeError) {
+  const SceneInput in = mixed_scene();
+  constexpr float t = 0.05f;
+  RenderSettings adaptive = settings(24, 24, 8192, 8, 3);
+  adaptive.noise_threshold = t;
+  const RenderResult a = render_input(in, adaptive);
+  double estimated = 0.0, actual = 0.0;
+  const RenderResult ref = render_input(in, settings(24, 24, 4096, 8, 9));
+  for (size_t i = 0; i < a.image.rgb.size(); ++i) {
+    const double m = a.image.rgb[i], r = ref.image.rgb[i];
+    estimated += a.variance.rgb[i] / (m * m + 1e-2);
+    // minus the reference's own variance, so its noise is not charged to the adaptive image
+    actual += ((m - r) * (m - r) - ref.variance.rgb[i]) / (r * r + 1e-2);
+  }
+  estimated /= double(a.image.rgb.size());
+  actual /= double(a.image.rgb.size());
+  EXPECT_LE(estimated, t * t);
+  EXPECT_GE(estimated, 0.3 * t * t);  // and it stopped near the target, not far past it
+  EXPECT_LE(actual, 1.2 * t * t);
+  EXPECT_LT(a.stats.spp_mean, 0.5 * 8192);
+  EXPECT_EQ(a.stats.spp_min, 16);  // the lit floor's easy pixels stop at the first estimate
+}
+
 TEST(TimeLimit, StopsEarlyWithAFiniteCompleteImage) {
   const SceneInput in = mixed_scene();
   RenderSettings s = settings(48, 48, 1 << 20, 8);
