@@ -6,9 +6,8 @@
 //    34), exactly the masking-shadowing Mitsuba 3's MicrofacetDistribution uses, so images match.
 // Sampling: Heitz 2018, "Sampling the GGX Distribution of Visible Normals" (JCGT 7(4)), whose
 //    density is D_wi(m) = G1(wi, m) max(0, wi.m) D(m) / wi.z (Heitz 2014 eq. 2 / 2018 eq. 1).
-#include <vector>
-
 #include "renderer/math.h"
+#include "renderer/quadrature.h"
 
 namespace penumbra {
 
@@ -44,9 +43,6 @@ class GgxDistribution {
  private:
   float alpha_;
 };
-
-// Gauss-Legendre nodes and weights on [-1, 1] (Newton iteration on P_n; Golub-Welsch would do too).
-void gauss_legendre(int n, std::vector<double>& nodes, std::vector<double>& weights);
 
 // Directional albedo of the single-scattering rough dielectric interface for an incident
 // direction with cosine `cos_i` > 0 on the side where the relative ior is `eta`, computed by

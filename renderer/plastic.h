@@ -7,7 +7,8 @@
 // bounces between base and coating (geometric series with the coating's internal diffuse
 // reflectance fdr_int, the linear form 1 / (1 - fdr_int)), and refracts out; the 1/eta^2 factor
 // accounts for the radiance change across the coating. Smooth coating: transmittances
-// (1 - F(cos_i)) (1 - F(cos_o)); rough coating: the precomputed rough-dielectric transmittance
+// (1 - F(cos_i)) (1 - F(cos_o)) and fdr_int by exact quadrature (Mitsuba uses a polynomial fit,
+// which gains energy at high ior); rough coating: the precomputed rough-dielectric transmittance
 // table t(cos) and internal reflectance.
 #include <array>
 
@@ -20,6 +21,7 @@ namespace penumbra {
 class PlasticBsdf {
  public:
   // Table resolution of the rough transmittance over cos(theta) in [0, 1] (Mitsuba uses 64).
+  // The nodes are not uniform (see plastic.cpp).
   static constexpr int kTransmittanceRes = 64;
 
   explicit PlasticBsdf(const PlasticParams& params);
@@ -44,11 +46,12 @@ class PlasticBsdf {
 
   Spectrum color_;
   float eta_;
-  float inv_eta2_;
   bool smooth_;
   GgxDistribution distr_;
   float specular_sampling_weight_;
   float internal_reflectance_;  // fdr_int (smooth) or its rough counterpart
+  float diffuse_scale_;         // 1 / (eta^2 (1 - internal_reflectance_)), computed in double
+  std::array<float, kTransmittanceRes> cosines_{};  // the rough table's nodes, increasing
   std::array<float, kTransmittanceRes> transmittance_{};
 };
 

@@ -5,6 +5,8 @@
 // return exactly its own radiance.
 #include <gtest/gtest.h>
 
+#include "renderer/fresnel.h"
+#include "renderer/plastic.h"
 #include "tests/renderer/bsdf_test_util.h"
 
 namespace penumbra {
@@ -121,19 +123,82 @@ TEST(BsdfEnergy, RoughDielectricLosesOnlyMultipleScattering) {
   }
 }
 
-TEST(BsdfEnergy, PlasticNeverGains) {
-  for (float r : {0.f, 0.05f, 0.3f, 1.f}) {
-    const Material mat(PlasticParams{Spectrum(1.f), 1.5f, r});
-    for (float t : kAngles) {
-      const Albedo a = energy_albedo(mat, test::spherical(test::deg(t), 0.3f), 40000, 5);
-      // The smooth model conserves energy exactly for a white base up to the ~0.1-0.6% error of
-      // the fdr polynomial fits Mitsuba uses; allow that.
-      EXPECT_LE(a.mean, 1.0 + 4.0 * a.stderr_ + 6e-3) << "r " << r << " theta " << t;
-      if (r == 0.f) {
-        EXPECT_GT(a.mean, 0.98) << "theta " << t;
+// The smooth plastic with a white base conserves energy exactly: its albedo is
+// F(mu_i) + (1 - F(mu_i)) (1 - fdr_ext) / (eta^2 (1 - fdr_int)) = 1, because
+// eta^2 (1 - fdr_int) = 1 - fdr_ext (radiance / n^2 is invariant, Veach 1997 sec. 5.2). Checked
+// deterministically (F plus a midpoint rule over the diffuse lobe) for iors across the whole
+// valid range (0, 1e30], normal to grazing incidence. With Mitsuba's polynomial fits for fdr_int
+// it was 1.0228 at ior 2.4 (normal incidence), 1.0011 at ior 1.5, 1.0009 at ior 1.01, and at
+// ior 4 the fit's fdr_int = 1.0100 > 1 made it negative (-2.18).
+TEST(BsdfEnergy, SmoothPlasticWhiteBaseReflectsExactlyOne) {
+  for (float ior : {0.3f, 0.5f, 0.9f, 1.0001f, 1.01f, 1.5f, 2.4f, 4.f, 10.f, 1e3f, 1e30f}) {
+    const Material mat(PlasticParams{Spectrum(1.f), ior, 0.f});
+    for (float t : {0.f, 30.f, 60.f, 80.f, 89.f, 89.9f}) {
+      const vec3 wi = test::spherical(test::deg(t), 0.f);
+      const int n = 200000;  // ior 0.3 transmits only within cos > 0.954: 9000 nodes there
+      double diffuse = 0.0;  // \int f cos dwo = 2 pi \int_0^1 eval(mu_o) dmu_o (isotropic lobe)
+      for (int i = 0; i < n; ++i) {
+        const float mu = (i + 0.5f) / n;
+        diffuse += mat.eval(BsdfContext{}, wi, vec3(std::sqrt(1.f - mu * mu), 0.f, mu)).x;
+      }
+      const double albedo = fresnel_dielectric(wi.z, ior).reflectance + 2.0 * kPi * diffuse / n;
+      EXPECT_NEAR(albedo, 1.0, 1e-5) << "ior " << ior << " theta " << t;
+    }
+  }
+}
+
+// The furnace through sample(), as the integrators use it, for smooth and rough coatings and
+// every ior above (below 1 the coating is the thinner medium and light from outside is totally
+// reflected beyond the critical angle). The rough coating (single-scattering GGX, Mitsuba's
+// tables) may lose energy, never gain it -- except below ior 1 at small roughness, see the
+// disabled test below. Before the rough table's nodes clustered at grazing incidence it gained
+// at 89.9 degrees: 1.004 at ior 1.01, 1.001 at ior 1.5 (roughness 0.0101).
+TEST(BsdfEnergy, PlasticWhiteBaseNeverGainsAtAnyIor) {
+  const float angles[] = {0.f, 30.f, 60.f, 80.f, 89.f, 89.9f};
+  for (float ior : {1e-4f, 0.5f, 1.01f, 1.5f, 2.4f, 4.f, 1e3f, 1e30f}) {
+    for (float r : {0.f, 0.0101f, 0.05f, 0.3f, 1.f}) {
+      if (ior < 1.f && r > 0.f && r < 0.3f) continue;  // the open issue below
+      const Material mat(PlasticParams{Spectrum(1.f), ior, r});
+      for (float t : angles) {
+        const vec3 wi = test::spherical(test::deg(t), 0.3f);
+        // No NaN anywhere in the range (Material would drop it silently and hide a loss).
+        for (float mu : {0.f, 1e-4f, 0.5f, 1.f}) {
+          const vec3 wo(std::sqrt(1.f - mu * mu), 0.f, mu);
+          ASSERT_TRUE(std::isfinite(PlasticBsdf(PlasticParams{Spectrum(1.f), ior, r})
+                                        .eval(BsdfContext{}, wi, wo).x))
+              << "ior " << ior << " r " << r << " theta " << t << " mu_o " << mu;
+        }
+        const Albedo a = energy_albedo(mat, wi, 40000, 5);
+        EXPECT_LE(a.mean, 1.0 + 4.0 * a.stderr_ + 1e-4)
+            << "ior " << ior << " r " << r << " theta " << t;
+        // (At ior 1e-4 the transmitting cone, cos > sqrt(1 - ior^2), is narrower than the float
+        // spacing below 1: the diffuse part, 4e-4 at normal incidence, is lost, not gained.)
+        if (r == 0.f && ior > 1e-3f) {
+          EXPECT_NEAR(a.mean, 1.0, 4.0 * a.stderr_ + 1e-4) << "ior " << ior << " theta " << t;
+        }
       }
     }
   }
+}
+
+// Open: a nearly smooth rough coating thinner than the outside medium (ior < 1) still gains a
+// little energy just beyond the critical angle, where its external transmittance t(mu) rises from
+// 0 (total internal reflection) within a few table cells and the table values are themselves
+// Gauss-Legendre integrals across that discontinuity. With Mitsuba 3's uniform 64-node table it
+// was 1.32 at ior 0.5, r 0.0101, 30 degrees; with the nodes clustered onto the critical angle
+// (plastic.cpp), measured with 2e6 samples: 1.020 +- 0.001 (ior 0.1, r 0.05, 6 degrees), 1.007
+// (ior 0.3, r 0.1, 18 degrees), 1.003 (ior 0.5, r 0.1, 30.5 degrees), 1.0006 (ior 0.7, r 0.05).
+// Roughness >= 0.3 and every ior >= 1 are fine.
+TEST(BsdfEnergy, DISABLED_RoughPlasticBelowIorOneNeverGains) {
+  for (float ior : {0.1f, 0.3f, 0.5f, 0.7f, 0.9f})
+    for (float r : {0.0101f, 0.05f, 0.1f, 0.2f}) {
+      const Material mat(PlasticParams{Spectrum(1.f), ior, r});
+      for (float t = 0.f; t < 90.f; t += 0.5f) {
+        const Albedo a = energy_albedo(mat, test::spherical(test::deg(t), 0.3f), 40000, 5);
+        EXPECT_LE(a.mean, 1.0 + 4.0 * a.stderr_ + 1e-4)
+            << "ior " << ior << " r " << r << " theta " << t;
+      }
+    }
 }
 
 }  // namespace
