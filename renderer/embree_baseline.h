@@ -2,7 +2,9 @@
 // A baseline for the speed benchmark: Embree alone tracing the same kind of rays the path tracer
 // traces on the same scene (camera rays, shadow rays towards the emitters, cosine-distributed
 // bounce rays), with no shading, sampling or film work. The renderer's rays/s divided by this
-// is the share of time it spends on ray casting rather than its own overhead.
+// is the share of time it spends on ray casting rather than its own overhead. It traces the
+// renderer's own Embree scene, so both use the same triangle test: the robust (watertight) one,
+// with the exact-t hit filter attached to every triangle geometry (renderer/scene.cpp).
 #include <cstdint>
 
 #include "renderer/scene.h"

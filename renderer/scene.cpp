@@ -11,7 +11,7 @@ namespace {
 // ---- Spheres as Embree user geometry: the exact quadratic motion path needs our own test. ----
 
 void sphere_bounds_fn(const RTCBoundsFunctionArguments* args) {
-  const auto* data = static_cast<const SphereGeometryData*>(args->geometryUserPtr);
+  const auto* data = static_cast<const GeometryData*>(args->geometryUserPtr);
   const SceneImpl& scene = *data->scene;
   const ObjectRecord& obj = scene.objects[data->object];
   vec3 lo(0.f), hi(0.f);
@@ -37,7 +37,7 @@ vec3 ray_direction(RTCRayN* ray, unsigned n, unsigned i) {
 }
 
 void sphere_intersect_fn(const RTCIntersectFunctionNArguments* args) {
-  const auto* data = static_cast<const SphereGeometryData*>(args->geometryUserPtr);
+  const auto* data = static_cast<const GeometryData*>(args->geometryUserPtr);
   const SceneImpl& scene = *data->scene;
   const ObjectRecord& obj = scene.objects[data->object];
   RTCRayHitN* rayhit = args->rayhit;
@@ -66,7 +66,7 @@ void sphere_intersect_fn(const RTCIntersectFunctionNArguments* args) {
 }
 
 void sphere_occluded_fn(const RTCOccludedFunctionNArguments* args) {
-  const auto* data = static_cast<const SphereGeometryData*>(args->geometryUserPtr);
+  const auto* data = static_cast<const GeometryData*>(args->geometryUserPtr);
   const SceneImpl& scene = *data->scene;
   const ObjectRecord& obj = scene.objects[data->object];
   RTCRayN* ray = args->ray;
@@ -79,6 +79,64 @@ void sphere_occluded_fn(const RTCOccludedFunctionNArguments* args) {
     const float t = intersect_sphere(c, obj.radius, o, d, t_far);
     if (t > RTCRayN_tnear(ray, args->N, i)) t_far = -kInfinity;
   }
+}
+
+// ---- Triangles: Embree's robust (watertight) test, with the sign of t settled exactly. ----
+//
+// Debian's Embree, like any, tests triangles by default with Moeller-Trumbore on precomputed
+// edges: not watertight, so shadow rays slip through edges two triangles share and a light in
+// the corner of a closed box leaks (tests/stress LightLeak). RTC_SCENE_FLAG_ROBUST switches to
+// its Pluecker test, whose edge functions are computed the same way for both triangles of an
+// edge, so no ray falls between them (Embree kernels/geometry/triangle_intersector_pluecker.h).
+//
+// Neither test bounds the rounding error of its own t, as pbrt-v4's triangle test does (it
+// rejects t <= deltaT, section 6.8.7); our spawn offsets (ray.h, pbrt-v4 section 6.8.6) cover
+// only the error of the hit point, so two cases re-hit the triangle a ray leaves:
+//  - The robust test accepts tnear <= t (inclusive). A hit point that is exact has a zero error
+//    bound and so a zero offset (any point of a quad in the plane y = 0): the ray starts on the
+//    plane, t computes to exactly 0 and is accepted; every such quad shadows itself entirely.
+//  - Embree computes the plane distance from vertices translated to the ray origin, with an
+//    error of order eps * (distance of the triangle's first vertex from the origin). Where a
+//    large triangle reaches close to the world origin that exceeds our offset, which scales with
+//    the hit point's coordinates: 36-58% of the rays spawned near such a corner hit the triangle
+//    again, with either Embree test (tests/stress LargeTriangleNearOrigin).
+// So each triangle hit Embree reports passes this filter, which re-evaluates the sign of
+// t = ((p0 - o) . n) / (d . n) in double precision from the same float vertices our hit points
+// are rebuilt from, and keeps the hit only if t > 0. The doubles hold the float inputs' products
+// with 2^-53 relative error, so the sign is right for any origin further than about 1e-15 of
+// the triangle's size from its plane (over the sine of its angle at p0 for a sliver), far
+// below any spawn offset: no error bound of Embree's internals is needed, any triangle is
+// covered (the one left, its coplanar neighbour in a quad, a larger neighbour), and since a hit
+// with t > 0 is never dropped, watertightness stays.
+inline void filter_triangle_hit(const RTCFilterFunctionNArguments* args, unsigned n, unsigned i) {
+  if (args->valid[i] == 0) return;
+  const auto* data = static_cast<const GeometryData*>(args->geometryUserPtr);
+  const SceneImpl& scene = *data->scene;
+  const ObjectRecord& obj = scene.objects[data->object];
+  const uint32_t* tri = obj.indices.data() + size_t(RTCHitN_primID(args->hit, n, i)) * 3;
+  // The same float vertices SceneImpl::intersect rebuilds hit points from.
+  vec3 a = obj.positions[tri[0]], b = obj.positions[tri[1]], c = obj.positions[tri[2]];
+  if (obj.time_steps > 1) {  // moving (static and shutter-less objects have one step)
+    const vec3 disp = obj.moving_displacement_at(RTCRayN_time(args->ray, n, i), scene.shutter_open,
+                                                 scene.shutter_span);
+    a += disp;
+    b += disp;
+    c += disp;
+  }
+  const dvec3 p0(a), normal = glm::cross(dvec3(b) - p0, dvec3(c) - p0);
+  const double num = glm::dot(p0 - dvec3(ray_origin(args->ray, n, i)), normal);
+  const double den = glm::dot(dvec3(ray_direction(args->ray, n, i)), normal);
+  // Signs compared, not num * den > 0, which could underflow to 0 in a tiny scene.
+  const bool ahead = (num > 0.0 && den > 0.0) || (num < 0.0 && den < 0.0);
+  if (!ahead) args->valid[i] = 0;
+}
+
+void triangle_filter_fn(const RTCFilterFunctionNArguments* args) {
+  if (args->N == 1) {  // rtcIntersect1 / rtcOccluded1: the accessors fold to plain fields
+    filter_triangle_hit(args, 1, 0);
+    return;
+  }
+  for (unsigned i = 0; i < args->N; ++i) filter_triangle_hit(args, args->N, i);
 }
 
 // ---- Build helpers ----
@@ -260,22 +318,26 @@ std::unique_ptr<Scene> Scene::build(const SceneInput& input) {
   RTCDevice device = embree_device();
   s.rtc_scene = rtcNewScene(device);
   rtcSetSceneBuildQuality(s.rtc_scene, RTC_BUILD_QUALITY_HIGH);
+  // Watertight triangle tests; triangle_filter_fn keeps them from re-hitting a ray's own surface.
+  // The benchmark's Embree-only baseline traces this same scene, so it pays for both too.
+  rtcSetSceneFlags(s.rtc_scene, RTC_SCENE_FLAG_ROBUST);
   static_assert(sizeof(vec3) == 12, "vertex layout");
-  std::vector<std::unique_ptr<SphereGeometryData>> sphere_data;
+  std::vector<std::unique_ptr<GeometryData>> geometry_data;
   for (size_t i = 0; i < s.objects.size(); ++i) {
     const ObjectRecord& obj = s.objects[i];
     RTCGeometry geom;
+    auto* data = new GeometryData{&s, uint32_t(i)};
+    geometry_data.emplace_back(data);
     if (obj.kind == ObjectRecord::Kind::kSphere) {
       geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_USER);
       rtcSetGeometryUserPrimitiveCount(geom, 1);
-      auto* data = new SphereGeometryData{&s, uint32_t(i)};
-      rtcSetGeometryUserData(geom, data);
-      sphere_data.emplace_back(data);
       rtcSetGeometryBoundsFunction(geom, sphere_bounds_fn, nullptr);
       rtcSetGeometryIntersectFunction(geom, sphere_intersect_fn);
       rtcSetGeometryOccludedFunction(geom, sphere_occluded_fn);
     } else {
       geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+      rtcSetGeometryIntersectFilterFunction(geom, triangle_filter_fn);
+      rtcSetGeometryOccludedFilterFunction(geom, triangle_filter_fn);
       rtcSetGeometryTimeStepCount(geom, unsigned(obj.time_steps));
       for (int k = 0; k < obj.time_steps; ++k) {
         auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(
@@ -296,6 +358,7 @@ std::unique_ptr<Scene> Scene::build(const SceneInput& input) {
       if (!idx) throw SceneBuildError("Embree could not allocate an index buffer: " + take_embree_error());
       std::copy(obj.indices.begin(), obj.indices.end(), idx);
     }
+    rtcSetGeometryUserData(geom, data);
     rtcCommitGeometry(geom);
     rtcAttachGeometryByID(s.rtc_scene, geom, unsigned(i));
     rtcReleaseGeometry(geom);
@@ -303,7 +366,7 @@ std::unique_ptr<Scene> Scene::build(const SceneInput& input) {
   rtcCommitScene(s.rtc_scene);
   const std::string err = take_embree_error();
   if (!err.empty()) throw SceneBuildError(err);
-  impl->sphere_data_keepalive = std::move(sphere_data);
+  impl->geometry_data_keepalive = std::move(geometry_data);
   return std::unique_ptr<Scene>(new Scene(std::move(impl)));
 }
 

@@ -62,8 +62,9 @@ struct ObjectRecord {
 
 class SceneImpl;
 
-// User data of one sphere's Embree geometry.
-struct SphereGeometryData {
+// User data of one Embree geometry (a sphere's callbacks and a triangle mesh's hit filter read
+// the object through it).
+struct GeometryData {
   const SceneImpl* scene;
   uint32_t object;
 };
@@ -90,8 +91,8 @@ class SceneImpl {
   LightSampler lights;
   vec3 bounds_min{0.f}, bounds_max{0.f};
   SceneFeatures features;
-  // User data of the sphere geometries (Embree keeps raw pointers to them).
-  std::vector<std::unique_ptr<SphereGeometryData>> sphere_data_keepalive;
+  // User data of the Embree geometries (Embree keeps raw pointers to them).
+  std::vector<std::unique_ptr<GeometryData>> geometry_data_keepalive;
 };
 
 }  // namespace penumbra
