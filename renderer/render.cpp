@@ -18,16 +18,48 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-struct Tile {
-  int x0, y0, x1, y1;
+// The image's pixels tile by tile (row-major inside each tile), and where each tile starts in
+// that order: a pass's work items are ranges of it.
+struct PixelOrder {
+  std::vector<uint32_t> pixels;
+  std::vector<size_t> tile_starts;  // one per tile, plus the end
 };
 
-std::vector<Tile> make_tiles(int width, int height, int size) {
-  std::vector<Tile> tiles;
-  for (int y = 0; y < height; y += size)
-    for (int x = 0; x < width; x += size)
-      tiles.push_back({x, y, std::min(x + size, width), std::min(y + size, height)});
-  return tiles;
+PixelOrder make_pixel_order(int width, int height, int size) {
+  PixelOrder o;
+  for (int y0 = 0; y0 < height; y0 += size)
+    for (int x0 = 0; x0 < width; x0 += size) {
+      o.tile_starts.push_back(o.pixels.size());
+      for (int y = y0; y < std::min(y0 + size, height); ++y)
+        for (int x = x0; x < std::min(x0 + size, width); ++x) o.pixels.push_back(uint32_t(y * width + x));
+    }
+  o.tile_starts.push_back(o.pixels.size());
+  return o;
+}
+
+// Work items of an adaptive pass: consecutive ranges of the pixel order holding about equal
+// numbers of samples. Once limits differ, the samples of a pass crowd into the few tiles where
+// the noise is, and tile-sized items would leave threads idle at the pass's end.
+std::vector<size_t> balanced_items(const PixelOrder& order, const std::vector<uint32_t>& taken,
+                                   const std::vector<uint32_t>& limit, uint32_t pass_samples,
+                                   int parts) {
+  auto work = [&](uint32_t p) {
+    return limit[p] > taken[p] ? std::min(pass_samples, limit[p] - taken[p]) : 0u;
+  };
+  uint64_t total = 0;
+  for (uint32_t p : order.pixels) total += work(p);
+  const uint64_t per_item = std::max<uint64_t>(1, total / uint64_t(std::max(1, parts)));
+  std::vector<size_t> starts{0};
+  uint64_t acc = 0;
+  for (size_t k = 0; k < order.pixels.size(); ++k) {
+    acc += work(order.pixels[k]);
+    if (acc >= per_item && k + 1 < order.pixels.size()) {
+      starts.push_back(k + 1);
+      acc = 0;
+    }
+  }
+  starts.push_back(order.pixels.size());
+  return starts;
 }
 
 // Sample counts of the progressive passes: 1, 1, 2, 4, 8, ... so a preview appears at once and
@@ -68,7 +100,7 @@ RenderResult render(const Scene& scene_handle, const RenderSettings& settings,
   const bool sample_time = scene.features.motion;
 
   Film film(width, height);
-  const std::vector<Tile> tiles = make_tiles(width, height, std::max(1, settings.tile_size));
+  const PixelOrder order = make_pixel_order(width, height, std::max(1, settings.tile_size));
   const int spp = std::max(1, settings.spp);
   const std::vector<int> passes = make_passes(spp);
   // Per pixel: samples taken so far and the most it may take. Uniform sampling keeps every limit
@@ -103,14 +135,16 @@ RenderResult render(const Scene& scene_handle, const RenderSettings& settings,
     const int s0 = first_sample, s1 = first_sample + passes[pass];
     // Limits are decided here, between passes, so the image does not depend on threads or tile
     // order; the progress total follows them so the fraction and ETA stay meaningful.
+    std::vector<size_t> items = order.tile_starts;
     if (adaptive && s0 >= adaptive_limits.min_samples) {
       arena.execute([&] { update_limits(film, adaptive_limits, &limit); });
       samples_total = 0;
       for (size_t i = 0; i < limit.size(); ++i) samples_total += std::max(limit[i], taken[i]);
+      items = balanced_items(order, taken, limit, uint32_t(s1 - s0), 8 * arena.max_concurrency());
     }
     arena.execute([&] {
-      tbb::parallel_for(tbb::blocked_range<size_t>(0, tiles.size(), 1), [&](const auto& range) {
-        for (size_t ti = range.begin(); ti != range.end(); ++ti) {
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, items.size() - 1, 1), [&](const auto& range) {
+        for (size_t item = range.begin(); item != range.end(); ++item) {
           if (stop.load(std::memory_order_relaxed)) return;
           if (control.cancel && control.cancel->load(std::memory_order_relaxed)) {
             cancelled = true;
@@ -122,32 +156,30 @@ RenderResult render(const Scene& scene_handle, const RenderSettings& settings,
             stop = true;
             return;
           }
-          const Tile& tile = tiles[ti];
           Sampler sampler(settings.seed);
           PathCounters counters;
-          uint64_t tile_samples = 0, tile_nonfinite = 0;
-          for (int y = tile.y0; y < tile.y1; ++y) {
-            for (int x = tile.x0; x < tile.x1; ++x) {
-              const size_t pi = size_t(y) * width + x;
-              const uint32_t n0 = taken[pi], n1 = std::min(n0 + uint32_t(s1 - s0), limit[pi]);
-              if (n0 >= n1) continue;
-              taken[pi] = n1;
-              for (uint32_t s = n0; s < n1; ++s) {
-                sampler.start_pixel_sample(x, y, s);
-                const vec2 film_pos = vec2(float(x), float(y)) + sampler.get_2d();
-                const vec2 lens = sample_lens ? sampler.get_2d() : vec2(0.5f);
-                const float time = sample_time ? sampler.get_1d() : 0.f;
-                const CameraRay cr = camera.generate_ray(film_pos, lens, time);
-                const Spectrum L =
-                    integrate(scene, isettings, Ray{cr.origin, cr.direction, cr.time}, sampler, counters);
-                if (!film.add_sample(x, y, L)) ++tile_nonfinite;
-                ++tile_samples;
-              }
+          uint64_t item_samples = 0, item_nonfinite = 0;
+          for (size_t k = items[item]; k < items[item + 1]; ++k) {
+            const uint32_t pi = order.pixels[k];
+            const int x = int(pi % uint32_t(width)), y = int(pi / uint32_t(width));
+            const uint32_t n0 = taken[pi], n1 = std::min(n0 + uint32_t(s1 - s0), limit[pi]);
+            if (n0 >= n1) continue;
+            taken[pi] = n1;
+            for (uint32_t s = n0; s < n1; ++s) {
+              sampler.start_pixel_sample(x, y, s);
+              const vec2 film_pos = vec2(float(x), float(y)) + sampler.get_2d();
+              const vec2 lens = sample_lens ? sampler.get_2d() : vec2(0.5f);
+              const float time = sample_time ? sampler.get_1d() : 0.f;
+              const CameraRay cr = camera.generate_ray(film_pos, lens, time);
+              const Spectrum L =
+                  integrate(scene, isettings, Ray{cr.origin, cr.direction, cr.time}, sampler, counters);
+              if (!film.add_sample(x, y, L)) ++item_nonfinite;
+              ++item_samples;
             }
           }
           rays += counters.rays;
-          samples_done += tile_samples;
-          if (tile_nonfinite) nonfinite += tile_nonfinite;
+          samples_done += item_samples;
+          if (item_nonfinite) nonfinite += item_nonfinite;
           if (control.on_progress) {
             std::lock_guard<std::mutex> lock(progress_mutex);
             control.on_progress(make_progress(passes_done));
