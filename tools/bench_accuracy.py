@@ -118,11 +118,17 @@ def curve(rows: list[dict]) -> list[tuple[float, float]]:
 
 
 def time_to_reach(rows: list[dict], target: float) -> float:
-    """Seconds to reach relMSE ``target``: a least-squares line through log(relMSE) against
-    log(seconds) over the ladder (seed means), evaluated at the target."""
+    """Seconds to reach relMSE ``target``: log-log interpolation between the two points of the
+    ladder (seed means) that bracket it, or, outside the ladder, a least-squares line through
+    log(relMSE) against log(seconds) evaluated at the target. (A line through the whole ladder
+    is biased where fixed costs dominate its cheapest points.)"""
     pts = curve(rows)
     if len(pts) < 2:
         return math.nan
+    for (s0, e0), (s1, e1) in zip(pts, pts[1:]):
+        if e1 < e0 and e1 <= target <= e0:
+            f = math.log(target / e0) / math.log(e1 / e0)
+            return float(math.exp(math.log(s0) + f * math.log(s1 / s0)))
     x = np.log([p[0] for p in pts])
     y = np.log([p[1] for p in pts])
     slope, intercept = np.polyfit(x, y, 1)
@@ -192,7 +198,22 @@ def main(argv: list[str]) -> int:
                     help="render.noise_threshold values for the 'penumbra adaptive' curve ('' to skip)")
     ap.add_argument("--adaptive-cap", type=int, default=1024, help="spp cap of the adaptive renders")
     ap.add_argument("--out", default=os.path.join(REPO, "bench", "out"))
+    ap.add_argument("--summarise", metavar="CSV", help="only redo bench.md/bench.png from a bench.csv")
     args = ap.parse_args(argv)
+
+    if args.summarise:
+        with open(args.summarise, newline="", encoding="utf-8") as f:
+            rows = [{k: (v if k in ("scene", "renderer") else float(v)) for k, v in r.items()}
+                    for r in csv.DictReader(f)]
+        scenes = list(dict.fromkeys(r["scene"] for r in rows))
+        renderers = list(dict.fromkeys(r["renderer"] for r in rows))
+        os.makedirs(args.out, exist_ok=True)
+        plot(rows, scenes, renderers, os.path.join(args.out, "bench.png"))
+        table = summarise(rows, scenes, renderers)
+        with open(os.path.join(args.out, "bench.md"), "w", encoding="utf-8") as f:
+            f.write("\n".join(table) + "\n")
+        print("\n".join(table))
+        return 0
 
     ladder = [int(s) for s in args.spp.split(",")]
     variants = [v for v in args.mitsuba.split(",") if v]
