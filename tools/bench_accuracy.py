@@ -185,6 +185,15 @@ def plot(rows: list[dict], scenes: list[str], renderers: list[str], path: str) -
     fig.savefig(path, dpi=90)
 
 
+def write_report(rows: list[dict], scenes: list[str], renderers: list[str], out: str) -> None:
+    """bench.png and bench.md in ``out``; the table is also printed."""
+    plot(rows, scenes, renderers, os.path.join(out, "bench.png"))
+    table = summarise(rows, scenes, renderers)
+    with open(os.path.join(out, "bench.md"), "w", encoding="utf-8") as f:
+        f.write("\n".join(table) + "\n")
+    print("\n".join(table))
+
+
 def main(argv: list[str]) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--penumbra", required=True, help="the penumbra executable")
@@ -208,11 +217,7 @@ def main(argv: list[str]) -> int:
         scenes = list(dict.fromkeys(r["scene"] for r in rows))
         renderers = list(dict.fromkeys(r["renderer"] for r in rows))
         os.makedirs(args.out, exist_ok=True)
-        plot(rows, scenes, renderers, os.path.join(args.out, "bench.png"))
-        table = summarise(rows, scenes, renderers)
-        with open(os.path.join(args.out, "bench.md"), "w", encoding="utf-8") as f:
-            f.write("\n".join(table) + "\n")
-        print("\n".join(table))
+        write_report(rows, scenes, renderers, args.out)
         return 0
 
     ladder = [int(s) for s in args.spp.split(",")]
@@ -260,11 +265,7 @@ def main(argv: list[str]) -> int:
         writer = csv.DictWriter(f, fieldnames=list(rows[0]))
         writer.writeheader()
         writer.writerows(rows)
-    plot(rows, scenes, renderers, os.path.join(args.out, "bench.png"))
-    table = summarise(rows, scenes, renderers)
-    with open(os.path.join(args.out, "bench.md"), "w", encoding="utf-8") as f:
-        f.write("\n".join(table) + "\n")
-    print("\n".join(table))
+    write_report(rows, scenes, renderers, args.out)
     return 0
 
 
