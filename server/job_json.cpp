@@ -25,7 +25,9 @@ nlohmann::ordered_json job_json(const JobView& v) {
   auto time_or_null = [](double t) { return t > 0 ? json(rfc3339(t)) : json(nullptr); };
   json j = {{"id", r.id}, {"state", to_string(r.state)}};
   double progress = 0;
-  uint64_t samples_done = 0;
+  // samples_total is width x height x spp, except while an adaptive render (noise_threshold)
+  // runs: then it is the renderer's current estimate, and once it succeeds, what it took.
+  uint64_t samples_done = 0, samples_total = r.samples_total;
   json eta = nullptr;
   if (r.state == JobState::kSucceeded) {
     progress = 1;
@@ -34,6 +36,7 @@ nlohmann::ordered_json job_json(const JobView& v) {
   if (v.progress) {
     progress = v.progress->fraction;
     samples_done = v.progress->samples_done;
+    if (v.progress->samples_total > 0) samples_total = v.progress->samples_total;
     if (v.progress->fraction > 0) eta = v.progress->eta_seconds;
   }
   json stats = nullptr;
@@ -41,12 +44,13 @@ nlohmann::ordered_json job_json(const JobView& v) {
     stats = json::parse(r.stats_json);
     if (r.state == JobState::kSucceeded || r.state == JobState::kCancelled)
       samples_done = stats.value("camera_samples", samples_done);
+    if (r.state == JobState::kSucceeded) samples_total = samples_done;
     if (r.state == JobState::kCancelled && r.samples_total > 0)
       progress = std::min(1.0, double(samples_done) / double(r.samples_total));  // how far it got
   }
   j["progress"] = progress;
   j["samples_done"] = samples_done;
-  j["samples_total"] = r.samples_total;
+  j["samples_total"] = samples_total;
   j["eta_seconds"] = eta;
   j["queue_position"] = v.queue_position ? json(*v.queue_position) : json(nullptr);
   if (v.stop_requested) j["cancel_requested"] = true;

@@ -72,6 +72,25 @@ TEST(JobLifecycle, SubmitPollFetchPngAndExrThenDelete) {
   EXPECT_FALSE(std::filesystem::exists(dir.path() + "/results/" + id + ".png"));
 }
 
+// With render.noise_threshold the render takes fewer samples than width x height x spp: the
+// finished job reports what it took, not the cap (and a running one the renderer's estimate).
+TEST(JobLifecycle, AdaptiveJobReportsTheSamplesItTook) {
+  TempDir dir;
+  ServerProcess server(dir.path());
+  auto c = server.client();
+  Json scene = tiny_scene(32, 32, 1024);
+  scene["render"]["noise_threshold"] = 0.2;
+  const std::string id = submit(*c, scene);
+  const Json done = wait_for_state(*c, id, {"succeeded", "failed"});
+  ASSERT_EQ(done["state"], "succeeded") << done.dump();
+  EXPECT_EQ(done["progress"], 1.0);
+  const uint64_t taken = done["samples_done"];
+  EXPECT_EQ(done["samples_total"], taken);
+  EXPECT_EQ(done["stats"]["camera_samples"], taken);
+  EXPECT_GE(taken, 32u * 32u * 16u);  // every pixel takes the first 16
+  EXPECT_LT(taken, 32u * 32u * 1024u / 2);
+}
+
 TEST(JobLifecycle, SynchronousRenderAnswersTheImage) {
   TempDir dir;
   ServerProcess server(dir.path());
