@@ -20,9 +20,11 @@ namespace penumbra {
 // Front-side model (wi.z > 0); Material mirrors back-side queries to the front.
 class PlasticBsdf {
  public:
-  // Table resolution of the rough transmittance over cos(theta) in [0, 1] (Mitsuba uses 64).
-  // The nodes are not uniform (see plastic.cpp).
+  // Table resolution of the rough transmittance over cos(theta) in [0, 1] (Mitsuba uses 64) for
+  // ior >= 1; below ior 1 the nodes are placed adaptively and twice as many are used. The nodes
+  // are not uniform (see plastic.cpp).
   static constexpr int kTransmittanceRes = 64;
+  static constexpr int kTransmittanceCapacity = 2 * kTransmittanceRes;
 
   explicit PlasticBsdf(const PlasticParams& params);
 
@@ -51,8 +53,9 @@ class PlasticBsdf {
   float specular_sampling_weight_;
   float internal_reflectance_;  // fdr_int (smooth) or its rough counterpart
   float diffuse_scale_;         // 1 / (eta^2 (1 - internal_reflectance_)), computed in double
-  std::array<float, kTransmittanceRes> cosines_{};  // the rough table's nodes, increasing
-  std::array<float, kTransmittanceRes> transmittance_{};
+  int nodes_ = 0;                                       // used entries of the rough table
+  std::array<float, kTransmittanceCapacity> cosines_{};  // the rough table's nodes, increasing
+  std::array<float, kTransmittanceCapacity> transmittance_{};
 };
 
 }  // namespace penumbra
