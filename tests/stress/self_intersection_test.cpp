@@ -123,31 +123,24 @@ PointCounts fire_rays(Shape shape, const Placement& p) {
   return c;
 }
 
+// Enough hits, and none of them acne, a lost exit or a lost internal reflection.
+void expect_clean_spawns(Shape shape, const Placement& placement) {
+  const PointCounts c = fire_rays(shape, placement);
+  EXPECT_GT(c.hits, 1000) << name_of(placement);
+  EXPECT_EQ(c.acne, 0) << name_of(placement);
+  EXPECT_EQ(c.lost_exits, 0) << name_of(placement);
+  EXPECT_EQ(c.lost_internal, 0) << name_of(placement);
+}
+
 class ConvexSpawn : public ::testing::TestWithParam<Placement> {};
 
-TEST_P(ConvexSpawn, SphereNoAcneNoLostExits) {
-  const PointCounts c = fire_rays(Shape::kSphere, GetParam());
-  EXPECT_GT(c.hits, 1000);
-  EXPECT_EQ(c.acne, 0) << name_of(GetParam());
-  EXPECT_EQ(c.lost_exits, 0) << name_of(GetParam());
-  EXPECT_EQ(c.lost_internal, 0) << name_of(GetParam());
-}
+TEST_P(ConvexSpawn, SphereNoAcneNoLostExits) { expect_clean_spawns(Shape::kSphere, GetParam()); }
 
 TEST_P(ConvexSpawn, TessellatedSphereNoAcneNoLostExits) {
-  const PointCounts c = fire_rays(Shape::kMeshSphere, GetParam());
-  EXPECT_GT(c.hits, 1000);
-  EXPECT_EQ(c.acne, 0) << name_of(GetParam());
-  EXPECT_EQ(c.lost_exits, 0) << name_of(GetParam());
-  EXPECT_EQ(c.lost_internal, 0) << name_of(GetParam());
+  expect_clean_spawns(Shape::kMeshSphere, GetParam());
 }
 
-TEST_P(ConvexSpawn, BoxNoAcneNoLostExits) {
-  const PointCounts c = fire_rays(Shape::kBox, GetParam());
-  EXPECT_GT(c.hits, 1000);
-  EXPECT_EQ(c.acne, 0) << name_of(GetParam());
-  EXPECT_EQ(c.lost_exits, 0) << name_of(GetParam());
-  EXPECT_EQ(c.lost_internal, 0) << name_of(GetParam());
-}
+TEST_P(ConvexSpawn, BoxNoAcneNoLostExits) { expect_clean_spawns(Shape::kBox, GetParam()); }
 
 INSTANTIATE_TEST_SUITE_P(Placements, ConvexSpawn, ::testing::ValuesIn(kPlacements));
 
