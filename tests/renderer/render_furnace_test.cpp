@@ -7,15 +7,6 @@
 namespace penumbra::testing {
 namespace {
 
-SceneInput furnace_with_sphere(const MaterialParams& material) {
-  SceneInput in;
-  in.camera = camera_looking({0, 0, 4}, {0, 0, 0}, 30.f);
-  in.environment = Spectrum(1.f);
-  in.materials = {material};
-  in.objects = {sphere_object({0, 0, 0}, 1.f, 0)};
-  return in;
-}
-
 // Every pixel's mean must lie within `k` standard errors of 1 (pooled over the image).
 void expect_image_mean_near(const RenderResult& r, double expected, double tolerance) {
   const ImageStats st = image_stats(r.image);

@@ -90,4 +90,14 @@ inline ObjectDesc sphere_object(const vec3& center, float radius, uint32_t mater
   return o;
 }
 
+// White furnace: a unit sphere of `material` inside a uniform environment of radiance 1.
+inline SceneInput furnace_with_sphere(const MaterialParams& material) {
+  SceneInput in;
+  in.camera = camera_looking({0, 0, 4}, {0, 0, 0}, 30.f);
+  in.environment = Spectrum(1.f);
+  in.materials = {material};
+  in.objects = {sphere_object({0, 0, 0}, 1.f, 0)};
+  return in;
+}
+
 }  // namespace penumbra::testing

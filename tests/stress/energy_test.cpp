@@ -43,14 +43,9 @@ TEST_P(Furnace, NeverAboveOneAndOneWhereConserved) {
   static const std::vector<EnergyCase> cases = energy_cases();
   const auto [index, kind] = GetParam();
   const EnergyCase& c = cases[size_t(index)];
-  SceneInput in;
-  in.camera = camera_looking({0, 0, 4}, {0, 0, 0}, 30.f);
-  in.environment = Spectrum(1.f);
-  in.materials = {c.material};
-  in.objects = {sphere({0, 0, 0}, 1.f, 0)};
   RenderSettings s = settings(16, 16, 64);
   s.integrator = kind;
-  const RenderResult r = render_input(in, s);
+  const RenderResult r = render_input(testing::furnace_with_sphere(c.material), s);
   EXPECT_EQ(nonfinite_count(r), 0) << c.name;
   const MeanAndError m = image_mean(r);
   const double noise = 4 * m.stderr_of_mean;

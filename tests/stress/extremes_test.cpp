@@ -9,14 +9,7 @@
 namespace penumbra::stress {
 namespace {
 
-SceneInput furnace_sphere(const MaterialParams& m) {
-  SceneInput in;
-  in.camera = camera_looking({0, 0, 4}, {0, 0, 0}, 30.f);
-  in.environment = Spectrum(1.f);
-  in.materials = {m};
-  in.objects = {sphere({0, 0, 0}, 1.f, 0)};
-  return in;
-}
+using testing::furnace_with_sphere;
 
 // Roughness 1e-4 maps to GGX alpha 1e-8, below the smooth cut-off (alpha 1e-4): it must render
 // exactly as roughness 0. Roughness 0.0101 (alpha just above the cut-off) is the sharpest rough
@@ -35,11 +28,11 @@ TEST(Extremes, RoughnessZeroTinyAndOne) {
       {"plastic", [](float r) -> MaterialParams { return PlasticParams{Spectrum(1.f), 1.5f, r}; }, 0.3, 0.03},
   };
   for (const Family& f : families) {
-    const RenderResult smooth = render_input(furnace_sphere(f.make(0.f)), settings(16, 16, 64));
-    const RenderResult tiny = render_input(furnace_sphere(f.make(1e-4f)), settings(16, 16, 64));
+    const RenderResult smooth = render_input(furnace_with_sphere(f.make(0.f)), settings(16, 16, 64));
+    const RenderResult tiny = render_input(furnace_with_sphere(f.make(1e-4f)), settings(16, 16, 64));
     EXPECT_EQ(smooth.image.rgb, tiny.image.rgb) << f.name << ": roughness 1e-4 is smooth";
     for (float r : {0.0101f, 1.f}) {
-      const RenderResult img = render_input(furnace_sphere(f.make(r)), settings(16, 16, 128));
+      const RenderResult img = render_input(furnace_with_sphere(f.make(r)), settings(16, 16, 128));
       EXPECT_EQ(nonfinite_count(img), 0) << f.name << " r " << r;
       const MeanAndError m = image_mean(img);
       EXPECT_LT(m.mean, 1.0 + 4 * m.stderr_of_mean + 0.002) << f.name << " r " << r;
@@ -289,7 +282,7 @@ TEST(Extremes, ExtremeApertures) {
   EXPECT_EQ(cmp.bad, 0) << cmp.first_bad;
 
   for (float focus : {3.f, 1e-6f, 1e6f}) {
-    SceneInput f = furnace_sphere(DiffuseParams{Spectrum(1.f)});
+    SceneInput f = furnace_with_sphere(DiffuseParams{Spectrum(1.f)});
     f.camera.aperture_radius = 1e3f;
     f.camera.focus_distance = focus;
     const RenderResult r = render_input(f, settings(16, 16, 64));
