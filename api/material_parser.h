@@ -6,7 +6,7 @@
 
 #include "api/json_reader.h"
 #include "api/scene_loader.h"
-#include "renderer/bsdf.h"
+#include "renderer/materials/material_params.h"
 
 namespace penumbra::api {
 

@@ -74,7 +74,7 @@ glm::dvec3 area_vector(const vec3& a, const vec3& b, const vec3& c) {
 
 }  // namespace
 
-std::optional<MeshShape> parse_mesh(ObjectReader& reader, const AffineTransform& transform,
+std::optional<MeshDesc> parse_mesh(ObjectReader& reader, const AffineTransform& transform,
                                     int64_t triangle_budget, int64_t max_triangles) {
   Diagnostics& diag = reader.diagnostics();
   const Json* positions_json = reader.array("positions", Presence::kRequired);
@@ -126,7 +126,7 @@ std::optional<MeshShape> parse_mesh(ObjectReader& reader, const AffineTransform&
   }
   if (!positions || !indices) return std::nullopt;
 
-  MeshShape mesh;
+  MeshDesc mesh;
   mesh.positions.reserve(vertex_count);
   for (const glm::dvec3& p : *positions) {
     const auto world = to_world(transform.point(p));

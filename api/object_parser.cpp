@@ -26,7 +26,7 @@ std::string_view blame(const ObjectReader& reader, std::string_view field) {
   return reader.has("transform") ? std::string_view("transform") : field;
 }
 
-std::optional<SphereShape> parse_sphere(ObjectReader& reader, const AffineTransform& transform) {
+std::optional<SphereDesc> parse_sphere(ObjectReader& reader, const AffineTransform& transform) {
   const auto center = reader.vec3("center", Range::any(), Presence::kRequired);
   const auto radius = reader.number("radius", Range::greater_than(0), Presence::kRequired);
   if (!center || !radius) return std::nullopt;
@@ -47,10 +47,10 @@ std::optional<SphereShape> parse_sphere(ObjectReader& reader, const AffineTransf
     reader.error(blame(reader, "radius"), "the radius is too small for single precision");
     return std::nullopt;
   }
-  return SphereShape{to_float(world_center), float(world_radius)};
+  return SphereDesc{to_float(world_center), float(world_radius)};
 }
 
-std::optional<QuadShape> parse_quad(ObjectReader& reader, const AffineTransform& transform) {
+std::optional<QuadDesc> parse_quad(ObjectReader& reader, const AffineTransform& transform) {
   const auto origin = reader.vec3("origin", Range::any(), Presence::kRequired);
   const auto u = reader.vec3("u", Range::any(), Presence::kRequired);
   const auto v = reader.vec3("v", Range::any(), Presence::kRequired);
@@ -63,7 +63,7 @@ std::optional<QuadShape> parse_quad(ObjectReader& reader, const AffineTransform&
     reader.error(blame(reader, "origin"), coordinate_message());
     return std::nullopt;
   }
-  QuadShape quad{to_float(world_origin), to_float(world_u), to_float(world_v)};
+  QuadDesc quad{to_float(world_origin), to_float(world_u), to_float(world_v)};
   // Judge the area on the single-precision vectors the renderer will use.
   const double area = glm::length(glm::cross(glm::dvec3(quad.u), glm::dvec3(quad.v)));
   if (!(area > 0) || float(area) == 0.f) {

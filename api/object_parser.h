@@ -8,7 +8,7 @@
 #include "api/json_reader.h"
 #include "api/material_parser.h"
 #include "api/scene_loader.h"
-#include "renderer/scene_input.h"
+#include "renderer/scene/scene_input.h"
 
 namespace penumbra::api {
 

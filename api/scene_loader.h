@@ -8,7 +8,7 @@
 #include <string_view>
 #include <vector>
 
-#include "renderer/scene_input.h"
+#include "renderer/scene/scene_input.h"
 
 namespace penumbra::api {
 

@@ -7,8 +7,8 @@
 #include "api/scene_loader.h"
 #include "app/commands.h"
 #include "app/option_parsing.h"
-#include "renderer/embree_baseline.h"
-#include "renderer/render.h"
+#include "renderer/render/embree_baseline.h"
+#include "renderer/render/render.h"
 
 namespace penumbra::app {
 namespace {

@@ -3,7 +3,7 @@
 #include <optional>
 #include <string>
 
-#include "renderer/scene_input.h"
+#include "renderer/scene/scene_input.h"
 
 namespace penumbra::app {
 

@@ -9,8 +9,8 @@
 #include "api/scene_loader.h"
 #include "app/commands.h"
 #include "app/option_parsing.h"
-#include "renderer/image_io.h"
-#include "renderer/render.h"
+#include "renderer/io/image_io.h"
+#include "renderer/render/render.h"
 
 namespace penumbra::app {
 namespace {

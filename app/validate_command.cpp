@@ -28,7 +28,7 @@ void print_help(std::FILE* out) {
 int64_t count_triangles(const SceneInput& scene) {
   int64_t triangles = 0;
   for (const ObjectDesc& object : scene.objects)
-    if (const auto* mesh = std::get_if<MeshShape>(&object.shape))
+    if (const auto* mesh = std::get_if<MeshDesc>(&object.shape))
       triangles += int64_t(mesh->indices.size() / 3);
   return triangles;
 }

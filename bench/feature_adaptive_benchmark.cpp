@@ -23,9 +23,9 @@
 #include <vector>
 
 #include "api/scene_loader.h"
-#include "renderer/image_io.h"
-#include "renderer/render.h"
-#include "renderer/scene.h"
+#include "renderer/io/image_io.h"
+#include "renderer/render/render.h"
+#include "renderer/scene/scene.h"
 
 namespace {
 

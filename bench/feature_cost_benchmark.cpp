@@ -17,8 +17,8 @@
 #include <string>
 
 #include "api/scene_loader.h"
-#include "renderer/render.h"
-#include "renderer/scene.h"
+#include "renderer/render/render.h"
+#include "renderer/scene/scene.h"
 
 namespace {
 

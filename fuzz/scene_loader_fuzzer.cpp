@@ -10,8 +10,8 @@
 #include <string_view>
 
 #include "api/scene_loader.h"
-#include "renderer/render.h"
-#include "renderer/scene.h"
+#include "renderer/render/render.h"
+#include "renderer/scene/scene.h"
 
 namespace {
 

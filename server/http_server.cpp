@@ -13,7 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "api/embedded_documents.h"
-#include "renderer/image_io.h"
+#include "renderer/io/image_io.h"
 #include "server/job_json.h"
 #include "server/problem.h"
 #include "server/request_guard.h"

@@ -7,7 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "renderer/image_io.h"
+#include "renderer/io/image_io.h"
 
 namespace penumbra::server {
 namespace {

@@ -7,8 +7,8 @@
 #include <string>
 
 #include "api/scene_loader.h"
-#include "renderer/image.h"
-#include "renderer/render.h"
+#include "renderer/core/image.h"
+#include "renderer/render/render.h"
 
 namespace penumbra::server {
 

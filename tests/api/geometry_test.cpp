@@ -11,8 +11,8 @@ Json mesh(Json positions, Json indices) {
   return {{"type", "mesh"}, {"positions", positions}, {"indices", indices}, {"material", "white"}};
 }
 
-const MeshShape& mesh_of(const LoadResult& r, std::size_t object) {
-  return std::get<MeshShape>(r.request->scene.objects.at(object).shape);
+const MeshDesc& mesh_of(const LoadResult& r, std::size_t object) {
+  return std::get<MeshDesc>(r.request->scene.objects.at(object).shape);
 }
 
 TEST(Geometry, ZeroAreaQuad) {
@@ -32,7 +32,7 @@ TEST(Geometry, QuadIsPassedThrough) {
       R"({"type": "quad", "origin": [1,2,3], "u": [1,0,0], "v": [0,0,-1], "material": "white"})"));
   const LoadResult r = load(scene);
   ASSERT_TRUE(r.ok()) << describe(r.errors);
-  const auto& quad = std::get<QuadShape>(r.request->scene.objects[1].shape);
+  const auto& quad = std::get<QuadDesc>(r.request->scene.objects[1].shape);
   EXPECT_EQ(quad.origin, vec3(1, 2, 3));
   EXPECT_EQ(quad.u, vec3(1, 0, 0));
   EXPECT_EQ(quad.v, vec3(0, 0, -1));
@@ -75,7 +75,7 @@ TEST(Geometry, DegenerateTrianglesAreDroppedWithAWarning) {
   const LoadResult r = load(scene);
   ASSERT_TRUE(r.ok()) << describe(r.errors);
   EXPECT_TRUE(has(r.warnings, "/objects/1/indices/3", "dropped 2 degenerate")) << describe(r.warnings);
-  const MeshShape& m = mesh_of(r, 1);
+  const MeshDesc& m = mesh_of(r, 1);
   EXPECT_EQ(m.indices, (std::vector<uint32_t>{0, 1, 2, 2, 1, 3}));
   EXPECT_EQ(m.positions.size(), 4u);
 }
@@ -95,7 +95,7 @@ TEST(Geometry, ZeroLengthNormalsAreRepairedFromFaces) {
   ASSERT_TRUE(r.ok()) << describe(r.errors);
   EXPECT_TRUE(has(r.warnings, "/objects/1/normals/0", "2 zero-length normal(s) replaced"))
       << describe(r.warnings);
-  const MeshShape& shape = mesh_of(r, 1);
+  const MeshDesc& shape = mesh_of(r, 1);
   ASSERT_EQ(shape.normals.size(), 4u);
   EXPECT_EQ(shape.normals[0], vec3(0, 0, 1));  // the face normal (counter-clockwise in xy)
   EXPECT_EQ(shape.normals[1], vec3(0, 0, 1));  // normalised
@@ -117,7 +117,7 @@ TEST(Geometry, MeshIsPassedThrough) {
   EXPECT_EQ(o.velocity, vec3(1, 2, 3));
   EXPECT_EQ(o.acceleration, vec3(0, -9.81f, 0));
   EXPECT_EQ(o.emission, Spectrum(4, 5, 6));
-  const MeshShape& shape = mesh_of(r, 1);
+  const MeshDesc& shape = mesh_of(r, 1);
   EXPECT_EQ(shape.positions[1], vec3(1, 0, 0));
   EXPECT_EQ(shape.indices, (std::vector<uint32_t>{0, 1, 2}));
 }
@@ -125,7 +125,7 @@ TEST(Geometry, MeshIsPassedThrough) {
 TEST(Geometry, SphereIsPassedThrough) {
   const LoadResult r = load(base_scene());
   ASSERT_TRUE(r.ok()) << describe(r.errors);
-  const auto& sphere = std::get<SphereShape>(r.request->scene.objects[0].shape);
+  const auto& sphere = std::get<SphereDesc>(r.request->scene.objects[0].shape);
   EXPECT_EQ(sphere.center, vec3(0));
   EXPECT_EQ(sphere.radius, 1.f);
 }

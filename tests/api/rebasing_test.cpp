@@ -22,9 +22,9 @@ TEST(Rebasing, PositionsAreRelativeToTheCamera) {
   EXPECT_EQ(q.scene.camera.position, vec3(0.f));
   EXPECT_EQ(q.scene.camera.look_at, vec3(0, 0, -5));
   // Offsets below float resolution at 1e6 (0.0625) survive exactly.
-  EXPECT_EQ(std::get<SphereShape>(q.scene.objects[0].shape).center, vec3(0.25f, 0.5f, -5.125f));
-  EXPECT_EQ(std::get<QuadShape>(q.scene.objects[1].shape).origin, vec3(0.5f, -1.f, -4.75f));
-  EXPECT_EQ(std::get<QuadShape>(q.scene.objects[1].shape).u, vec3(1, 0, 0));
+  EXPECT_EQ(std::get<SphereDesc>(q.scene.objects[0].shape).center, vec3(0.25f, 0.5f, -5.125f));
+  EXPECT_EQ(std::get<QuadDesc>(q.scene.objects[1].shape).origin, vec3(0.5f, -1.f, -4.75f));
+  EXPECT_EQ(std::get<QuadDesc>(q.scene.objects[1].shape).u, vec3(1, 0, 0));
   EXPECT_EQ(std::get<PointLightDesc>(q.scene.lights[0]).position, vec3(0.75f, 1.f, -5.5f));
 }
 

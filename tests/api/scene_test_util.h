@@ -30,9 +30,9 @@ inline void restore_json_coordinates(SceneRequest& r) {
   add(r.scene.camera.position);
   add(r.scene.camera.look_at);
   for (ObjectDesc& o : r.scene.objects) {
-    if (auto* s = std::get_if<SphereShape>(&o.shape)) add(s->center);
-    if (auto* q = std::get_if<QuadShape>(&o.shape)) add(q->origin);
-    if (auto* m = std::get_if<MeshShape>(&o.shape))
+    if (auto* s = std::get_if<SphereDesc>(&o.shape)) add(s->center);
+    if (auto* q = std::get_if<QuadDesc>(&o.shape)) add(q->origin);
+    if (auto* m = std::get_if<MeshDesc>(&o.shape))
       for (vec3& p : m->positions) add(p);
   }
   for (LightDesc& l : r.scene.lights)

@@ -25,7 +25,7 @@ TEST(Transform, ScaleThenRotateThenTranslate) {
   const LoadResult r = load_with_quad_transform(Json::parse(
       R"({"translate": [0, 0, 5], "rotate": {"axis": [0, 0, 3], "degrees": 90}, "scale": [2, 1, 1]})"));
   ASSERT_TRUE(r.ok()) << describe(r.errors);
-  const auto& quad = std::get<QuadShape>(r.request->scene.objects[1].shape);
+  const auto& quad = std::get<QuadDesc>(r.request->scene.objects[1].shape);
   expect_near(quad.origin, vec3(0, 2, 5));  // a point: all three steps
   expect_near(quad.u, vec3(0, 2, 0));       // a vector: no translation
   expect_near(quad.v, vec3(-1, 0, 0));
@@ -34,7 +34,7 @@ TEST(Transform, ScaleThenRotateThenTranslate) {
 TEST(Transform, UniformScaleAsNumber) {
   const LoadResult r = load_with_quad_transform({{"scale", 3}});
   ASSERT_TRUE(r.ok()) << describe(r.errors);
-  const auto& quad = std::get<QuadShape>(r.request->scene.objects[1].shape);
+  const auto& quad = std::get<QuadDesc>(r.request->scene.objects[1].shape);
   expect_near(quad.origin, vec3(3, 0, 0));
   expect_near(quad.v, vec3(0, 3, 0));
 }
@@ -44,7 +44,7 @@ TEST(Transform, MatrixIsRowMajor) {
   const LoadResult r = load_with_quad_transform(
       {{"matrix", {0, -1, 0, 10, 1, 0, 0, 20, 0, 0, 1, 30, 0, 0, 0, 1}}});
   ASSERT_TRUE(r.ok()) << describe(r.errors);
-  const auto& quad = std::get<QuadShape>(r.request->scene.objects[1].shape);
+  const auto& quad = std::get<QuadDesc>(r.request->scene.objects[1].shape);
   expect_near(quad.origin, vec3(10, 21, 30));  // (1,0,0) rotated to (0,1,0), then translated
   expect_near(quad.u, vec3(0, 1, 0));
   expect_near(quad.v, vec3(-1, 0, 0));
@@ -90,7 +90,7 @@ TEST(Transform, MeshNormalsUseTheInverseTranspose) {
     "normals": [1,-1,0, 1,-1,0, 1,-1,0], "transform": {"scale": [2, 1, 1]}})"));
   const LoadResult r = load(scene);
   ASSERT_TRUE(r.ok()) << describe(r.errors);
-  const auto& mesh = std::get<MeshShape>(r.request->scene.objects[1].shape);
+  const auto& mesh = std::get<MeshDesc>(r.request->scene.objects[1].shape);
   expect_near(mesh.positions[1], vec3(2, 1, 0));
   const vec3 expected = glm::normalize(vec3(0.5f, -1.f, 0.f));
   expect_near(mesh.normals[0], expected);
@@ -105,7 +105,7 @@ TEST(Transform, SphereUnderSimilarity) {
       R"({"scale": 2, "rotate": {"axis": [0, 1, 0], "degrees": 90}, "translate": [0, 1, 0]})");
   const LoadResult r = load(scene);
   ASSERT_TRUE(r.ok()) << describe(r.errors);
-  const auto& sphere = std::get<SphereShape>(r.request->scene.objects[0].shape);
+  const auto& sphere = std::get<SphereDesc>(r.request->scene.objects[0].shape);
   // (1,0,0) scaled to (2,0,0), rotated about +y by 90 degrees to (0,0,-2), translated.
   expect_near(sphere.center, vec3(0, 1, -2));
   EXPECT_NEAR(sphere.radius, 2.f, 1e-6f);

@@ -44,7 +44,7 @@ TEST(DielectricStress, TotalInternalReflectionInAPrism) {
     SceneInput in;
     // Prism cross-section in x-y: legs along +x and +y from the origin, hypotenuse from (1,0) to
     // (0,1); extruded along z over [-1, 1].
-    MeshShape m;
+    MeshDesc m;
     const float z0 = -1.f, z1 = 1.f;
     m.positions = {vec3(0, 0, z0), vec3(1, 0, z0), vec3(0, 1, z0), vec3(0, 0, z1), vec3(1, 0, z1), vec3(0, 1, z1)};
     for (vec3& q : m.positions) q *= scale;

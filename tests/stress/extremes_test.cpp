@@ -177,13 +177,13 @@ TEST(Extremes, DegenerateTrianglesInAMeshAreSkipped) {
   SceneInput in;
   in.camera = camera_looking({0, 1.5f, 3}, {0, 0, 0}, 40.f);
   in.materials = {DiffuseParams{Spectrum(0.7f)}};
-  MeshShape m;
+  MeshDesc m;
   m.positions = {vec3(-1, 0, 1), vec3(1, 0, 1), vec3(1, 0, -1), vec3(-1, 0, -1), vec3(0, 0, 0)};
   m.indices = {0, 1, 2, 0, 0, 1, 0, 4, 2, 0, 2, 3, 3, 3, 3};
   ObjectDesc floor;
   floor.shape = m;
   ObjectDesc lamp;
-  MeshShape lm = m;
+  MeshDesc lm = m;
   for (vec3& p : lm.positions) p = vec3(p.x * 0.3f, 1.5f, -p.z * 0.3f);  // flipped: faces down
   lamp.shape = lm;
   lamp.emission = Spectrum(3.f);
@@ -191,7 +191,7 @@ TEST(Extremes, DegenerateTrianglesInAMeshAreSkipped) {
   const RenderResult r = render_input(in, settings(24, 24, 64, 4));
   EXPECT_EQ(nonfinite_count(r), 0);
   SceneInput clean_in = in;
-  for (ObjectDesc& o : clean_in.objects) std::get<MeshShape>(o.shape).indices = {0, 1, 2, 0, 2, 3};
+  for (ObjectDesc& o : clean_in.objects) std::get<MeshDesc>(o.shape).indices = {0, 1, 2, 0, 2, 3};
   const RenderResult ref = render_input(clean_in, settings(24, 24, 64, 4));
   EXPECT_GT(image_mean(ref).mean, 0.005);
   const BlockComparison cmp = compare_blocks(ref, r, 8, 5.0, 0.01);
@@ -214,7 +214,7 @@ TEST(Extremes, ZeroLengthNormals) {
   in.camera = camera_looking({0, 1.5f, 3}, {0, 0, 0}, 40.f);
   in.materials = {DiffuseParams{Spectrum(0.7f)}};
   in.lights = {DirectionalLightDesc{{0.3f, -1, -0.2f}, Spectrum(2.f)}};
-  MeshShape m;
+  MeshDesc m;
   m.positions = {vec3(-1, 0, 1), vec3(1, 0, 1), vec3(1, 0, -1), vec3(-1, 0, -1)};
   m.indices = {0, 1, 2, 0, 2, 3};
   ObjectDesc plain;

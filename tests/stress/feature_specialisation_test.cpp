@@ -5,10 +5,10 @@
 
 #include <cstring>
 
-#include "renderer/integrator.h"
-#include "renderer/sampler.h"
-#include "renderer/scene_impl.h"
-#include "renderer/thin_lens_camera.h"
+#include "renderer/render/integrator.h"
+#include "renderer/sampling/sampler.h"
+#include "renderer/scene/scene_impl.h"
+#include "renderer/render/thin_lens_camera.h"
 #include "tests/stress/stress_util.h"
 
 namespace penumbra::stress {

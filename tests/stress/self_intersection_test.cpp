@@ -11,10 +11,10 @@
 
 #include <random>
 
-#include "renderer/frame.h"
-#include "renderer/sampling.h"
-#include "renderer/scene_impl.h"
-#include "renderer/thin_lens_camera.h"
+#include "renderer/core/frame.h"
+#include "renderer/sampling/sampling.h"
+#include "renderer/scene/scene_impl.h"
+#include "renderer/render/thin_lens_camera.h"
 #include "tests/stress/stress_util.h"
 
 namespace penumbra::stress {
@@ -169,7 +169,7 @@ TEST(LargeTriangleNearOrigin, SpawnedRaysNeverReHitTheirSurface) {
     const vec3 u = c.axis_aligned ? vec3(1, 0, 0) : glm::normalize(vec3(0.8f, 0.3f, -0.5f));
     const vec3 w = c.axis_aligned ? vec3(0, 0, -1)
                                   : glm::normalize(glm::cross(u, vec3(0.2f, 1.f, 0.1f)));
-    MeshShape m;
+    MeshDesc m;
     m.positions = {vec3(0.f), u * c.size, (u + w) * c.size, w * c.size};
     const uint32_t tris[2][3] = {{0, 1, 2}, {0, 2, 3}};
     for (const auto& t : tris)
@@ -232,7 +232,7 @@ TEST_P(FlatGrazing, EveryPixelMatchesCosineLaw) {
   const float half = 20.f * p.scale;
   if (gc.mesh) {
     // Slivers radiating from the centre: 256 triangles, each about 0.5 degree wide.
-    MeshShape m;
+    MeshDesc m;
     m.positions.push_back(p.offset);
     const int n = 256;
     for (int i = 0; i < n; ++i) {

@@ -9,10 +9,10 @@
 #include <vector>
 
 #include "api/scene_loader.h"
-#include "renderer/render.h"
-#include "renderer/scene.h"
-#include "renderer/scene_input.h"
-#include "tests/renderer/render_test_util.h"
+#include "renderer/render/render.h"
+#include "renderer/scene/scene.h"
+#include "renderer/scene/scene_input.h"
+#include "tests/renderer/render/render_test_util.h"
 
 namespace penumbra::stress {
 
@@ -130,7 +130,7 @@ inline ObjectDesc sphere(const vec3& center, float radius, uint32_t material,
 }
 
 inline ObjectDesc box(const vec3& lo, const vec3& hi, uint32_t material) {
-  MeshShape m;
+  MeshDesc m;
   for (int i = 0; i < 8; ++i)
     m.positions.push_back(vec3(i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z));
   // Each face: four corners counter-clockwise seen from outside.
@@ -145,8 +145,8 @@ inline ObjectDesc box(const vec3& lo, const vec3& hi, uint32_t material) {
 
 // Unit-radius UV sphere as a triangle mesh (counter-clockwise from outside), optional smooth
 // normals.
-inline MeshShape uv_sphere_mesh(const vec3& center, float radius, int rings, int segments, bool normals) {
-  MeshShape m;
+inline MeshDesc uv_sphere_mesh(const vec3& center, float radius, int rings, int segments, bool normals) {
+  MeshDesc m;
   for (int i = 0; i <= rings; ++i) {
     const float theta = kPi * float(i) / float(rings);
     for (int j = 0; j <= segments; ++j) {

@@ -1,0 +1,119 @@
+#include "renderer/io/image_io.h"
+
+#include <OpenImageIO/filesystem.h>
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <random>
+#include <unistd.h>
+
+namespace penumbra {
+namespace {
+
+std::string lower_extension(const std::string& path) {
+  const size_t dot = path.find_last_of('.');
+  if (dot == std::string::npos) return "";
+  std::string ext = path.substr(dot + 1);
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext;
+}
+
+// IEC 61966-2-1 sRGB transfer function.
+float linear_to_srgb(float v) {
+  if (!(v > 0.f)) return 0.f;
+  if (v >= 1.f) return 1.f;
+  return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.f / 2.4f) - 0.055f;
+}
+float srgb_to_linear(float v) {
+  return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
+}
+
+}  // namespace
+
+ImageFormat image_format_from_path(const std::string& path) {
+  const std::string ext = lower_extension(path);
+  if (ext == "png") return ImageFormat::kPng;
+  if (ext == "exr") return ImageFormat::kExr;
+  throw ImageIoError("unsupported image format '" + path + "' (use .png or .exr)");
+}
+
+std::vector<uint8_t> encode_image(const Image& image, ImageFormat format,
+                                  const ImageMetadata& metadata) {
+  std::vector<unsigned char> buffer;
+  OIIO::Filesystem::IOVecOutput proxy(buffer);
+  const char* name = format == ImageFormat::kPng ? "image.png" : "image.exr";
+  auto out = OIIO::ImageOutput::create(name);
+  if (!out) throw ImageIoError("OpenImageIO has no writer for " + std::string(name));
+  const size_t n = size_t(image.width) * image.height * 3;
+  OIIO::ImageSpec spec;
+  std::vector<float> linear;
+  std::vector<uint8_t> bytes;
+  const void* data;
+  if (format == ImageFormat::kPng) {
+    spec = OIIO::ImageSpec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
+    bytes.resize(n);
+    for (size_t i = 0; i < n; ++i)
+      bytes[i] = uint8_t(std::lround(linear_to_srgb(image.rgb[i]) * 255.f));
+    data = bytes.data();
+  } else {
+    spec = OIIO::ImageSpec(image.width, image.height, 3, OIIO::TypeDesc::FLOAT);
+    spec.attribute("compression", "zip");
+    linear.resize(n);
+    for (size_t i = 0; i < n; ++i) linear[i] = std::isfinite(image.rgb[i]) ? image.rgb[i] : 0.f;
+    data = linear.data();
+  }
+  for (const auto& [key, value] : metadata) spec.attribute(key, value);
+  void* proxy_ptr = &proxy;
+  spec.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy_ptr);
+  if (!out->open(name, spec)) throw ImageIoError("cannot encode image: " + out->geterror());
+  const OIIO::TypeDesc type = format == ImageFormat::kPng ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT;
+  if (!out->write_image(type, data)) throw ImageIoError("cannot encode image: " + out->geterror());
+  if (!out->close()) throw ImageIoError("cannot encode image: " + out->geterror());
+  return std::vector<uint8_t>(buffer.begin(), buffer.end());
+}
+
+void write_image_file(const std::string& path, const Image& image, const ImageMetadata& metadata) {
+  const std::vector<uint8_t> bytes = encode_image(image, image_format_from_path(path), metadata);
+  // Temporary file beside the target, then rename: readers never see a partial image.
+  std::random_device rd;
+  const std::string tmp = path + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(rd());
+  {
+    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
+    if (!f) throw ImageIoError("cannot write " + path);
+    f.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+    f.flush();
+    if (!f) {
+      std::remove(tmp.c_str());
+      throw ImageIoError("cannot write " + path);
+    }
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    std::remove(tmp.c_str());
+    throw ImageIoError("cannot write " + path);
+  }
+}
+
+Image read_image_file(const std::string& path) {
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) throw ImageIoError("cannot read " + path + ": " + OIIO::geterror());
+  const OIIO::ImageSpec& spec = in->spec();
+  Image img(spec.width, spec.height);
+  const int nc = spec.nchannels;
+  std::vector<float> data(size_t(spec.width) * spec.height * nc);
+  if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, data.data()))
+    throw ImageIoError("cannot read " + path + ": " + in->geterror());
+  const bool srgb = spec.format.basetype == OIIO::TypeDesc::UINT8;
+  for (size_t i = 0; i < size_t(spec.width) * spec.height; ++i)
+    for (int c = 0; c < 3; ++c) {
+      const float v = data[i * nc + std::min(c, nc - 1)];
+      img.rgb[3 * i + c] = srgb ? srgb_to_linear(v) : v;
+    }
+  in->close();
+  return img;
+}
+
+}  // namespace penumbra

@@ -1,0 +1,29 @@
+#pragma once
+// Conductor with a constant (angle-independent) Fresnel reflectance: a perfect mirror when smooth,
+// GGX microfacet reflection when rough (the model of Mitsuba 3's `conductor` / `roughconductor`
+// with distribution = ggx, sample_visible = true and specular_reflectance = color).
+#include "renderer/materials/bsdf.h"
+#include "renderer/materials/material_params.h"
+#include "renderer/materials/microfacet.h"
+
+namespace penumbra {
+
+// Front-side model (wi.z > 0); Material mirrors back-side queries to the front.
+class ConductorBsdf {
+ public:
+  explicit ConductorBsdf(const ConductorParams& params);
+
+  bool smooth() const { return smooth_; }
+  uint32_t lobes() const { return smooth_ ? kLobeDeltaReflection : kLobeGlossyReflection; }
+  Spectrum eval(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
+  float pdf(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
+  std::optional<BsdfSample> sample(const BsdfContext& ctx, const vec3& wi, float u_lobe,
+                                   const vec2& u) const;
+
+ private:
+  Spectrum color_;
+  bool smooth_;
+  GgxDistribution distr_;
+};
+
+}  // namespace penumbra

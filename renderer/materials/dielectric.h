@@ -1,0 +1,41 @@
+#pragma once
+// Dielectric interface between the exterior (ior 1, the +z side) and the interior (ior `ior`).
+// Smooth: Fresnel-weighted choice between Dirac reflection and refraction, with total internal
+// reflection. Rough: Walter et al. 2007, "Microfacet Models for Refraction through Rough
+// Surfaces", with GGX and visible-normal sampling (the model of Mitsuba 3's `roughdielectric`).
+// Radiance transport: refracted radiance is scaled by 1/eta^2 (Veach 1997, sec. 5.2).
+#include "renderer/materials/bsdf.h"
+#include "renderer/materials/material_params.h"
+#include "renderer/materials/microfacet.h"
+
+namespace penumbra {
+
+class DielectricBsdf {
+ public:
+  explicit DielectricBsdf(const DielectricParams& params);
+
+  // Index-matched (ior == 1): the interface is invisible, a Dirac transmission of weight 1.
+  bool index_matched() const { return index_matched_; }
+  bool smooth() const { return smooth_; }
+  uint32_t lobes() const;
+  Spectrum eval(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
+  float pdf(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
+  std::optional<BsdfSample> sample(const BsdfContext& ctx, const vec3& wi, float u_lobe,
+                                   const vec2& u) const;
+
+ private:
+  std::optional<BsdfSample> sample_smooth(const BsdfContext& ctx, const vec3& wi,
+                                          float u_lobe) const;
+  std::optional<BsdfSample> sample_rough(const BsdfContext& ctx, const vec3& wi, float u_lobe,
+                                         const vec2& u) const;
+  // Generalised half vector (Walter et al. 2007 eq. 13 and 16) oriented to +z, plus the relative
+  // ior eta = eta_o / eta_i; returns false when wi, wo and m do not form a valid configuration.
+  bool half_vector(const vec3& wi, const vec3& wo, vec3& m, float& eta, bool& is_reflection) const;
+
+  float eta_;  // interior / exterior
+  bool index_matched_;
+  bool smooth_;
+  GgxDistribution distr_;
+};
+
+}  // namespace penumbra

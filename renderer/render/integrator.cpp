@@ -1,0 +1,187 @@
+#include "renderer/render/integrator.h"
+
+#include <array>
+#include <climits>
+#include <utility>
+
+#include "renderer/core/frame.h"
+#include "renderer/sampling/sampling.h"
+
+namespace penumbra {
+namespace {
+
+// A direction pair is usable only if the shading frame and the true surface agree on whether it
+// reflects or transmits; otherwise shading normals would leak light through surfaces
+// (Veach 1997 section 5.3).
+bool geometry_agrees(const vec3& wi_world, const vec3& wo_world, const vec3& ng, const vec3& wi_local,
+                     const vec3& wo_local) {
+  const float geo = glm::dot(wi_world, ng) * glm::dot(wo_world, ng);
+  const float shade = wi_local.z * wo_local.z;
+  return geo != 0.f && (geo > 0.f) == (shade > 0.f);
+}
+
+// Feature bits an instantiation is compiled for. A bit that is off removes that code from the
+// loop entirely (Cycles compiles only the kernel features a scene uses); a bit that is on keeps
+// the run-time test, so the all-on instantiation is the generic integrator and any
+// instantiation gives bit-identical images on the scenes it is chosen for.
+enum IntegratorFeature : uint32_t {
+  kFeatureAbsorption = 1u << 0,    // Beer-Lambert attenuation inside dielectrics
+  kFeatureTransmission = 1u << 1,  // refraction: eta bookkeeping for Russian roulette
+  kFeatureEnvironment = 1u << 2,   // escaping rays gather the environment
+  kFeatureLights = 1u << 3,        // next-event estimation (any light at all)
+  kFeatureAll = (1u << 4) - 1,
+};
+
+template <bool kDistributed, uint32_t kFeatures>
+Spectrum integrate(const SceneImpl& scene, const IntegratorSettings& settings, Ray ray,
+                   Sampler& sampler, PathCounters& counters) {
+  Spectrum radiance(0.f), beta(1.f);
+  const int max_depth = settings.max_depth < 0 ? INT_MAX : settings.max_depth;
+  // The strategy that produced the current ray, for MIS on the emitter it may hit.
+  float prev_pdf = 0.f;
+  bool prev_delta = true;
+  vec3 prev_p = ray.origin;
+  float eta = 1.f;
+  const LightSampler& lights = scene.lights;
+  constexpr uint32_t kContinueLobes = kDistributed ? uint32_t(kLobeNonDiffuse) : uint32_t(kLobeAll);
+
+  for (int depth = 1;; ++depth) {
+    SurfaceHit hit;
+    ++counters.rays;
+    if (!scene.intersect(ray, &hit)) {
+      if constexpr ((kFeatures & kFeatureEnvironment) != 0) {
+        if (!scene.features.environment) break;
+        const float w = prev_delta ? 1.f : power_heuristic(prev_pdf, lights.environment_pdf());
+        radiance += beta * scene.environment * w;
+      }
+      break;
+    }
+    const ObjectRecord& obj = scene.objects[hit.object];
+    const Material& material = scene.materials[obj.material];
+    const bool front = glm::dot(ray.direction, hit.ng) < 0.f;
+
+    // Beer-Lambert: a segment that ends on the back of an absorbing dielectric ran inside it.
+    if constexpr ((kFeatures & kFeatureAbsorption) != 0) {
+      if (scene.features.absorption && !front) {
+        const Spectrum sigma = material.absorption();
+        if (!is_black(sigma)) beta *= glm::exp(-sigma * hit.t);
+      }
+    }
+    if (obj.light >= 0 && front) {
+      float w = 1.f;
+      if (!prev_delta)
+        w = power_heuristic(prev_pdf, lights.area_pdf(scene, obj.light, prev_p, hit.p, hit.ng, ray.time));
+      radiance += beta * obj.emission * w;
+    }
+    if (depth >= max_depth) break;
+
+    const Frame frame(hit.ns);
+    const vec3 wi_world = -ray.direction;
+    const vec3 wi = frame.to_local(wi_world);
+    const uint32_t lobes = material.lobes();
+
+    // Next-event estimation.
+    if ((kFeatures & kFeatureLights) != 0 && (lobes & ~uint32_t(kLobeDelta)) && !lights.empty()) {
+      const float u_light = sampler.get_1d();
+      const vec2 u_point = sampler.get_2d();
+      LightSample ls;
+      if (lights.sample(scene, hit.p, ray.time, u_light, u_point, &ls)) {
+        const vec3 wo = frame.to_local(ls.wi);
+        if (geometry_agrees(wi_world, ls.wi, hit.ng, wi, wo)) {
+          Spectrum f;
+          if constexpr (kDistributed) {
+            // Diffuse lobes see direct light through light sampling alone; the other lobes
+            // share it with their own sampling by MIS.
+            const BsdfContext diffuse{kLobeDiffuse}, rest{kLobeNonDiffuse};
+            const Spectrum f_rest = material.eval(rest, wi, wo);
+            const float w = ls.is_delta ? 1.f : power_heuristic(ls.pdf, material.pdf(rest, wi, wo));
+            f = material.eval(diffuse, wi, wo) + f_rest * w;
+          } else {
+            const BsdfContext all{};
+            const float w = ls.is_delta ? 1.f : power_heuristic(ls.pdf, material.pdf(all, wi, wo));
+            f = material.eval(all, wi, wo) * w;
+          }
+          if (!is_black(f)) {
+            const vec3 origin = offset_ray_origin(hit.p, hit.p_error, hit.ng, ls.wi);
+            vec3 dir = ls.wi;
+            float t_max = kInfinity;
+            if (std::isfinite(ls.distance)) {
+              const vec3 target = ls.n == vec3(0.f)
+                                      ? ls.p
+                                      : offset_ray_origin(ls.p, ls.p_error, ls.n, -ls.wi);
+              const vec3 d = target - origin;
+              const float dist = glm::length(d);
+              dir = dist > 0.f ? d / dist : ls.wi;
+              // A point light is a point in free space: nothing at the far end to miss, and a
+              // relative shortening would let the ray stop short of a wall the light sits
+              // closer to than 1e-4 of the distance (a leak the stress suite checks). An area
+              // light's point is offset off its surface already; the epsilon absorbs rounding.
+              t_max = ls.n == vec3(0.f) ? dist : dist * (1.f - kShadowEpsilon);
+            }
+            ++counters.rays;
+            if (t_max > 0.f && !scene.occluded(origin, dir, t_max, ray.time))
+              radiance += beta * f * ls.value / ls.pdf;
+          }
+        }
+      }
+    }
+
+    if constexpr (kDistributed) {
+      if (!(lobes & kLobeNonDiffuse)) break;
+    }
+    const float u_lobe = sampler.get_1d();
+    const vec2 u_dir = sampler.get_2d();
+    const auto bs = material.sample(BsdfContext{kContinueLobes}, wi, u_lobe, u_dir);
+    if (!bs) break;
+    const vec3 wo_world = frame.to_world(bs->wo);
+    if (!geometry_agrees(wi_world, wo_world, hit.ng, wi, bs->wo)) break;
+    beta *= bs->weight;
+    prev_pdf = bs->pdf;
+    prev_delta = (bs->lobe & kLobeDelta) != 0;
+    prev_p = hit.p;
+    if constexpr ((kFeatures & kFeatureTransmission) != 0) eta *= bs->eta;
+    ray = Ray{offset_ray_origin(hit.p, hit.p_error, hit.ng, wo_world), wo_world, ray.time};
+
+    const float beta_max = max_component(beta);
+    if (!(beta_max > 0.f)) break;
+    // Russian roulette as Mitsuba 3: survival by throughput, with eta^2 undoing the radiance
+    // scaling of refraction so paths inside glass are not killed early.
+    if (depth >= settings.rr_depth) {
+      const float q = std::min(beta_max * eta * eta, 0.95f);
+      if (sampler.get_1d() >= q) break;
+      beta /= q;
+    }
+  }
+  return radiance;
+}
+
+template <bool kDistributed, size_t... kMasks>
+constexpr std::array<IntegrateFn, sizeof...(kMasks)> make_table(std::index_sequence<kMasks...>) {
+  return {&integrate<kDistributed, uint32_t(kMasks)>...};
+}
+constexpr auto kPathTable = make_table<false>(std::make_index_sequence<kFeatureAll + 1>{});
+constexpr auto kDistributedTable = make_table<true>(std::make_index_sequence<kFeatureAll + 1>{});
+
+}  // namespace
+
+uint32_t integrator_feature_mask(const SceneFeatures& f) {
+  uint32_t mask = 0;
+  if (f.absorption) mask |= kFeatureAbsorption;
+  // An absorbing material is a dielectric, so absorption implies transmission.
+  if (f.transmission) mask |= kFeatureTransmission;
+  if (f.environment) mask |= kFeatureEnvironment;
+  if (f.area_lights || f.point_lights || f.directional_lights || f.environment) mask |= kFeatureLights;
+  return mask;
+}
+
+IntegrateFn select_integrator(IntegratorKind kind, const SceneFeatures& features) {
+  const uint32_t mask = integrator_feature_mask(features);
+  return kind == IntegratorKind::kDistributed ? kDistributedTable[mask] : kPathTable[mask];
+}
+
+IntegrateFn select_generic_integrator(IntegratorKind kind) {
+  return kind == IntegratorKind::kDistributed ? kDistributedTable[kFeatureAll]
+                                              : kPathTable[kFeatureAll];
+}
+
+}  // namespace penumbra

@@ -1,0 +1,221 @@
+#include "renderer/render/render.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <chrono>
+#include <mutex>
+
+#include "renderer/render/adaptive_sampling.h"
+#include "renderer/render/film.h"
+#include "renderer/render/integrator.h"
+#include "renderer/scene/scene_impl.h"
+#include "renderer/render/thin_lens_camera.h"
+
+namespace penumbra {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// The image's pixels tile by tile (row-major inside each tile), and where each tile starts in
+// that order: a pass's work items are ranges of it.
+struct PixelOrder {
+  std::vector<uint32_t> pixels;
+  std::vector<size_t> tile_starts;  // one per tile, plus the end
+};
+
+PixelOrder make_pixel_order(int width, int height, int size) {
+  PixelOrder o;
+  for (int y0 = 0; y0 < height; y0 += size)
+    for (int x0 = 0; x0 < width; x0 += size) {
+      o.tile_starts.push_back(o.pixels.size());
+      for (int y = y0; y < std::min(y0 + size, height); ++y)
+        for (int x = x0; x < std::min(x0 + size, width); ++x) o.pixels.push_back(uint32_t(y * width + x));
+    }
+  o.tile_starts.push_back(o.pixels.size());
+  return o;
+}
+
+// Work items of an adaptive pass: consecutive ranges of the pixel order holding about equal
+// numbers of samples. Once limits differ, the samples of a pass crowd into the few tiles where
+// the noise is, and tile-sized items would leave threads idle at the pass's end.
+std::vector<size_t> balanced_items(const PixelOrder& order, const std::vector<uint32_t>& taken,
+                                   const std::vector<uint32_t>& limit, uint32_t pass_samples,
+                                   int parts) {
+  auto work = [&](uint32_t p) {
+    return limit[p] > taken[p] ? std::min(pass_samples, limit[p] - taken[p]) : 0u;
+  };
+  uint64_t total = 0;
+  for (uint32_t p : order.pixels) total += work(p);
+  const uint64_t per_item = std::max<uint64_t>(1, total / uint64_t(std::max(1, parts)));
+  std::vector<size_t> starts{0};
+  uint64_t acc = 0;
+  for (size_t k = 0; k < order.pixels.size(); ++k) {
+    acc += work(order.pixels[k]);
+    if (acc >= per_item && k + 1 < order.pixels.size()) {
+      starts.push_back(k + 1);
+      acc = 0;
+    }
+  }
+  starts.push_back(order.pixels.size());
+  return starts;
+}
+
+// Sample counts of the progressive passes: 1, 1, 2, 4, 8, ... so a preview appears at once and
+// each pass doubles the samples; the last pass takes what remains.
+std::vector<int> make_passes(int spp) {
+  std::vector<int> passes;
+  int done = 0, next = 1;
+  while (done < spp) {
+    const int n = std::min(next, spp - done);
+    passes.push_back(n);
+    done += n;
+    if (passes.size() > 1) next *= 2;
+  }
+  return passes;
+}
+
+// Adaptive sampling: re-estimates every pixel's sample limit from the samples so far.
+void update_limits(const Film& film, const AdaptiveLimits& limits, std::vector<uint32_t>* out) {
+  const int w = film.width(), h = film.height();
+  std::vector<double> deviation(size_t(w) * h);
+  tbb::parallel_for(0, h, [&](int y) {
+    for (int x = 0; x < w; ++x) deviation[size_t(y) * w + x] = film.relative_deviation(x, y);
+  });
+  *out = adaptive_sample_limits(deviation, w, h, limits);
+}
+
+}  // namespace
+
+RenderResult render(const Scene& scene_handle, const RenderSettings& settings,
+                    const RenderControl& control) {
+  const SceneImpl& scene = scene_handle.impl();
+  const auto start = Clock::now();
+  const int width = settings.width, height = settings.height;
+  const ThinLensCamera camera(scene.camera, width, height);
+  const IntegrateFn integrate = select_integrator(settings.integrator, scene.features);
+  const IntegratorSettings isettings{settings.max_depth, settings.rr_depth};
+  const bool sample_lens = scene.features.lens;
+  const bool sample_time = scene.features.motion;
+
+  Film film(width, height);
+  const PixelOrder order = make_pixel_order(width, height, std::max(1, settings.tile_size));
+  const int spp = std::max(1, settings.spp);
+  const std::vector<int> passes = make_passes(spp);
+  // Per pixel: samples taken so far and the most it may take. Uniform sampling keeps every limit
+  // at spp; adaptive sampling (render.noise_threshold) re-estimates the limits after each pass
+  // from 16 samples on (renderer/adaptive_sampling.h). Sample indices stay consecutive per pixel
+  // so each pixel's samples are a prefix of its Sobol sequence.
+  std::vector<uint32_t> limit(size_t(width) * height, uint32_t(spp)), taken(size_t(width) * height, 0);
+  const bool adaptive = settings.noise_threshold > 0.f;
+  const AdaptiveLimits adaptive_limits{settings.noise_threshold, 16, spp};
+
+  std::atomic<uint64_t> rays{0}, samples_done{0}, nonfinite{0};
+  std::atomic<bool> stop{false}, timed_out{false}, cancelled{false};
+  std::mutex progress_mutex;
+  uint64_t samples_total = uint64_t(width) * height * uint64_t(spp);
+
+  auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
+  auto make_progress = [&](int passes_done) {
+    RenderProgress p;
+    p.samples_total = samples_total;
+    p.samples_done = samples_done.load();
+    p.fraction = samples_total ? std::min(1.0, double(p.samples_done) / double(samples_total)) : 1.0;
+    p.elapsed_seconds = elapsed();
+    p.eta_seconds = p.fraction > 0 ? p.elapsed_seconds * (1.0 - p.fraction) / p.fraction : 0.0;
+    p.passes_done = passes_done;
+    return p;
+  };
+
+  tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
+  int first_sample = 0;
+  int passes_done = 0;
+  for (size_t pass = 0; pass < passes.size() && !stop.load(); ++pass) {
+    const int s0 = first_sample, s1 = first_sample + passes[pass];
+    // Limits are decided here, between passes, so the image does not depend on threads or tile
+    // order; the progress total follows them so the fraction and ETA stay meaningful.
+    std::vector<size_t> items = order.tile_starts;
+    if (adaptive && s0 >= adaptive_limits.min_samples) {
+      arena.execute([&] { update_limits(film, adaptive_limits, &limit); });
+      samples_total = 0;
+      for (size_t i = 0; i < limit.size(); ++i) samples_total += std::max(limit[i], taken[i]);
+      items = balanced_items(order, taken, limit, uint32_t(s1 - s0), 8 * arena.max_concurrency());
+    }
+    arena.execute([&] {
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, items.size() - 1, 1), [&](const auto& range) {
+        for (size_t item = range.begin(); item != range.end(); ++item) {
+          if (stop.load(std::memory_order_relaxed)) return;
+          if (control.cancel && control.cancel->load(std::memory_order_relaxed)) {
+            cancelled = true;
+            stop = true;
+            return;
+          }
+          if (settings.time_limit > 0 && elapsed() >= settings.time_limit) {
+            timed_out = true;
+            stop = true;
+            return;
+          }
+          Sampler sampler(settings.seed);
+          PathCounters counters;
+          uint64_t item_samples = 0, item_nonfinite = 0;
+          for (size_t k = items[item]; k < items[item + 1]; ++k) {
+            const uint32_t pi = order.pixels[k];
+            const int x = int(pi % uint32_t(width)), y = int(pi / uint32_t(width));
+            const uint32_t n0 = taken[pi], n1 = std::min(n0 + uint32_t(s1 - s0), limit[pi]);
+            if (n0 >= n1) continue;
+            taken[pi] = n1;
+            for (uint32_t s = n0; s < n1; ++s) {
+              sampler.start_pixel_sample(x, y, s);
+              const vec2 film_pos = vec2(float(x), float(y)) + sampler.get_2d();
+              const vec2 lens = sample_lens ? sampler.get_2d() : vec2(0.5f);
+              const float time = sample_time ? sampler.get_1d() : 0.f;
+              const CameraRay cr = camera.generate_ray(film_pos, lens, time);
+              const Spectrum L =
+                  integrate(scene, isettings, Ray{cr.origin, cr.direction, cr.time}, sampler, counters);
+              if (!film.add_sample(x, y, L)) ++item_nonfinite;
+              ++item_samples;
+            }
+          }
+          rays += counters.rays;
+          samples_done += item_samples;
+          if (item_nonfinite) nonfinite += item_nonfinite;
+          if (control.on_progress) {
+            std::lock_guard<std::mutex> lock(progress_mutex);
+            control.on_progress(make_progress(passes_done));
+          }
+        }
+      });
+    });
+    if (stop.load()) break;
+    first_sample = s1;
+    ++passes_done;
+    if (control.on_pass) control.on_pass(film.resolve(), make_progress(passes_done));
+  }
+
+  RenderResult result;
+  result.image = film.resolve();
+  result.variance = film.resolve_variance();
+  RenderStats& st = result.stats;
+  st.seconds = elapsed();
+  st.rays = rays.load();
+  st.camera_samples = samples_done.load();
+  st.cancelled = cancelled.load();
+  st.stopped_by_time_limit = timed_out.load();
+  st.nonfinite_samples = nonfinite.load();
+  uint32_t lo = UINT32_MAX, hi = 0;
+  double sum = 0.0;
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      const uint32_t n = film.samples(x, y);
+      lo = std::min(lo, n);
+      hi = std::max(hi, n);
+      sum += n;
+    }
+  st.spp_min = int(lo == UINT32_MAX ? 0 : lo);
+  st.spp_max = int(hi);
+  st.spp_mean = width * height > 0 ? sum / (double(width) * height) : 0.0;
+  return result;
+}
+
+}  // namespace penumbra

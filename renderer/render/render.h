@@ -1,0 +1,54 @@
+#pragma once
+// The render loop: tiles on a thread pool, progressive passes, cancellation and time budget.
+#include <atomic>
+#include <cstdint>
+#include <functional>
+
+#include "renderer/core/image.h"
+#include "renderer/scene/scene.h"
+
+namespace penumbra {
+
+struct RenderProgress {
+  double fraction = 0.0;          // 0..1 of the planned samples
+  uint64_t samples_done = 0;      // camera samples taken so far (all pixels)
+  uint64_t samples_total = 0;
+  double elapsed_seconds = 0.0;
+  double eta_seconds = 0.0;
+  int passes_done = 0;
+};
+
+struct RenderControl {
+  // Polled between tiles: set it and the render stops within about one tile's time.
+  const std::atomic<bool>* cancel = nullptr;
+  // Called from render threads (serialised) after every finished tile; keep it cheap.
+  std::function<void(const RenderProgress&)> on_progress;
+  // Called after every finished pass with the current resolved image (progressive preview).
+  std::function<void(const Image&, const RenderProgress&)> on_pass;
+};
+
+struct RenderStats {
+  double seconds = 0.0;
+  uint64_t rays = 0;             // every ray traced: camera, bounce and shadow rays
+  uint64_t camera_samples = 0;
+  int spp_min = 0;               // samples in the least-sampled pixel
+  int spp_max = 0;
+  double spp_mean = 0.0;
+  bool cancelled = false;
+  bool stopped_by_time_limit = false;
+  uint64_t nonfinite_samples = 0;  // dropped samples that evaluated to NaN/Inf (should stay 0)
+  double mrays_per_second() const { return seconds > 0 ? rays / seconds * 1e-6 : 0.0; }
+};
+
+struct RenderResult {
+  Image image;     // mean radiance per pixel
+  Image variance;  // per pixel and channel: estimated variance of that mean (sample variance / n)
+  RenderStats stats;
+};
+
+// Deterministic: for a given scene, settings and seed, the image does not depend on the number
+// of threads or the tile size.
+RenderResult render(const Scene& scene, const RenderSettings& settings,
+                    const RenderControl& control = {});
+
+}  // namespace penumbra

@@ -1,0 +1,29 @@
+#pragma once
+// Perspective camera with a thin lens (Cook, Porter & Carpenter 1984) and a shutter interval.
+#include "renderer/core/math.h"
+#include "renderer/scene/scene_input.h"
+
+namespace penumbra {
+
+struct CameraRay {
+  vec3 origin;
+  vec3 direction;  // unit
+  float time;      // normalised shutter time in [0,1]
+};
+
+class ThinLensCamera {
+ public:
+  ThinLensCamera(const CameraDesc& desc, int width, int height);
+
+  // film: continuous pixel coordinates (x right, y down, [0,w)x[0,h)); lens, time: in [0,1).
+  CameraRay generate_ray(const vec2& film, const vec2& lens, float time) const;
+
+
+ private:
+  vec3 position_, right_, up_, forward_;
+  float tan_half_fov_, aspect_;
+  float aperture_radius_, focus_distance_;
+  int width_, height_;
+};
+
+}  // namespace penumbra

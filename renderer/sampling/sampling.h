@@ -1,0 +1,66 @@
+#pragma once
+// Warps from the unit square to directions and points, with their densities.
+#include "renderer/core/math.h"
+
+namespace penumbra {
+
+// Shirley & Chiu 1997 concentric map, unit disk.
+inline vec2 square_to_disk_concentric(const vec2& u) {
+  const float ox = 2.f * u.x - 1.f, oy = 2.f * u.y - 1.f;
+  if (ox == 0.f && oy == 0.f) return vec2(0.f);
+  float r, phi;
+  if (std::abs(ox) > std::abs(oy)) {
+    r = ox;
+    phi = (kPi / 4.f) * (oy / ox);
+  } else {
+    r = oy;
+    phi = (kPi / 2.f) - (kPi / 4.f) * (ox / oy);
+  }
+  return vec2(r * std::cos(phi), r * std::sin(phi));
+}
+
+// Malley's method: cosine-weighted hemisphere around +z; pdf = cos(theta) / pi.
+inline vec3 square_to_cosine_hemisphere(const vec2& u) {
+  const vec2 d = square_to_disk_concentric(u);
+  return vec3(d.x, d.y, safe_sqrt(1.f - d.x * d.x - d.y * d.y));
+}
+inline float cosine_hemisphere_pdf(const vec3& w) { return w.z > 0.f ? w.z * kInvPi : 0.f; }
+
+inline vec3 square_to_uniform_sphere(const vec2& u) {
+  const float z = 1.f - 2.f * u.x;
+  const float r = safe_sqrt(1.f - z * z);
+  const float phi = 2.f * kPi * u.y;
+  return vec3(r * std::cos(phi), r * std::sin(phi), z);
+}
+inline constexpr float uniform_sphere_pdf() { return kInv4Pi; }
+
+// Uniform direction in the cone around +z with cos(theta) >= cos_max; pdf = 1 / (2 pi (1 - cos_max)).
+inline vec3 square_to_uniform_cone(const vec2& u, float cos_max) {
+  const float cos_t = 1.f - u.x * (1.f - cos_max);
+  const float sin_t = safe_sqrt(1.f - cos_t * cos_t);
+  const float phi = 2.f * kPi * u.y;
+  return vec3(sin_t * std::cos(phi), sin_t * std::sin(phi), cos_t);
+}
+inline float uniform_cone_pdf(float cos_max) { return 1.f / (2.f * kPi * (1.f - cos_max)); }
+
+// Uniform barycentrics (b1, b2) on a triangle: Heitz 2019, "A Low-Distortion Map Between
+// Triangle and Square".
+inline vec2 square_to_triangle(const vec2& u) {
+  float b0, b1;
+  if (u.y > u.x) {
+    b0 = u.x / 2.f;
+    b1 = u.y - b0;
+  } else {
+    b1 = u.y / 2.f;
+    b0 = u.x - b1;
+  }
+  return vec2(b0, b1);
+}
+
+// Veach's power heuristic with beta = 2 (Veach 1997, eq. 9.13).
+inline float power_heuristic(float pdf_a, float pdf_b) {
+  const float a = pdf_a * pdf_a, b = pdf_b * pdf_b;
+  return a + b > 0.f ? a / (a + b) : 0.f;
+}
+
+}  // namespace penumbra

@@ -1,0 +1,87 @@
+#pragma once
+// The renderer's input: a scene as plain data, in world space, already validated.
+// api/ produces it from JSON (applying object transforms) and places the origin at the camera
+// position, computed in double precision, so single-precision rendering keeps its accuracy for
+// scenes far from the JSON origin; tests may build it directly.
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "renderer/materials/material_params.h"
+#include "renderer/core/math.h"
+
+namespace penumbra {
+
+struct CameraDesc {
+  vec3 position{0.f, 0.f, 1.f};
+  vec3 look_at{0.f, 0.f, 0.f};
+  vec3 up{0.f, 1.f, 0.f};
+  float fov_degrees = 40.f;       // vertical field of view
+  float aperture_radius = 0.f;    // thin lens (Cook et al. 1984); 0 = pinhole
+  float focus_distance = 1.f;     // distance along the view direction that is in focus
+  float shutter_open = 0.f;       // scene time units; open == close means no motion blur
+  float shutter_close = 0.f;
+};
+
+struct SphereDesc {
+  vec3 center{0.f};
+  float radius = 1.f;
+};
+// Parallelogram origin + s*u + t*v, s,t in [0,1]; front side along cross(u, v).
+struct QuadDesc {
+  vec3 origin{0.f};
+  vec3 u{1.f, 0.f, 0.f};
+  vec3 v{0.f, 1.f, 0.f};
+};
+// Triangle mesh; counter-clockwise = front. `normals` is empty or one per position (shading).
+struct MeshDesc {
+  std::vector<vec3> positions;
+  std::vector<uint32_t> indices;  // 3 per triangle
+  std::vector<vec3> normals;
+};
+using ShapeDesc = std::variant<SphereDesc, QuadDesc, MeshDesc>;
+
+struct ObjectDesc {
+  ShapeDesc shape;
+  uint32_t material = 0;         // index into SceneInput::materials
+  Spectrum emission{0.f};        // radiance leaving the front side; 0 = not a light
+  // Rigid motion: position(t) = position(0) + velocity*t + 0.5*acceleration*t^2.
+  vec3 velocity{0.f};
+  vec3 acceleration{0.f};
+};
+
+struct PointLightDesc {
+  vec3 position{0.f};
+  Spectrum intensity{1.f};  // W/sr
+};
+struct DirectionalLightDesc {
+  vec3 direction{0.f, -1.f, 0.f};  // the direction light travels
+  Spectrum irradiance{1.f};        // W/m^2 on a surface facing the light
+};
+using LightDesc = std::variant<PointLightDesc, DirectionalLightDesc>;
+
+struct SceneInput {
+  CameraDesc camera;
+  Spectrum environment{0.f};  // constant radiance arriving from every direction at infinity
+  std::vector<MaterialParams> materials;
+  std::vector<ObjectDesc> objects;
+  std::vector<LightDesc> lights;
+};
+
+enum class IntegratorKind { kPath, kDistributed };
+
+struct RenderSettings {
+  int width = 256;
+  int height = 256;
+  int spp = 64;
+  int max_depth = 8;      // path segments from the camera, Mitsuba 3 convention; -1 = unlimited
+  int rr_depth = 5;       // Russian roulette starts at this depth (Mitsuba 3 default)
+  IntegratorKind integrator = IntegratorKind::kPath;
+  uint64_t seed = 0;
+  int threads = 0;        // 0 = all hardware threads
+  int tile_size = 16;
+  float noise_threshold = 0.f;  // adaptive sampling: stop pixels below this relative error; 0 = off
+  double time_limit = 0.0;      // seconds; 0 = none
+};
+
+}  // namespace penumbra

@@ -1,0 +1,103 @@
+#pragma once
+// Scene construction helpers for render tests (scenes built as plain SceneInput, no JSON).
+#include <cmath>
+#include <memory>
+
+#include "renderer/render/render.h"
+#include "renderer/scene/scene.h"
+#include "renderer/scene/scene_input.h"
+
+namespace penumbra::testing {
+
+inline RenderSettings small_settings(int w, int h, int spp, int max_depth = -1) {
+  RenderSettings s;
+  s.width = w;
+  s.height = h;
+  s.spp = spp;
+  s.max_depth = max_depth;
+  return s;
+}
+
+inline RenderResult render_input(const SceneInput& input, const RenderSettings& settings) {
+  const auto scene = Scene::build(input);
+  return render(*scene, settings);
+}
+
+struct ImageStats {
+  double mean[3] = {0, 0, 0};
+  double min = INFINITY, max = -INFINITY;
+  int nonfinite = 0;
+};
+
+inline ImageStats image_stats(const Image& img) {
+  ImageStats st;
+  const size_t n = size_t(img.width) * img.height;
+  for (size_t i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c) {
+      const float v = img.rgb[3 * i + c];
+      if (!std::isfinite(v)) {
+        ++st.nonfinite;
+        continue;
+      }
+      st.mean[c] += v / double(n);
+      st.min = std::min(st.min, double(v));
+      st.max = std::max(st.max, double(v));
+    }
+  return st;
+}
+
+// Mean over a rectangle of pixels of one channel, and the standard error of that mean from the
+// film's per-pixel variance estimates.
+inline void region_mean(const RenderResult& r, int x0, int y0, int x1, int y1, int c, double* mean,
+                        double* stderr_of_mean) {
+  double sum = 0.0, var = 0.0;
+  int n = 0;
+  for (int y = y0; y < y1; ++y)
+    for (int x = x0; x < x1; ++x) {
+      sum += r.image.pixel(x, y)[c];
+      var += r.variance.pixel(x, y)[c];
+      ++n;
+    }
+  *mean = sum / n;
+  *stderr_of_mean = std::sqrt(var) / n;
+}
+
+inline CameraDesc camera_looking(const vec3& from, const vec3& to, float fov, const vec3& up = {0, 1, 0}) {
+  CameraDesc c;
+  c.position = from;
+  c.look_at = to;
+  c.up = up;
+  c.fov_degrees = fov;
+  c.focus_distance = glm::length(to - from);
+  return c;
+}
+
+inline ObjectDesc quad_object(const vec3& origin, const vec3& u, const vec3& v, uint32_t material,
+                              const Spectrum& emission = Spectrum(0.f)) {
+  ObjectDesc o;
+  o.shape = QuadDesc{origin, u, v};
+  o.material = material;
+  o.emission = emission;
+  return o;
+}
+
+inline ObjectDesc sphere_object(const vec3& center, float radius, uint32_t material,
+                                const Spectrum& emission = Spectrum(0.f)) {
+  ObjectDesc o;
+  o.shape = SphereDesc{center, radius};
+  o.material = material;
+  o.emission = emission;
+  return o;
+}
+
+// White furnace: a unit sphere of `material` inside a uniform environment of radiance 1.
+inline SceneInput furnace_with_sphere(const MaterialParams& material) {
+  SceneInput in;
+  in.camera = camera_looking({0, 0, 4}, {0, 0, 0}, 30.f);
+  in.environment = Spectrum(1.f);
+  in.materials = {material};
+  in.objects = {sphere_object({0, 0, 0}, 1.f, 0)};
+  return in;
+}
+
+}  // namespace penumbra::testing

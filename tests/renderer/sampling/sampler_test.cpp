@@ -1,0 +1,93 @@
+// The Owen-scrambled Sobol sampler: values in [0,1), stratified like a (0,m,2)-net in every
+// dimension pair, independent between pixels and dimensions.
+#include <gtest/gtest.h>
+
+#include <set>
+
+#include "renderer/sampling/sampler.h"
+
+namespace penumbra {
+namespace {
+
+TEST(Sampler, ValuesAreInUnitInterval) {
+  Sampler s(3);
+  for (int i = 0; i < 4096; ++i) {
+    s.start_pixel_sample(i % 7, i % 5, uint32_t(i));
+    for (int d = 0; d < 8; ++d) {
+      const float a = s.get_1d();
+      const vec2 b = s.get_2d();
+      ASSERT_GE(a, 0.f);
+      ASSERT_LT(a, 1.f);
+      ASSERT_GE(b.x, 0.f);
+      ASSERT_LT(b.x, 1.f);
+      ASSERT_GE(b.y, 0.f);
+      ASSERT_LT(b.y, 1.f);
+    }
+  }
+}
+
+// The first 2^m samples of a 2D dimension fall one per elementary interval of every shape
+// 2^-k x 2^-(m-k): the property that makes it beat independent random numbers.
+TEST(Sampler, TwoDimensionalSamplesFormANet) {
+  constexpr int m = 8, n = 1 << m;
+  for (int dim_pair = 0; dim_pair < 4; ++dim_pair) {
+    std::vector<vec2> pts;
+    Sampler s(11);
+    for (int i = 0; i < n; ++i) {
+      s.start_pixel_sample(5, 9, uint32_t(i));
+      vec2 p;
+      for (int d = 0; d <= dim_pair; ++d) p = s.get_2d();
+      pts.push_back(p);
+    }
+    for (int k = 0; k <= m; ++k) {
+      std::set<std::pair<int, int>> cells;
+      for (const vec2& p : pts) cells.insert({int(p.x * (1 << k)), int(p.y * (1 << (m - k)))});
+      EXPECT_EQ(int(cells.size()), n) << "dimension pair " << dim_pair << ", k " << k;
+    }
+  }
+}
+
+TEST(Sampler, OneDimensionalSamplesAreStratified) {
+  constexpr int n = 64;
+  Sampler s(5);
+  std::set<int> strata;
+  for (int i = 0; i < n; ++i) {
+    s.start_pixel_sample(1, 2, uint32_t(i));
+    strata.insert(int(s.get_1d() * n));
+  }
+  EXPECT_EQ(int(strata.size()), n);
+}
+
+TEST(Sampler, PixelsAndDimensionsAreDecorrelated) {
+  Sampler s(0);
+  s.start_pixel_sample(0, 0, 0);
+  const vec2 a = s.get_2d(), b = s.get_2d();
+  s.start_pixel_sample(1, 0, 0);
+  const vec2 c = s.get_2d();
+  EXPECT_NE(a, b);
+  EXPECT_NE(a, c);
+  // Mean of many pixels' first sample is 1/2 (scrambles are uniform).
+  double sum = 0.0;
+  for (int x = 0; x < 4096; ++x) {
+    s.start_pixel_sample(x, 3, 0);
+    sum += s.get_1d();
+  }
+  EXPECT_NEAR(sum / 4096.0, 0.5, 0.015);
+}
+
+}  // namespace
+}  // namespace penumbra
+
+namespace penumbra {
+namespace {
+TEST(Sampler, TableDrivenSobolMatchesBitLoop) {
+  uint32_t x = 12345;
+  for (int i = 0; i < 100000; ++i) {
+    x = x * 1664525u + 1013904223u;
+    ASSERT_EQ(sobol_dimension1(x), sobol_dimension1_reference(x)) << x;
+  }
+  EXPECT_EQ(nested_uniform_scramble(sobol_dimension0(77u), 991u),
+            reverse_bits32(laine_karras_permutation(77u, 991u)));
+}
+}  // namespace
+}  // namespace penumbra
