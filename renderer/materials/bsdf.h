@@ -50,4 +50,12 @@ struct BsdfSample {
   float eta = 1.f;   // relative ior crossed along wo (1 for reflection), for Russian roulette
 };
 
+// The capability answers shared by every opaque model (all but the dielectric): two-sided, no
+// interior to absorb in. A model class answers two_sided() and absorption() itself or inherits
+// these; Material and the scene build ask the model, never its type.
+struct OpaqueBsdf {
+  static constexpr bool two_sided() { return true; }
+  Spectrum absorption() const { return Spectrum(0.f); }
+};
+
 }  // namespace penumbra

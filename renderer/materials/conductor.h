@@ -9,7 +9,7 @@
 namespace penumbra {
 
 // Front-side model (wi.z > 0); Material mirrors back-side queries to the front.
-class ConductorBsdf {
+class ConductorBsdf : public OpaqueBsdf {
  public:
   explicit ConductorBsdf(const ConductorParams& params);
 

@@ -12,6 +12,7 @@ constexpr float kIndexMatchedTolerance = 1e-4f;
 
 DielectricBsdf::DielectricBsdf(const DielectricParams& params)
     : eta_(params.ior),
+      absorption_(params.absorption),
       index_matched_(std::abs(params.ior - 1.f) < kIndexMatchedTolerance),
       smooth_(roughness_to_alpha(params.roughness) < kMinMicrofacetAlpha),
       distr_(roughness_to_alpha(params.roughness)) {}

@@ -17,6 +17,10 @@ class DielectricBsdf {
   // Index-matched (ior == 1): the interface is invisible, a Dirac transmission of weight 1.
   bool index_matched() const { return index_matched_; }
   bool smooth() const { return smooth_; }
+  // Oriented: +z is the outside, so the back is the inside, not a mirrored front.
+  static constexpr bool two_sided() { return false; }
+  // Beer-Lambert sigma_a of the interior; the integrator applies it along segments inside.
+  Spectrum absorption() const { return absorption_; }
   uint32_t lobes() const;
   Spectrum eval(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
   float pdf(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
@@ -33,6 +37,7 @@ class DielectricBsdf {
   bool half_vector(const vec3& wi, const vec3& wo, vec3& m, float& eta, bool& is_reflection) const;
 
   float eta_;  // interior / exterior
+  Spectrum absorption_;
   bool index_matched_;
   bool smooth_;
   GgxDistribution distr_;

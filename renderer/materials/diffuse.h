@@ -6,7 +6,7 @@
 namespace penumbra {
 
 // Front-side model (wi.z > 0); Material mirrors back-side queries to the front.
-class DiffuseBsdf {
+class DiffuseBsdf : public OpaqueBsdf {
  public:
   explicit DiffuseBsdf(const DiffuseParams& params) : color_(params.color) {}
 

@@ -38,9 +38,11 @@ struct Material::Impl {
   bool two_sided;
 };
 
-Material::Material(const MaterialParams& params)
-    : impl_(std::make_unique<Impl>(Impl{params, make_model(params),
-                                        !std::holds_alternative<DielectricParams>(params)})) {}
+Material::Material(const MaterialParams& params) {
+  BsdfModel model = make_model(params);
+  const bool two_sided = std::visit([](const auto& m) { return m.two_sided(); }, model);
+  impl_ = std::make_unique<Impl>(Impl{params, std::move(model), two_sided});
+}
 Material::~Material() = default;
 Material::Material(Material&&) noexcept = default;
 Material& Material::operator=(Material&&) noexcept = default;
@@ -76,9 +78,10 @@ uint32_t Material::lobes() const {
 }
 
 Spectrum Material::absorption() const {
-  if (const auto* d = std::get_if<DielectricParams>(&impl_->params)) return d->absorption;
-  return Spectrum(0.f);
+  return std::visit([](const auto& m) { return m.absorption(); }, impl_->model);
 }
+
+bool Material::two_sided() const { return impl_->two_sided; }
 
 const MaterialParams& Material::params() const { return impl_->params; }
 

@@ -25,8 +25,11 @@ class Material {
 
   uint32_t lobes() const;  // union of BsdfLobe bits this material can produce
   bool has_transmission() const { return (lobes() & kLobeTransmission) != 0; }
-  // Beer-Lambert sigma_a of the interior, zero for everything but an absorbing dielectric.
+  // Opaque models are two-sided (the back behaves as the front); oriented ones are not.
+  bool two_sided() const;
+  // Beer-Lambert sigma_a of the interior, zero for everything that does not absorb inside.
   Spectrum absorption() const;
+  bool has_absorption() const { return !is_black(absorption()); }
   const MaterialParams& params() const;
 
  private:

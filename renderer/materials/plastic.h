@@ -19,7 +19,7 @@
 namespace penumbra {
 
 // Front-side model (wi.z > 0); Material mirrors back-side queries to the front.
-class PlasticBsdf {
+class PlasticBsdf : public OpaqueBsdf {
  public:
   // Table resolution of the rough transmittance over cos(theta) in [0, 1] (Mitsuba uses 64) for
   // ior >= 1; below ior 1 the nodes are placed adaptively and twice as many are used. The nodes

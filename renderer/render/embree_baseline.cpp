@@ -1,5 +1,7 @@
 #include "renderer/render/embree_baseline.h"
 
+#include <embree3/rtcore.h>
+
 #include <tbb/blocked_range2d.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
@@ -10,24 +12,21 @@
 #include "renderer/core/frame.h"
 #include "renderer/sampling/sampler.h"
 #include "renderer/sampling/sampling.h"
-#include "renderer/scene/scene_impl.h"
+#include "renderer/lights/area_light.h"
 #include "renderer/render/thin_lens_camera.h"
 
 namespace penumbra {
 
-BaselineResult trace_embree_baseline(const Scene& scene_handle, const RenderSettings& settings) {
-  const SceneImpl& scene = scene_handle.impl();
-  const ThinLensCamera camera(scene.camera, settings.width, settings.height);
+BaselineResult trace_embree_baseline(const Scene& scene, const RenderSettings& settings) {
+  const ThinLensCamera camera(scene.camera(), settings.width, settings.height);
   const int max_depth = settings.max_depth < 0 ? 64 : settings.max_depth;
   // Shadow-ray targets: the emitters' centres (or a point above the scene if there are none).
   std::vector<vec3> targets;
-  for (const ObjectRecord& obj : scene.objects) {
-    if (obj.light < 0) continue;
-    if (obj.kind == ObjectRecord::Kind::kSphere) targets.push_back(obj.center);
-    else if (obj.is_quad) targets.push_back(obj.quad.origin + 0.5f * (obj.quad.u + obj.quad.v));
-    else targets.push_back(obj.positions[obj.indices[0]]);
-  }
-  if (targets.empty()) targets.push_back(scene.bounds_max + (scene.bounds_max - scene.bounds_min));
+  for (uint32_t i = 0; i < scene.object_count(); ++i)
+    if (const AreaLight* light = scene.object(i).area_light)
+      targets.push_back(light->shape().reference_point());
+  const Bounds3& bounds = scene.bounds();
+  if (targets.empty()) targets.push_back(bounds.hi + (bounds.hi - bounds.lo));
 
   std::atomic<uint64_t> total_rays{0};
   const auto start = std::chrono::steady_clock::now();
@@ -55,7 +54,7 @@ BaselineResult trace_embree_baseline(const Scene& scene_handle, const RenderSett
                   rh.ray.mask = 0xFFFFFFFFu;
                   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
                   ++rays;
-                  rtcIntersect1(scene.rtc_scene, &ctx, &rh);
+                  rtcIntersect1(scene.embree_scene(), &ctx, &rh);
                   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID || depth == max_depth) break;
                   const vec3 p = org + dir * rh.ray.tfar;
                   vec3 n = glm::normalize(vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z));
@@ -71,7 +70,7 @@ BaselineResult trace_embree_baseline(const Scene& scene_handle, const RenderSett
                   shadow.tfar = dist * 0.999f;
                   shadow.mask = 0xFFFFFFFFu;
                   ++rays;
-                  rtcOccluded1(scene.rtc_scene, &ctx, &shadow);
+                  rtcOccluded1(scene.embree_scene(), &ctx, &shadow);
                   org = origin;
                   dir = glm::normalize(Frame(n).to_world(square_to_cosine_hemisphere(sampler.get_2d())));
                 }

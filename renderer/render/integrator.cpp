@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "renderer/core/frame.h"
+#include "renderer/lights/area_light.h"
 #include "renderer/sampling/sampling.h"
 
 namespace penumbra {
@@ -33,7 +34,7 @@ enum IntegratorFeature : uint32_t {
 };
 
 template <bool kDistributed, uint32_t kFeatures>
-Spectrum integrate(const SceneImpl& scene, const IntegratorSettings& settings, Ray ray,
+Spectrum integrate(const Scene& scene, const IntegratorSettings& settings, Ray ray,
                    Sampler& sampler, PathCounters& counters) {
   Spectrum radiance(0.f), beta(1.f);
   const int max_depth = settings.max_depth < 0 ? INT_MAX : settings.max_depth;
@@ -42,7 +43,8 @@ Spectrum integrate(const SceneImpl& scene, const IntegratorSettings& settings, R
   bool prev_delta = true;
   vec3 prev_p = ray.origin;
   float eta = 1.f;
-  const LightSampler& lights = scene.lights;
+  const LightSampler& lights = scene.light_sampler();
+  const EnvironmentLight* environment = scene.environment();
   constexpr uint32_t kContinueLobes = kDistributed ? uint32_t(kLobeNonDiffuse) : uint32_t(kLobeAll);
 
   for (int depth = 1;; ++depth) {
@@ -50,28 +52,32 @@ Spectrum integrate(const SceneImpl& scene, const IntegratorSettings& settings, R
     ++counters.rays;
     if (!scene.intersect(ray, &hit)) {
       if constexpr ((kFeatures & kFeatureEnvironment) != 0) {
-        if (!scene.features.environment) break;
-        const float w = prev_delta ? 1.f : power_heuristic(prev_pdf, lights.environment_pdf());
-        radiance += beta * scene.environment * w;
+        if (!environment) break;
+        const float w =
+            prev_delta ? 1.f
+                       : power_heuristic(prev_pdf, lights.pmf(scene.environment_light()) *
+                                                       environment->pdf(ray.direction));
+        radiance += beta * environment->radiance(ray.direction) * w;
       }
       break;
     }
-    const ObjectRecord& obj = scene.objects[hit.object];
-    const Material& material = scene.materials[obj.material];
+    const SceneObject& obj = scene.object(hit.object);
+    const Material& material = scene.material(obj.material);
     const bool front = glm::dot(ray.direction, hit.ng) < 0.f;
 
     // Beer-Lambert: a segment that ends on the back of an absorbing dielectric ran inside it.
     if constexpr ((kFeatures & kFeatureAbsorption) != 0) {
-      if (scene.features.absorption && !front) {
+      if (scene.features().absorption && !front) {
         const Spectrum sigma = material.absorption();
         if (!is_black(sigma)) beta *= glm::exp(-sigma * hit.t);
       }
     }
-    if (obj.light >= 0 && front) {
+    if (obj.area_light && front) {
       float w = 1.f;
       if (!prev_delta)
-        w = power_heuristic(prev_pdf, lights.area_pdf(scene, obj.light, prev_p, hit.p, hit.ng, ray.time));
-      radiance += beta * obj.emission * w;
+        w = power_heuristic(prev_pdf, lights.pmf(obj.light) * obj.area_light->pdf(prev_p, hit.p, hit.ng,
+                                                                                  ray.time));
+      radiance += beta * obj.area_light->radiance() * w;
     }
     if (depth >= max_depth) break;
 
@@ -85,7 +91,9 @@ Spectrum integrate(const SceneImpl& scene, const IntegratorSettings& settings, R
       const float u_light = sampler.get_1d();
       const vec2 u_point = sampler.get_2d();
       LightSample ls;
-      if (lights.sample(scene, hit.p, ray.time, u_light, u_point, &ls)) {
+      const int light = lights.choose(u_light);
+      if (scene.light(light).sample(hit.p, ray.time, u_point, &ls)) {
+        ls.pdf *= lights.pmf(light);
         const vec3 wo = frame.to_local(ls.wi);
         if (geometry_agrees(wi_world, ls.wi, hit.ng, wi, wo)) {
           Spectrum f;
@@ -170,7 +178,7 @@ uint32_t integrator_feature_mask(const SceneFeatures& f) {
   // An absorbing material is a dielectric, so absorption implies transmission.
   if (f.transmission) mask |= kFeatureTransmission;
   if (f.environment) mask |= kFeatureEnvironment;
-  if (f.area_lights || f.point_lights || f.directional_lights || f.environment) mask |= kFeatureLights;
+  if (f.lights) mask |= kFeatureLights;
   return mask;
 }
 

@@ -9,7 +9,7 @@
 #include "renderer/core/math.h"
 #include "renderer/core/ray.h"
 #include "renderer/sampling/sampler.h"
-#include "renderer/scene/scene_impl.h"
+#include "renderer/scene/scene.h"
 
 namespace penumbra {
 
@@ -22,7 +22,7 @@ struct PathCounters {
   uint64_t rays = 0;
 };
 
-using IntegrateFn = Spectrum (*)(const SceneImpl& scene, const IntegratorSettings& settings,
+using IntegrateFn = Spectrum (*)(const Scene& scene, const IntegratorSettings& settings,
                                  Ray ray, Sampler& sampler, PathCounters& counters);
 
 // The integrator specialised on the features the scene uses (chosen once per render): code for

@@ -10,7 +10,6 @@
 #include "renderer/render/adaptive_sampling.h"
 #include "renderer/render/film.h"
 #include "renderer/render/integrator.h"
-#include "renderer/scene/scene_impl.h"
 #include "renderer/render/thin_lens_camera.h"
 
 namespace penumbra {
@@ -88,16 +87,15 @@ void update_limits(const Film& film, const AdaptiveLimits& limits, std::vector<u
 
 }  // namespace
 
-RenderResult render(const Scene& scene_handle, const RenderSettings& settings,
+RenderResult render(const Scene& scene, const RenderSettings& settings,
                     const RenderControl& control) {
-  const SceneImpl& scene = scene_handle.impl();
   const auto start = Clock::now();
   const int width = settings.width, height = settings.height;
-  const ThinLensCamera camera(scene.camera, width, height);
-  const IntegrateFn integrate = select_integrator(settings.integrator, scene.features);
+  const ThinLensCamera camera(scene.camera(), width, height);
+  const IntegrateFn integrate = select_integrator(settings.integrator, scene.features());
   const IntegratorSettings isettings{settings.max_depth, settings.rr_depth};
-  const bool sample_lens = scene.features.lens;
-  const bool sample_time = scene.features.motion;
+  const bool sample_lens = scene.features().lens;
+  const bool sample_time = scene.features().motion;
 
   Film film(width, height);
   const PixelOrder order = make_pixel_order(width, height, std::max(1, settings.tile_size));

@@ -1,30 +1,73 @@
 #pragma once
-// The render scene: built once from a SceneInput (Embree BVH, lights, materials), then immutable
-// and shared const by every render thread.
+// The render scene: built once from a SceneInput (shapes, materials, lights, Embree BVH), then
+// immutable and shared const by every render thread. Integrators see it only through these
+// const queries.
 #include <memory>
-#include <stdexcept>
+#include <vector>
 
+#include "renderer/core/bounds.h"
+#include "renderer/core/errors.h"
+#include "renderer/core/ray.h"
+#include "renderer/lights/environment_light.h"
+#include "renderer/lights/light_sampler.h"
+#include "renderer/materials/material.h"
+#include "renderer/scene/scene_features.h"
 #include "renderer/scene/scene_input.h"
+#include "renderer/scene/scene_object.h"
+
+struct RTCSceneTy;  // Embree's scene handle
 
 namespace penumbra {
 
-struct SceneBuildError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-
-class SceneImpl;  // renderer-internal
+class Shape;
+class Light;
 
 class Scene {
  public:
   // Throws SceneBuildError (e.g. an Embree failure). Input is assumed validated.
   static std::unique_ptr<Scene> build(const SceneInput& input);
   ~Scene();
+  Scene(const Scene&) = delete;
+  Scene& operator=(const Scene&) = delete;
 
-  const SceneImpl& impl() const { return *impl_; }
+  // Nearest surface along the ray (t in (0, ray.t_max)), with its geometry rebuilt by its shape.
+  bool intersect(const Ray& ray, SurfaceHit* hit) const;
+  // Whether anything blocks origin + t*dir for t in (0, t_max) at normalised time `time`.
+  bool occluded(const vec3& origin, const vec3& dir, float t_max, float time) const;
+
+  const CameraDesc& camera() const { return camera_; }
+  const SceneFeatures& features() const { return features_; }
+  // World bounds of every object over the shutter (empty scene: a point at the origin).
+  const Bounds3& bounds() const { return bounds_; }
+
+  size_t object_count() const { return objects_.size(); }
+  const SceneObject& object(uint32_t id) const { return objects_[id]; }
+  const Material& material(uint32_t index) const { return materials_[index]; }
+
+  const LightSampler& light_sampler() const { return light_sampler_; }
+  const Light& light(int index) const { return *lights_[size_t(index)]; }
+  // The environment (nullptr if rays that escape see black) and its index among the lights.
+  const EnvironmentLight* environment() const { return environment_; }
+  int environment_light() const { return environment_light_; }
+
+  // The Embree scene, for the Embree-only benchmark (render/embree_baseline.cpp).
+  RTCSceneTy* embree_scene() const { return rtc_scene_; }
 
  private:
-  explicit Scene(std::unique_ptr<SceneImpl> impl);
-  std::unique_ptr<SceneImpl> impl_;
+  friend class SceneBuilder;
+  Scene() = default;
+
+  CameraDesc camera_;
+  SceneFeatures features_;
+  Bounds3 bounds_;
+  std::vector<Material> materials_;
+  std::vector<std::unique_ptr<Shape>> shapes_;
+  std::vector<SceneObject> objects_;  // index = Embree geometry id
+  std::vector<std::unique_ptr<Light>> lights_;
+  LightSampler light_sampler_;
+  const EnvironmentLight* environment_ = nullptr;
+  int environment_light_ = -1;
+  RTCSceneTy* rtc_scene_ = nullptr;  // owned; released before the shapes it points into
 };
 
 }  // namespace penumbra

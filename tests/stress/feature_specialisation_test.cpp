@@ -7,7 +7,7 @@
 
 #include "renderer/render/integrator.h"
 #include "renderer/sampling/sampler.h"
-#include "renderer/scene/scene_impl.h"
+#include "renderer/scene/scene.h"
 #include "renderer/render/thin_lens_camera.h"
 #include "tests/stress/stress_util.h"
 
@@ -16,9 +16,8 @@ namespace {
 
 // The render loop of renderer/render.cpp (same sampler dimensions, same accumulation order and
 // precision), with the generic integrator.
-Image render_generic(const Scene& scene_handle, const RenderSettings& s) {
-  const SceneImpl& scene = scene_handle.impl();
-  const ThinLensCamera camera(scene.camera, s.width, s.height);
+Image render_generic(const Scene& scene, const RenderSettings& s) {
+  const ThinLensCamera camera(scene.camera(), s.width, s.height);
   const IntegrateFn integrate = select_generic_integrator(s.integrator);
   const IntegratorSettings is{s.max_depth, s.rr_depth};
   Image img(s.width, s.height);
@@ -31,8 +30,8 @@ Image render_generic(const Scene& scene_handle, const RenderSettings& s) {
       for (int i = 0; i < s.spp; ++i) {
         sampler.start_pixel_sample(x, y, uint32_t(i));
         const vec2 film = vec2(float(x), float(y)) + sampler.get_2d();
-        const vec2 lens = scene.features.lens ? sampler.get_2d() : vec2(0.5f);
-        const float time = scene.features.motion ? sampler.get_1d() : 0.f;
+        const vec2 lens = scene.features().lens ? sampler.get_2d() : vec2(0.5f);
+        const float time = scene.features().motion ? sampler.get_1d() : 0.f;
         const CameraRay cr = camera.generate_ray(film, lens, time);
         const Spectrum L = integrate(scene, is, Ray{cr.origin, cr.direction, cr.time}, sampler, counters);
         if (!is_finite(L)) continue;
@@ -107,10 +106,10 @@ TEST(FeatureSpecialisation, BitIdenticalToGenericIntegrator) {
       ASSERT_EQ(specialised.image.rgb.size(), generic.rgb.size());
       EXPECT_EQ(std::memcmp(specialised.image.rgb.data(), generic.rgb.data(), generic.rgb.size() * sizeof(float)), 0)
           << fs.name << (kind == IntegratorKind::kPath ? " path" : " distributed");
-      masks.push_back(integrator_feature_mask(scene->impl().features));
+      masks.push_back(integrator_feature_mask(scene->features()));
       const uint32_t all = integrator_feature_mask(
-          SceneFeatures{true, true, true, true, true, true, true, true, true, true});
-      EXPECT_EQ(select_integrator(kind, scene->impl().features) == select_generic_integrator(kind),
+          SceneFeatures{true, true, true, true, true, true});
+      EXPECT_EQ(select_integrator(kind, scene->features()) == select_generic_integrator(kind),
                 masks.back() == all)
           << fs.name;
     }
@@ -138,9 +137,9 @@ TEST(FeatureSpecialisation, ZeroVelocityAndApertureCountAsAbsent) {
   const api::LoadResult a = api::load_scene(plain), b = api::load_scene(zeros);
   ASSERT_TRUE(a.ok() && b.ok()) << (b.errors.empty() ? "" : b.errors[0].to_string());
   const auto sa = Scene::build(a.request->scene), sb = Scene::build(b.request->scene);
-  EXPECT_FALSE(sb->impl().features.motion);
-  EXPECT_FALSE(sb->impl().features.lens);
-  EXPECT_EQ(integrator_feature_mask(sa->impl().features), integrator_feature_mask(sb->impl().features));
+  EXPECT_FALSE(sb->features().motion);
+  EXPECT_FALSE(sb->features().lens);
+  EXPECT_EQ(integrator_feature_mask(sa->features()), integrator_feature_mask(sb->features()));
   EXPECT_EQ(render(*sa, a.request->settings).image.rgb, render(*sb, b.request->settings).image.rgb);
 }
 

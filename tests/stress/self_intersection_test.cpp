@@ -13,7 +13,7 @@
 
 #include "renderer/core/frame.h"
 #include "renderer/sampling/sampling.h"
-#include "renderer/scene/scene_impl.h"
+#include "renderer/scene/scene.h"
 #include "renderer/render/thin_lens_camera.h"
 #include "tests/stress/stress_util.h"
 
@@ -84,7 +84,7 @@ struct PointCounts {
 PointCounts fire_rays(Shape shape, const Placement& p) {
   const SceneInput in = convex_object(shape, p);
   const auto scene = Scene::build(in);
-  const SceneImpl& s = scene->impl();
+  const Scene& s = *scene;
   std::mt19937 rng(11);
   std::uniform_real_distribution<float> u01(0.f, 0.99999994f);
   PointCounts c;
@@ -181,7 +181,7 @@ TEST(LargeTriangleNearOrigin, SpawnedRaysNeverReHitTheirSurface) {
     o.shape = m;
     in.objects = {o};
     const auto scene = Scene::build(in);
-    const SceneImpl& s = scene->impl();
+    const Scene& s = *scene;
     const vec3 n = glm::normalize(glm::cross(u, w));
     std::mt19937 rng(3);
     std::uniform_real_distribution<float> u01(0.f, 0.99999994f);
@@ -404,7 +404,7 @@ TEST(LightLeak, ShadowRaysNeverSlipThroughBoxEdges) {
     in.materials = {DiffuseParams{Spectrum(0.8f)}};
     in.objects = {box(-vec3(s), vec3(s), 0)};
     const auto scene = Scene::build(in);
-    const SceneImpl& impl = scene->impl();
+    const Scene& impl = *scene;
     const vec3 light = vec3(1.f - 1e-4f) * s;
     std::mt19937 rng(1);
     std::uniform_real_distribution<float> u(-1.f, 1.f);

@@ -7,7 +7,7 @@
 
 #include "renderer/core/frame.h"
 #include "renderer/sampling/sampling.h"
-#include "renderer/scene/scene_impl.h"
+#include "renderer/scene/scene.h"
 #include "tests/renderer/render/render_test_util.h"
 
 namespace penumbra::testing {
@@ -43,7 +43,7 @@ SceneInput one_object(const Case& c, const ShapeDesc& shape) {
 // For spheres, also spawns rays into the surface and checks they reach the far side.
 void check_no_self_hits(const SceneInput& in, float scale, const vec3& center, bool sphere) {
   const auto scene = Scene::build(in);
-  const SceneImpl& s = scene->impl();
+  const Scene& s = *scene;
   std::mt19937 rng(7);
   std::uniform_real_distribution<float> u01(0.f, 0.99999994f);
   int hits = 0, self_hits = 0, lost_exits = 0;

@@ -1,0 +1,33 @@
+#pragma once
+// Light arriving from infinitely far away in every direction: what a ray that leaves the scene
+// sees. Rays that escape ask radiance(); next-event estimation samples it.
+#include "renderer/lights/light.h"
+
+namespace penumbra {
+
+class EnvironmentLight : public Light {
+ public:
+  // Radiance arriving along -dir (dir points from the scene towards the sky).
+  virtual Spectrum radiance(const vec3& dir) const = 0;
+  // Solid-angle density with which sample() picks dir.
+  virtual float pdf(const vec3& dir) const = 0;
+};
+
+// The same radiance from every direction, sampled uniformly over the sphere.
+class ConstantEnvironment final : public EnvironmentLight {
+ public:
+  explicit ConstantEnvironment(const Spectrum& radiance) : radiance_(radiance) {}
+
+  bool sample(const vec3& ref, float time, const vec2& u, LightSample* out) const override;
+  // Radiance L over the sphere of directions onto the scene's bounding disc: L 4 pi * pi r^2.
+  float power(float scene_radius) const override {
+    return luminance(radiance_) * 4.f * kPi * kPi * (scene_radius * scene_radius);
+  }
+  Spectrum radiance(const vec3&) const override { return radiance_; }
+  float pdf(const vec3& dir) const override;
+
+ private:
+  Spectrum radiance_;
+};
+
+}  // namespace penumbra

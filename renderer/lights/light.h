@@ -1,0 +1,30 @@
+#pragma once
+// What every light answers for next-event estimation. Lights are chosen by the LightSampler;
+// each kind samples itself (an area light through the shape it holds).
+//
+// Adding a light: a file pair here (a class deriving from Light), its input struct in
+// scene/scene_input.h, one line in lights/make_light.cpp, and its tests (docs/architecture.md).
+#include "renderer/core/math.h"
+
+namespace penumbra {
+
+struct LightSample {
+  vec3 wi;                  // unit direction from the reference point towards the light
+  float distance = kInfinity;
+  Spectrum value{0.f};      // radiance arriving along -wi (point: I/d^2; directional: E)
+  float pdf = 0.f;          // solid-angle pdf; for delta lights 1. Excludes the light's choice.
+  bool is_delta = false;
+  vec3 p{0.f}, p_error{0.f}, n{0.f};  // the point on an area light, for the shadow ray's far end
+};
+
+class Light {
+ public:
+  virtual ~Light() = default;
+
+  // Samples light arriving at `ref` at normalised shutter time `time`; false if none arrives.
+  virtual bool sample(const vec3& ref, float time, const vec2& u, LightSample* out) const = 0;
+  // An estimate of the emitted power (luminance), from which the light sampler chooses.
+  virtual float power(float scene_radius) const = 0;
+};
+
+}  // namespace penumbra

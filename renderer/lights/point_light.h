@@ -1,0 +1,20 @@
+#pragma once
+// An isotropic point light of intensity I (W/sr): irradiance I cos / d^2.
+#include "renderer/lights/light.h"
+
+namespace penumbra {
+
+class PointLight final : public Light {
+ public:
+  PointLight(const vec3& position, const Spectrum& intensity)
+      : position_(position), intensity_(intensity) {}
+
+  bool sample(const vec3& ref, float time, const vec2& u, LightSample* out) const override;
+  float power(float) const override { return 4.f * kPi * luminance(intensity_); }
+
+ private:
+  vec3 position_;
+  Spectrum intensity_;
+};
+
+}  // namespace penumbra

@@ -1,0 +1,132 @@
+// Scene::build as a sequence of named steps. Everything a step creates is owned by the Scene
+// under construction or by an RAII handle, so a step that throws leaks nothing.
+#include <embree3/rtcore.h>
+
+#include "renderer/embree/device.h"
+#include "renderer/embree/handles.h"
+#include "renderer/lights/area_light.h"
+#include "renderer/lights/make_light.h"
+#include "renderer/scene/scene.h"
+#include "renderer/shapes/make_shape.h"
+
+namespace penumbra {
+
+class SceneBuilder {
+ public:
+  SceneBuilder(const SceneInput& input, Scene& scene) : in_(input), s_(scene) {}
+
+  void camera_and_shutter() {
+    s_.camera_ = in_.camera;
+    shutter_open_ = in_.camera.shutter_open;
+    shutter_span_ = std::max(0.f, in_.camera.shutter_close - in_.camera.shutter_open);
+    s_.features_.lens = in_.camera.aperture_radius > 0.f;
+  }
+
+  // Materials answer for themselves what the integrator must be compiled for.
+  void materials() {
+    s_.materials_.reserve(in_.materials.size());
+    for (const MaterialParams& params : in_.materials) {
+      const Material& m = s_.materials_.emplace_back(params);
+      if (m.has_transmission()) s_.features_.transmission = true;
+      if (m.has_absorption()) s_.features_.absorption = true;
+    }
+  }
+
+  void shapes() {
+    s_.shapes_.reserve(in_.objects.size());
+    s_.objects_.resize(in_.objects.size());
+    for (size_t i = 0; i < in_.objects.size(); ++i) {
+      const ObjectDesc& desc = in_.objects[i];
+      ShapeContext ctx;
+      ctx.motion = ShapeMotion{Motion{desc.velocity, desc.acceleration}, shutter_open_, shutter_span_};
+      // Without a shutter interval there is no blur: bake the place at the shutter time in.
+      if (shutter_span_ <= 0.f) {
+        ctx.offset = ctx.motion.motion.displacement(shutter_open_);
+        ctx.motion.motion = Motion{};
+      }
+      if (!ctx.motion.is_static()) s_.features_.motion = true;
+      ctx.camera_position = in_.camera.position;
+      ctx.emissive = !is_black(desc.emission);
+      s_.shapes_.push_back(make_shape(desc.shape, ctx));
+      s_.objects_[i].shape = s_.shapes_.back().get();
+      s_.objects_[i].material = desc.material;
+    }
+  }
+
+  void bounds() {
+    Bounds3 b;
+    for (const auto& shape : s_.shapes_) b.extend(shape->bounds());
+    if (s_.shapes_.empty()) b = Bounds3{vec3(0.f), vec3(0.f)};
+    s_.bounds_ = b;
+  }
+
+  // Area lights (in object order), then the scene's lights, then the environment: the order
+  // fixes light indices and so the sampler's choices.
+  void lights() {
+    for (size_t i = 0; i < in_.objects.size(); ++i) {
+      const Shape& shape = *s_.shapes_[i];
+      if (is_black(in_.objects[i].emission) || shape.area() <= 0.f) continue;
+      auto light = std::make_unique<AreaLight>(shape, in_.objects[i].emission);
+      s_.objects_[i].area_light = light.get();
+      s_.objects_[i].light = int(s_.lights_.size());
+      s_.lights_.push_back(std::move(light));
+    }
+    for (const LightDesc& desc : in_.lights)
+      if (auto light = make_light(desc)) s_.lights_.push_back(std::move(light));
+    if (!is_black(in_.environment)) {
+      auto env = std::make_unique<ConstantEnvironment>(in_.environment);
+      s_.environment_ = env.get();
+      s_.environment_light_ = int(s_.lights_.size());
+      s_.lights_.push_back(std::move(env));
+      s_.features_.environment = true;
+    }
+    s_.features_.lights = !s_.lights_.empty();
+    const float radius = std::max(0.5f * glm::length(s_.bounds_.hi - s_.bounds_.lo), 1e-6f);
+    std::vector<float> powers;
+    powers.reserve(s_.lights_.size());
+    for (const auto& light : s_.lights_) powers.push_back(light->power(radius));
+    s_.light_sampler_ = LightSampler(powers);
+  }
+
+  void embree_scene() {
+    RTCDevice device = embree_device();
+    EmbreeErrorScope errors;
+    EmbreeScene scene(rtcNewScene(device));
+    if (!scene) throw SceneBuildError("Embree could not create a scene: " + errors.first_error());
+    rtcSetSceneBuildQuality(scene.get(), RTC_BUILD_QUALITY_HIGH);
+    // Watertight triangle tests (shapes/triangle_mesh.cpp filters their hits so rays do not
+    // re-hit the surface they leave). The Embree-only benchmark traces this same scene, so it
+    // pays for both too.
+    rtcSetSceneFlags(scene.get(), RTC_SCENE_FLAG_ROBUST);
+    for (size_t i = 0; i < s_.shapes_.size(); ++i) {
+      const EmbreeGeometry geom = s_.shapes_[i]->make_geometry(device);
+      if (!geom)
+        throw SceneBuildError("Embree could not create the geometry of object " + std::to_string(i) +
+                              ": " + errors.first_error());
+      rtcAttachGeometryByID(scene.get(), geom.get(), unsigned(i));
+    }
+    rtcCommitScene(scene.get());
+    const std::string error = errors.first_error();
+    if (!error.empty()) throw SceneBuildError(error);
+    s_.rtc_scene_ = scene.release();
+  }
+
+ private:
+  const SceneInput& in_;
+  Scene& s_;
+  float shutter_open_ = 0.f, shutter_span_ = 0.f;
+};
+
+std::unique_ptr<Scene> Scene::build(const SceneInput& input) {
+  std::unique_ptr<Scene> scene(new Scene());
+  SceneBuilder b(input, *scene);
+  b.camera_and_shutter();
+  b.materials();
+  b.shapes();
+  b.bounds();
+  b.lights();
+  b.embree_scene();
+  return scene;
+}
+
+}  // namespace penumbra

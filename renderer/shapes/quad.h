@@ -1,0 +1,19 @@
+#pragma once
+// A parallelogram origin + s*u + t*v (s, t in [0, 1]), front side along cross(u, v): traced as
+// two triangles, sampled uniformly over (s, t) as a light.
+#include "renderer/shapes/triangle_mesh.h"
+
+namespace penumbra {
+
+class Quad final : public TriangleMesh {
+ public:
+  Quad(const QuadDesc& desc, const ShapeContext& ctx);
+
+  bool sample(const vec3& ref, float time, const vec2& u, ShapeSample* out) const override;
+  vec3 reference_point() const override { return quad_.origin + 0.5f * (quad_.u + quad_.v); }
+
+ private:
+  QuadDesc quad_;  // origin moved by the context's offset
+};
+
+}  // namespace penumbra

@@ -1,0 +1,78 @@
+#pragma once
+// What every shape answers, in one place per kind (as pbrt-v4's shapes.h and Mitsuba 3's
+// src/shapes/*.cpp): its Embree geometry, its bounds and area, the reconstruction of a hit point
+// with its floating-point error bound, and sampling of points for area lights.
+//
+// Adding a shape: a file pair here (a class deriving from Shape), its input struct in
+// scene/scene_input.h, one line in shapes/make_shape.cpp, and its tests (docs/architecture.md).
+#include <embree3/rtcore.h>
+
+#include "renderer/core/bounds.h"
+#include "renderer/core/motion.h"
+#include "renderer/core/ray.h"
+#include "renderer/embree/handles.h"
+
+namespace penumbra {
+
+struct ShapeSample {
+  vec3 p;           // point on the surface
+  vec3 p_error;     // its absolute error bound
+  vec3 n;           // unit geometric normal (front side)
+  float pdf = 0.f;  // solid-angle density seen from the reference point (0 = failed)
+};
+
+// A shape's rigid motion over the camera's shutter. Times passed to shapes are normalised
+// shutter times in [0, 1]; scene time = shutter_open + time * shutter_span.
+struct ShapeMotion {
+  Motion motion;
+  float shutter_open = 0.f;
+  float shutter_span = 0.f;
+
+  bool is_static() const { return motion.is_static(); }
+  // The exact displacement at normalised time `time`.
+  vec3 displacement(float time) const { return motion.displacement(shutter_open + time * shutter_span); }
+  // Componentwise bounds of the displacement over the whole shutter.
+  Bounds3 displacement_bounds() const {
+    Bounds3 b;
+    motion.displacement_bounds(shutter_open, shutter_open + shutter_span, &b.lo, &b.hi);
+    return b;
+  }
+};
+
+// What a shape needs to know of the scene it is built into.
+struct ShapeContext {
+  ShapeMotion motion;
+  vec3 offset{0.f};             // added to every position (motion baked in without a shutter)
+  vec3 camera_position{0.f};    // picks how finely a moving mesh is tessellated in time
+  bool emissive = false;        // an area light will sample it: prepare sampling by area
+};
+
+class Shape {
+ public:
+  virtual ~Shape() = default;
+
+  // A new Embree geometry for this shape, committed; its user data is this Shape, which must
+  // outlive the Embree scene.
+  virtual EmbreeGeometry make_geometry(RTCDevice device) const = 0;
+  // World bounds over the whole shutter.
+  virtual Bounds3 bounds() const = 0;
+  // Surface area at time 0 (motion is rigid).
+  virtual float area() const = 0;
+  // Fills p, p_error, ng and ns of a hit Embree reported at distance t on primitive `prim` with
+  // barycentrics `uv`. The point is rebuilt from the primitive, not taken as o + t*d, whose
+  // error grows with t (pbrt-v4 section 6.8.4).
+  virtual void hit_geometry(const Ray& ray, float t, uint32_t prim, const vec2& uv,
+                            SurfaceHit* hit) const = 0;
+  // Samples a point of the surface as seen from `ref` at normalised time `time`; false if none.
+  virtual bool sample(const vec3& ref, float time, const vec2& u, ShapeSample* out) const = 0;
+  // Solid-angle density with which sample() yields point p (normal n) from ref.
+  virtual float pdf(const vec3& ref, const vec3& p, const vec3& n, float time) const = 0;
+  // A point on the shape at time 0 (the Embree-only benchmark aims its shadow rays at it).
+  virtual vec3 reference_point() const = 0;
+};
+
+// Solid-angle density of picking point p (normal n) uniformly by area on a surface of `area`:
+// the area density 1/area times dist^2 / |cos| (pbrt-v4 section 6.1.3).
+float area_to_solid_angle(const vec3& ref, const vec3& p, const vec3& n, float area);
+
+}  // namespace penumbra

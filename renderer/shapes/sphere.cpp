@@ -1,0 +1,200 @@
+#include "renderer/shapes/sphere.h"
+
+#include "renderer/core/frame.h"
+#include "renderer/embree/ray_access.h"
+#include "renderer/sampling/sampling.h"
+
+namespace penumbra {
+namespace {
+
+void sphere_bounds_fn(const RTCBoundsFunctionArguments* args) {
+  const auto& sphere = *static_cast<const Sphere*>(args->geometryUserPtr);
+  const Bounds3 b = sphere.embree_bounds();
+  RTCBounds* out = args->bounds_o;
+  out->lower_x = b.lo.x;
+  out->lower_y = b.lo.y;
+  out->lower_z = b.lo.z;
+  out->upper_x = b.hi.x;
+  out->upper_y = b.hi.y;
+  out->upper_z = b.hi.z;
+}
+
+void sphere_intersect_fn(const RTCIntersectFunctionNArguments* args) {
+  const auto& sphere = *static_cast<const Sphere*>(args->geometryUserPtr);
+  RTCRayHitN* rayhit = args->rayhit;
+  RTCRayN* ray = RTCRayHitN_RayN(rayhit, args->N);
+  RTCHitN* hit = RTCRayHitN_HitN(rayhit, args->N);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] == 0) continue;
+    const vec3 o = embree_ray_origin(ray, args->N, i), d = embree_ray_direction(ray, args->N, i);
+    const float t_near = RTCRayN_tnear(ray, args->N, i);
+    float& t_far = RTCRayN_tfar(ray, args->N, i);
+    const vec3 c = sphere.center_at(RTCRayN_time(ray, args->N, i));
+    const float t = intersect_sphere(c, sphere.radius(), o, d, t_far);
+    if (t <= t_near) continue;
+    t_far = t;
+    const vec3 n = o + t * d - c;
+    RTCHitN_Ng_x(hit, args->N, i) = n.x;
+    RTCHitN_Ng_y(hit, args->N, i) = n.y;
+    RTCHitN_Ng_z(hit, args->N, i) = n.z;
+    RTCHitN_u(hit, args->N, i) = 0.f;
+    RTCHitN_v(hit, args->N, i) = 0.f;
+    RTCHitN_primID(hit, args->N, i) = args->primID;
+    RTCHitN_geomID(hit, args->N, i) = args->geomID;
+    RTCHitN_instID(hit, args->N, i, 0) = args->context->instID[0];
+  }
+}
+
+void sphere_occluded_fn(const RTCOccludedFunctionNArguments* args) {
+  const auto& sphere = *static_cast<const Sphere*>(args->geometryUserPtr);
+  RTCRayN* ray = args->ray;
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] == 0) continue;
+    const vec3 o = embree_ray_origin(ray, args->N, i), d = embree_ray_direction(ray, args->N, i);
+    float& t_far = RTCRayN_tfar(ray, args->N, i);
+    const vec3 c = sphere.center_at(RTCRayN_time(ray, args->N, i));
+    const float t = intersect_sphere(c, sphere.radius(), o, d, t_far);
+    if (t > RTCRayN_tnear(ray, args->N, i)) t_far = -kInfinity;
+  }
+}
+
+}  // namespace
+
+Sphere::Sphere(const SphereDesc& desc, const ShapeContext& ctx)
+    : center_(desc.center + ctx.offset),
+      radius_(desc.radius),
+      area_(4.f * kPi * desc.radius * desc.radius),
+      motion_(ctx.motion) {}
+
+EmbreeGeometry Sphere::make_geometry(RTCDevice device) const {
+  // User geometry: the exact quadratic motion path needs our own test.
+  EmbreeGeometry geom(rtcNewGeometry(device, RTC_GEOMETRY_TYPE_USER));
+  if (!geom) return geom;
+  rtcSetGeometryUserPrimitiveCount(geom.get(), 1);
+  rtcSetGeometryBoundsFunction(geom.get(), sphere_bounds_fn, nullptr);
+  rtcSetGeometryIntersectFunction(geom.get(), sphere_intersect_fn);
+  rtcSetGeometryOccludedFunction(geom.get(), sphere_occluded_fn);
+  rtcSetGeometryUserData(geom.get(), const_cast<Sphere*>(this));
+  rtcCommitGeometry(geom.get());
+  return geom;
+}
+
+Bounds3 Sphere::bounds() const {
+  const Bounds3 d = motion_.displacement_bounds();
+  return Bounds3{center_ - vec3(radius_) + d.lo, center_ + vec3(radius_) + d.hi};
+}
+
+Bounds3 Sphere::embree_bounds() const {
+  // One static box around the whole swept path over the shutter: Embree's linear motion of
+  // boxes between time steps cannot contain a quadratic path in general. The radius is padded
+  // by the rounding error of the intersection test.
+  const Bounds3 d = motion_.displacement_bounds();
+  const vec3 r(radius_ * (1.f + 4.f * gamma_bound(4)));
+  return Bounds3{center_ + d.lo - r, center_ + d.hi + r};
+}
+
+void Sphere::hit_geometry(const Ray& ray, float t, uint32_t, const vec2&, SurfaceHit* hit) const {
+  sphere_hit_geometry(center_at(ray.time), radius_, ray.origin + ray.direction * t, hit);
+}
+
+bool Sphere::sample(const vec3& ref, float time, const vec2& u, ShapeSample* out) const {
+  *out = sample_sphere(center_at(time), radius_, ref, u);
+  return true;
+}
+
+float Sphere::pdf(const vec3& ref, const vec3& p, const vec3& n, float time) const {
+  return sphere_pdf(center_at(time), radius_, ref, p, n);
+}
+
+float intersect_sphere(const vec3& center, float radius, const vec3& origin, const vec3& dir,
+                       float t_max) {
+  const vec3 f = origin - center;
+  const float b = -glm::dot(f, dir);
+  const vec3 l = f + b * dir;  // closest approach of the line to the centre
+  const float r2 = radius * radius;
+  const float disc = r2 - glm::dot(l, l);
+  if (disc < 0.f) return -1.f;
+  const float c = glm::dot(f, f) - r2;
+  const float q = b + std::copysign(std::sqrt(disc), b);
+  float t0 = q != 0.f ? c / q : 0.f;
+  float t1 = q;
+  if (t0 > t1) std::swap(t0, t1);
+  if (t0 > 0.f && t0 < t_max) return t0;
+  if (t1 > 0.f && t1 < t_max) return t1;
+  return -1.f;
+}
+
+void sphere_hit_geometry(const vec3& center, float radius, const vec3& p_approx, SurfaceHit* hit) {
+  vec3 d = p_approx - center;
+  const float len = glm::length(d);
+  const vec3 n = len > 0.f ? d / len : vec3(0.f, 0.f, 1.f);
+  hit->p = center + n * radius;
+  // Error of centre + radius*n after re-projection (pbrt-v4 eq. 6.16 bounds the re-projected
+  // point by gamma(5)|p| about the centre); the addition of the centre adds gamma(1)|p|.
+  hit->p_error = gamma_bound(6) * (glm::abs(center) + glm::abs(n * radius));
+  hit->ng = n;
+  hit->ns = n;
+}
+
+ShapeSample sample_sphere(const vec3& center, float radius, const vec3& ref, const vec2& u) {
+  ShapeSample s;
+  const vec3 to_center = center - ref;
+  const float dc2 = glm::dot(to_center, to_center);
+  const float r2 = radius * radius;
+  if (dc2 <= r2 * 1.0001f) {
+    // Inside (or on) the sphere: uniform area sampling.
+    const vec3 n = square_to_uniform_sphere(u);
+    s.p = center + radius * n;
+    s.n = n;
+    s.p_error = gamma_bound(6) * (glm::abs(center) + glm::abs(n * radius));
+    const vec3 w = s.p - ref;
+    const float dist2 = glm::dot(w, w);
+    const float cos_l = std::abs(glm::dot(n, w)) / std::sqrt(dist2);
+    const float area = 4.f * kPi * r2;
+    s.pdf = cos_l > 0.f ? dist2 / (cos_l * area) : 0.f;
+    return s;
+  }
+  const float dc = std::sqrt(dc2);
+  const vec3 wc = to_center / dc;
+  const Frame frame(wc);
+  const float sin2_max = r2 / dc2;
+  const float cos_max = safe_sqrt(1.f - sin2_max);
+  // For tiny or distant spheres 1 - cos_max cancels catastrophically; its series is exact enough.
+  const float one_minus_cos_max = sin2_max < 1e-3f ? sin2_max * 0.5f + sin2_max * sin2_max / 8.f
+                                                   : 1.f - cos_max;
+  const float cos_t = 1.f - u.x * one_minus_cos_max;
+  const float sin2_t = std::max(0.f, 1.f - cos_t * cos_t);
+  const float sin2_t_exact = u.x * one_minus_cos_max * (2.f - u.x * one_minus_cos_max);
+  const float sin2 = sin2_max < 1e-3f ? sin2_t_exact : sin2_t;
+  // Angle alpha at the centre between -wc and the sampled point, by the law of cosines in the
+  // triangle (ref, centre, point) (pbrt-v3 section 14.2.2).
+  const float ds = dc * cos_t - safe_sqrt(r2 - dc2 * sin2);
+  const float ca = std::clamp((dc2 + r2 - ds * ds) / (2.f * dc * radius), -1.f, 1.f);
+  const float sa = safe_sqrt(1.f - ca * ca);
+  const float phi = 2.f * kPi * u.y;
+  const vec3 n_local(sa * std::cos(phi), sa * std::sin(phi), ca);
+  const vec3 n = -frame.to_world(n_local);
+  s.n = glm::normalize(n);
+  s.p = center + radius * s.n;
+  s.p_error = gamma_bound(6) * (glm::abs(center) + glm::abs(s.n * radius));
+  s.pdf = 1.f / (2.f * kPi * one_minus_cos_max);
+  return s;
+}
+
+float sphere_pdf(const vec3& center, float radius, const vec3& ref, const vec3& p, const vec3& n) {
+  const vec3 to_center = center - ref;
+  const float dc2 = glm::dot(to_center, to_center);
+  const float r2 = radius * radius;
+  if (dc2 <= r2 * 1.0001f) {
+    const vec3 w = p - ref;
+    const float dist2 = glm::dot(w, w);
+    const float cos_l = std::abs(glm::dot(n, w)) / std::sqrt(dist2);
+    return cos_l > 0.f ? dist2 / (cos_l * 4.f * kPi * r2) : 0.f;
+  }
+  const float sin2_max = r2 / dc2;
+  const float one_minus_cos_max =
+      sin2_max < 1e-3f ? sin2_max * 0.5f + sin2_max * sin2_max / 8.f : 1.f - safe_sqrt(1.f - sin2_max);
+  return 1.f / (2.f * kPi * one_minus_cos_max);
+}
+
+}  // namespace penumbra

@@ -1,0 +1,209 @@
+#include "renderer/shapes/triangle_mesh.h"
+
+#include <algorithm>
+
+#include "renderer/embree/ray_access.h"
+#include "renderer/sampling/sampling.h"
+
+namespace penumbra {
+namespace {
+
+// ---- Embree's robust (watertight) test, with the sign of t settled exactly ----
+//
+// Embree's default triangle test (Moeller-Trumbore on precomputed edges) is not watertight:
+// shadow rays slip through edges two triangles share (tests/stress LightLeak).
+// RTC_SCENE_FLAG_ROBUST switches to its Pluecker test, whose edge functions are computed the same
+// way for both triangles of an edge (Embree kernels/geometry/triangle_intersector_pluecker.h).
+// Neither test bounds the rounding error of its own t as pbrt-v4's does (it rejects t <= deltaT,
+// section 6.8.7), and our spawn offsets (core/ray.h, pbrt-v4 section 6.8.6) cover only the hit
+// point's error, so a ray can re-hit the triangle it leaves: the robust test accepts t == tnear
+// == 0 for a ray starting exactly on the plane (an exact hit point has a zero offset), and
+// Embree's plane distance carries an error of order eps times the distance of the triangle's
+// first vertex from the ray origin (docs/stability-and-features.md has the measurements).
+// So every triangle hit passes this filter, which re-evaluates the sign of
+// t = ((p0 - o) . n) / (d . n) in double precision from the same float vertices hit points are
+// rebuilt from and keeps the hit only if t > 0. Products of floats are exact to 2^-53 in
+// double, so the sign is right far below any spawn offset; a hit with t > 0 is never dropped,
+// so watertightness stays.
+inline void filter_triangle_hit(const RTCFilterFunctionNArguments* args, unsigned n, unsigned i) {
+  if (args->valid[i] == 0) return;
+  const auto& mesh = *static_cast<const TriangleMesh*>(args->geometryUserPtr);
+  if (!mesh.ahead_of_ray(RTCHitN_primID(args->hit, n, i), embree_ray_origin(args->ray, n, i),
+                         embree_ray_direction(args->ray, n, i), RTCRayN_time(args->ray, n, i)))
+    args->valid[i] = 0;
+}
+
+void triangle_filter_fn(const RTCFilterFunctionNArguments* args) {
+  if (args->N == 1) {  // rtcIntersect1 / rtcOccluded1: the accessors fold to plain fields
+    filter_triangle_hit(args, 1, 0);
+    return;
+  }
+  for (unsigned i = 0; i < args->N; ++i) filter_triangle_hit(args, args->N, i);
+}
+
+// Vertex buffers at evenly spread shutter instants. Linear interpolation of the quadratic path
+// between steps deviates by at most |a| dt^2 / 8; keep that below 1e-4 of the distance to the
+// camera (about a seventh of a pixel at 1000 pixels over a 40 degree view), at most Embree's 129.
+int motion_time_steps(const Motion& motion, float span, float camera_distance) {
+  if (motion.is_static() || span <= 0.f) return 1;
+  const float a = glm::length(motion.acceleration);
+  if (a == 0.f) return 2;
+  const float tolerance = std::max(1e-4f * camera_distance, 1e-12f);
+  const float intervals = std::ceil(span * std::sqrt(a / (8.f * tolerance)));
+  return int(std::clamp(intervals, 1.f, 128.f)) + 1;
+}
+
+float triangle_area(const vec3& a, const vec3& b, const vec3& c) {
+  return 0.5f * glm::length(glm::cross(b - a, c - a));
+}
+
+}  // namespace
+
+TriangleMesh::TriangleMesh(const MeshDesc& desc, const ShapeContext& ctx)
+    : positions_(desc.positions), indices_(desc.indices), normals_(desc.normals) {
+  for (vec3& p : positions_) p += ctx.offset;
+  const size_t n = indices_.size() / 3;
+  std::vector<float> areas(n);
+  double total = 0.0;
+  for (size_t t = 0; t < n; ++t) {
+    areas[t] = triangle_area(positions_[indices_[3 * t]], positions_[indices_[3 * t + 1]],
+                             positions_[indices_[3 * t + 2]]);
+    total += areas[t];
+  }
+  area_ = float(total);
+  if (ctx.emissive && n > 0) {
+    triangle_cdf_.resize(n);
+    double acc = 0.0;
+    for (size_t t = 0; t < n; ++t) {
+      acc += areas[t];
+      triangle_cdf_[t] = float(acc / total);
+    }
+    triangle_cdf_.back() = 1.f;
+  }
+
+  Bounds3 own;
+  for (const vec3& p : positions_) own.extend(p);
+  const Bounds3 d = ctx.motion.displacement_bounds();
+  bounds_ = Bounds3{own.lo + d.lo, own.hi + d.hi};
+
+  const vec3 nearest = glm::clamp(ctx.camera_position, bounds_.lo, bounds_.hi);
+  const float camera_distance = std::max(glm::length(nearest - ctx.camera_position),
+                                         1e-3f * glm::length(own.hi - own.lo));
+  time_steps_ = motion_time_steps(ctx.motion.motion, ctx.motion.shutter_span, camera_distance);
+  if (time_steps_ > 1) {
+    step_displacement_.resize(time_steps_);
+    for (int k = 0; k < time_steps_; ++k)
+      step_displacement_[k] = ctx.motion.motion.displacement(
+          ctx.motion.shutter_open + ctx.motion.shutter_span * float(k) / float(time_steps_ - 1));
+  }
+}
+
+vec3 TriangleMesh::interpolated_displacement(float time) const {
+  // Embree interpolates vertex buffers linearly between evenly spread time steps.
+  const float f = std::clamp(time, 0.f, 1.f) * float(time_steps_ - 1);
+  const int i = std::min(int(f), time_steps_ - 2);
+  const float w = f - float(i);
+  return glm::mix(step_displacement_[i], step_displacement_[i + 1], w);
+}
+
+EmbreeGeometry TriangleMesh::make_geometry(RTCDevice device) const {
+  EmbreeGeometry geom(rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE));
+  if (!geom) return geom;
+  rtcSetGeometryIntersectFilterFunction(geom.get(), triangle_filter_fn);
+  rtcSetGeometryOccludedFilterFunction(geom.get(), triangle_filter_fn);
+  rtcSetGeometryTimeStepCount(geom.get(), unsigned(time_steps_));
+  static_assert(sizeof(vec3) == 12, "vertex layout");
+  for (int k = 0; k < time_steps_; ++k) {
+    auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom.get(), RTC_BUFFER_TYPE_VERTEX,
+                                                          unsigned(k), RTC_FORMAT_FLOAT3,
+                                                          sizeof(float) * 3, positions_.size()));
+    if (!v) return EmbreeGeometry();  // the scene build reports Embree's error
+    const vec3 d = time_steps_ > 1 ? step_displacement_[k] : vec3(0.f);
+    for (size_t p = 0; p < positions_.size(); ++p) {
+      const vec3 q = positions_[p] + d;
+      v[3 * p] = q.x;
+      v[3 * p + 1] = q.y;
+      v[3 * p + 2] = q.z;
+    }
+  }
+  auto* idx = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(
+      geom.get(), RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, sizeof(uint32_t) * 3, indices_.size() / 3));
+  if (!idx) return EmbreeGeometry();
+  std::copy(indices_.begin(), indices_.end(), idx);
+  rtcSetGeometryUserData(geom.get(), const_cast<TriangleMesh*>(this));
+  rtcCommitGeometry(geom.get());
+  return geom;
+}
+
+bool TriangleMesh::ahead_of_ray(uint32_t prim, const vec3& o, const vec3& d, float time) const {
+  const uint32_t* tri = indices_.data() + size_t(prim) * 3;
+  // The same float vertices hit_geometry rebuilds hit points from.
+  vec3 a = positions_[tri[0]], b = positions_[tri[1]], c = positions_[tri[2]];
+  if (time_steps_ > 1) {  // moving (static and shutter-less objects have one step)
+    const vec3 disp = interpolated_displacement(time);
+    a += disp;
+    b += disp;
+    c += disp;
+  }
+  const dvec3 p0(a), normal = glm::cross(dvec3(b) - p0, dvec3(c) - p0);
+  const double num = glm::dot(p0 - dvec3(o), normal);
+  const double den = glm::dot(dvec3(d), normal);
+  // Signs compared, not num * den > 0, which could underflow to 0 in a tiny scene.
+  return (num > 0.0 && den > 0.0) || (num < 0.0 && den < 0.0);
+}
+
+void TriangleMesh::hit_geometry(const Ray& ray, float, uint32_t prim, const vec2& uv,
+                                SurfaceHit* hit) const {
+  const vec3 disp = displacement_at(ray.time);
+  const uint32_t* tri = &indices_[size_t(prim) * 3];
+  const vec3 p0 = positions_[tri[0]] + disp;
+  const vec3 p1 = positions_[tri[1]] + disp;
+  const vec3 p2 = positions_[tri[2]] + disp;
+  const float b1 = uv.x, b2 = uv.y, b0 = 1.f - b1 - b2;
+  // pbrt-v4 section 6.8.4 bounds the error of the barycentric sum by gamma(7).
+  const vec3 t0 = b0 * p0, t1 = b1 * p1, t2 = b2 * p2;
+  hit->p = t0 + t1 + t2;
+  hit->p_error = gamma_bound(7) * (glm::abs(t0) + glm::abs(t1) + glm::abs(t2));
+  vec3 ng = glm::cross(p1 - p0, p2 - p0);
+  const float len = glm::length(ng);
+  ng = len > 0.f ? ng / len : vec3(0.f, 0.f, 1.f);
+  hit->ng = ng;
+  hit->ns = ng;
+  if (!normals_.empty()) {
+    vec3 ns = b0 * normals_[tri[0]] + b1 * normals_[tri[1]] + b2 * normals_[tri[2]];
+    const float ls = glm::length(ns);
+    if (ls > 0.f && std::isfinite(ls)) {
+      ns /= ls;
+      hit->ns = glm::dot(ns, ng) < 0.f ? -ns : ns;
+    }
+  }
+}
+
+bool TriangleMesh::sample(const vec3& ref, float time, const vec2& u, ShapeSample* out) const {
+  // Pick a triangle by area with u.x, reuse what is left of u.x inside its interval.
+  const auto it = std::upper_bound(triangle_cdf_.begin(), triangle_cdf_.end(), u.x);
+  const size_t t = std::min<size_t>(it - triangle_cdf_.begin(), triangle_cdf_.size() - 1);
+  const float lo = t > 0 ? triangle_cdf_[t - 1] : 0.f;
+  const float width = triangle_cdf_[t] - lo;
+  const float ux = width > 0.f ? std::min((u.x - lo) / width, kOneMinusEpsilon) : 0.5f;
+  const vec2 b = square_to_triangle(vec2(ux, u.y));
+  const vec3 disp = displacement_at(time);
+  const uint32_t* tri = &indices_[3 * t];
+  const vec3 p0 = positions_[tri[0]] + disp, p1 = positions_[tri[1]] + disp,
+             p2 = positions_[tri[2]] + disp;
+  const vec3 t0 = (1.f - b.x - b.y) * p0, t1 = b.x * p1, t2 = b.y * p2;
+  out->p = t0 + t1 + t2;
+  out->p_error = gamma_bound(7) * (glm::abs(t0) + glm::abs(t1) + glm::abs(t2));
+  const vec3 ng = glm::cross(p1 - p0, p2 - p0);
+  const float len = glm::length(ng);
+  if (!(len > 0.f)) return false;
+  out->n = ng / len;
+  out->pdf = area_to_solid_angle(ref, out->p, out->n, area_);
+  return true;
+}
+
+float TriangleMesh::pdf(const vec3& ref, const vec3& p, const vec3& n, float) const {
+  return area_to_solid_angle(ref, p, n, area_);
+}
+
+}  // namespace penumbra

@@ -1,0 +1,54 @@
+#pragma once
+// A triangle mesh: Embree's watertight triangle test with the sign of t settled exactly, hit
+// points rebuilt from barycentrics, shading normals interpolated, uniform sampling by area.
+#include <vector>
+
+#include "renderer/scene/scene_input.h"
+#include "renderer/shapes/shape.h"
+
+namespace penumbra {
+
+class TriangleMesh : public Shape {
+ public:
+  TriangleMesh(const MeshDesc& desc, const ShapeContext& ctx);
+
+  EmbreeGeometry make_geometry(RTCDevice device) const override;
+  Bounds3 bounds() const override { return bounds_; }
+  float area() const override { return area_; }
+  void hit_geometry(const Ray& ray, float t, uint32_t prim, const vec2& uv,
+                    SurfaceHit* hit) const override;
+  bool sample(const vec3& ref, float time, const vec2& u, ShapeSample* out) const override;
+  float pdf(const vec3& ref, const vec3& p, const vec3& n, float time) const override;
+  vec3 reference_point() const override { return positions_[indices_[0]]; }
+
+  // The displacement of every vertex at normalised shutter time `time`, as Embree interpolates
+  // it between its time steps (not the exact quadratic path): hit points must lie on the
+  // triangle Embree tested.
+  vec3 displacement_at(float time) const {
+    return time_steps_ > 1 ? interpolated_displacement(time) : vec3(0.f);
+  }
+  // True if the ray (origin o, direction d) meets the plane of triangle `prim` at t > 0,
+  // decided in double precision (see triangle_mesh.cpp).
+  bool ahead_of_ray(uint32_t prim, const vec3& o, const vec3& d, float time) const;
+  int time_steps() const { return time_steps_; }
+
+ protected:
+  // For shapes made of triangles that keep their own area and sampling (quads).
+  void set_area(float area) { area_ = area; }
+
+ private:
+  vec3 interpolated_displacement(float time) const;
+
+  std::vector<vec3> positions_;  // world space at time 0
+  std::vector<uint32_t> indices_;
+  std::vector<vec3> normals_;  // empty or one per position
+  std::vector<float> triangle_cdf_;  // emitters: cumulative triangle areas, normalised
+  float area_ = 0.f;
+  Bounds3 bounds_;
+  // Embree motion: vertex buffers at time_steps_ instants evenly spread over the shutter, and
+  // the displacement at each (all vertices share it: motion is rigid).
+  int time_steps_ = 1;
+  std::vector<vec3> step_displacement_;
+};
+
+}  // namespace penumbra
