@@ -14,14 +14,14 @@ namespace {
 
 using BsdfModel = std::variant<DiffuseBsdf, ConductorBsdf, DielectricBsdf, PlasticBsdf>;
 
-BsdfModel make_model(const MaterialParams& params) {
+BsdfModel make_model(const MaterialParams& params, CoatingTableCache* cache) {
   return std::visit(
-      [](const auto& p) -> BsdfModel {
+      [cache](const auto& p) -> BsdfModel {
         using P = std::decay_t<decltype(p)>;
         if constexpr (std::is_same_v<P, DiffuseParams>) return DiffuseBsdf(p);
         else if constexpr (std::is_same_v<P, ConductorParams>) return ConductorBsdf(p);
         else if constexpr (std::is_same_v<P, DielectricParams>) return DielectricBsdf(p);
-        else return PlasticBsdf(p);
+        else return PlasticBsdf(p, cache);
       },
       params);
 }
@@ -38,8 +38,8 @@ struct Material::Impl {
   bool two_sided;
 };
 
-Material::Material(const MaterialParams& params) {
-  BsdfModel model = make_model(params);
+Material::Material(const MaterialParams& params, CoatingTableCache* cache) {
+  BsdfModel model = make_model(params, cache);
   const bool two_sided = std::visit([](const auto& m) { return m.two_sided(); }, model);
   impl_ = std::make_unique<Impl>(Impl{params, std::move(model), two_sided});
 }

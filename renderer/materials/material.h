@@ -8,11 +8,14 @@
 
 namespace penumbra {
 
+class CoatingTableCache;
+
 // A material ready for rendering: parameters plus any precomputed data (e.g. the rough plastic
 // transmittance tables). Immutable after construction and safe to share between threads.
 class Material {
  public:
-  explicit Material(const MaterialParams& params);
+  // `cache` shares precomputed tables between the materials of one scene build (may be null).
+  explicit Material(const MaterialParams& params, CoatingTableCache* cache = nullptr);
   ~Material();
   Material(Material&&) noexcept;
   Material& operator=(Material&&) noexcept;

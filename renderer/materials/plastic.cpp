@@ -1,212 +1,14 @@
 #include "renderer/materials/plastic.h"
 
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <cmath>
-#include <map>
-#include <mutex>
-#include <vector>
 
 #include "renderer/materials/fresnel.h"
 #include "renderer/sampling/sampling.h"
 
 namespace penumbra {
-namespace {
 
-// What a coating needs that depends only on (alpha, eta): the rough coating's transmittance
-// table, the internal diffuse reflectance fdr_int and the diffuse factor 1 / (eta^2 (1 - fdr_int)).
-struct CoatingTables {
-  // Rough coating only: t at the increasing cosines (nodes[0] = 0, nodes[n - 1] = 1).
-  int nodes = 0;
-  std::array<float, PlasticBsdf::kTransmittanceCapacity> cosines{};
-  std::array<float, PlasticBsdf::kTransmittanceCapacity> transmittance{};
-  float internal_reflectance = 0.f;
-  float diffuse_scale = 0.f;
-};
-
-// 1 / (eta^2 (1 - fdr_int)) in double: near 1 (large ior) fdr_int in float would lose the
-// difference, and eta^2 overflows a float for the largest valid ior. 0 if nothing gets out.
-float diffuse_scale(double eta, double internal_transmittance) {
-  const double d = eta * eta * internal_transmittance;
-  return d > 0.0 ? float(1.0 / d) : 0.f;
-}
-
-CoatingTables smooth_coating_tables(float eta) {
-  // Light inside the coating sees the relative ior 1/eta. The exact average makes
-  // eta^2 (1 - fdr_int) equal the external diffuse transmittance 1 - fdr_ext (see
-  // fresnel_diffuse), so the smooth plastic with a white base reflects exactly 1 at every angle.
-  // (With Mitsuba's polynomial fit a white plastic rendered 1.016 in a furnace at ior 2.4, and
-  // at ior 4 the fit's fdr_int exceeds 1.)
-  const DiffuseFresnel internal = fresnel_diffuse(1.0 / double(eta));
-  CoatingTables tables;
-  tables.internal_reflectance = float(internal.reflectance);
-  tables.diffuse_scale = diffuse_scale(eta, internal.transmittance);
-  return tables;
-}
-
-// Cosines at which the rough coating's external transmittance t(mu) is tabulated for eta >= 1.
-// Where t varies fastest, linear interpolation between uniform nodes over-estimates it, and the
-// interpolated t added to the exactly evaluated glossy reflection then exceeds 1 (measured with
-// Mitsuba's uniform nodes: 1.004 at 89.9 degrees for ior 1.01, roughness 0.0101). So the nodes
-// cluster at grazing incidence, where t has its steep foot: mu = x^2 for x uniform in [0, 1]
-// (measured: <= 1 for ior 1.0001..1e30, roughness 0.0101..1, 0..89.999 degrees).
-std::array<float, PlasticBsdf::kTransmittanceRes> grazing_nodes() {
-  constexpr int n = PlasticBsdf::kTransmittanceRes;
-  std::array<float, n> nodes{};
-  for (int i = 0; i < n; ++i) {
-    const double x = double(i) / (n - 1);
-    nodes[i] = float(x * x);
-  }
-  nodes[n - 1] = 1.f;
-  return nodes;
-}
-
-// eta < 1 (the coating is the thinner medium): t rises from 0 (total reflection below the
-// critical cosine mu_c = sqrt(1 - eta^2) for a smooth coating) within a foot whose width scales
-// with alpha, down to ~1e-3 in mu at ior 0.1, roughness 0.05. Fixed clustering onto mu_c (cubic
-// below, quadratic above) left only ~2 nodes in that foot, and the interpolated t exceeded the
-// pointwise bound 1 - E_spec(mu) by up to 0.019 (ior 0.1, roughness 0.05, mu 0.9945): the
-// furnace gained 2%. So the nodes are placed adaptively: a coarse version of that clustering,
-// then repeated bisection of the cell whose midpoint value departs most from the chord (the
-// interpolation error of a piecewise-linear table, de Boor 1978 ch. III), which puts the nodes
-// where the foot's curvature is, whatever alpha and eta are.
-void adaptive_transmittance_table(const GgxDistribution& distr, float eta,
-                                  std::array<float, PlasticBsdf::kTransmittanceCapacity>& cosines,
-                                  std::array<float, PlasticBsdf::kTransmittanceCapacity>& values) {
-  constexpr int n = PlasticBsdf::kTransmittanceCapacity;
-  constexpr int seed = 16;  // nodes of the coarse clustering
-  const auto t_at = [&](double mu) {
-    return rough_dielectric_transmittance(distr, std::max(1e-6f, float(mu)), eta);
-  };
-  const double mu_c = std::sqrt(1.0 - double(eta) * eta);
-  std::vector<double> mu(seed);
-  constexpr int below = seed / 2;
-  for (int i = 0; i <= below; ++i) {
-    const double w = 1.0 - double(i) / below;
-    mu[i] = mu_c * (1.0 - w * w * w);
-  }
-  for (int i = below + 1; i < seed; ++i) {
-    const double v = double(i - below) / (seed - 1 - below);
-    mu[i] = mu_c + (1.0 - mu_c) * v * v;
-  }
-  mu[seed - 1] = 1.0;
-  std::vector<double> t(seed), mid(seed - 1);
-  tbb::parallel_for(0, seed, [&](int i) { t[i] = t_at(mu[i]); });
-  tbb::parallel_for(0, seed - 1, [&](int i) { mid[i] = t_at(0.5 * (mu[i] + mu[i + 1])); });
-  const auto error = [&](size_t i) {
-    // Cells below float resolution cannot be split further.
-    if (float(0.5 * (mu[i] + mu[i + 1])) <= float(mu[i]) ||
-        float(0.5 * (mu[i] + mu[i + 1])) >= float(mu[i + 1]))
-      return -1.0;
-    return std::abs(mid[i] - 0.5 * (t[i] + t[i + 1]));
-  };
-  while (int(mu.size()) < n) {
-    size_t worst = 0;
-    double worst_error = -1.0;
-    for (size_t i = 0; i + 1 < mu.size(); ++i) {
-      const double e = error(i);
-      if (e > worst_error) worst_error = e, worst = i;
-    }
-    const double m = 0.5 * (mu[worst] + mu[worst + 1]);
-    if (worst_error < 0.0) {  // nothing left to split: pad with duplicates of the last node
-      mu.push_back(1.0), t.push_back(t.back()), mid.push_back(t.back());
-      continue;
-    }
-    const double tm = mid[worst];
-    const double left = t_at(0.5 * (mu[worst] + m));
-    const double right = t_at(0.5 * (m + mu[worst + 1]));
-    mu.insert(mu.begin() + worst + 1, m);
-    t.insert(t.begin() + worst + 1, tm);
-    mid[worst] = left;
-    mid.insert(mid.begin() + worst + 1, right);
-  }
-  for (int i = 0; i < n; ++i) {
-    cosines[i] = float(mu[i]);
-    values[i] = float(t[i]);
-  }
-  cosines[0] = 0.f;
-  cosines[n - 1] = 1.f;
-}
-
-// 2 \int_0^1 t(mu) mu dmu for the piecewise-linear interpolant of the table, exactly.
-double table_diffuse_average(const CoatingTables& tables) {
-  const auto& cosines = tables.cosines;
-  const auto& values = tables.transmittance;
-  double sum = 0.0;
-  for (int i = 0; i + 1 < tables.nodes; ++i) {
-    const double a = cosines[i], b = cosines[i + 1];
-    sum += (b - a) / 6.0 * (values[i] * (2.0 * a + b) + values[i + 1] * (a + 2.0 * b));
-  }
-  return 2.0 * sum;
-}
-
-CoatingTables rough_coating_tables(const GgxDistribution& distr, float eta) {
-  constexpr int n = PlasticBsdf::kTransmittanceRes;
-  CoatingTables tables;
-  if (eta < 1.f) {
-    // The diffuse factor from reciprocity: for the same (separable-Smith, hence reciprocal)
-    // microfacet BTDF, eta^2 (1 - fdr_int) equals the external diffuse transmittance
-    // 2 \int t(mu) mu dmu (radiance / n^2 is invariant, Veach 1997 sec. 5.2), as for the smooth
-    // coating. Taking the latter from the interpolated table itself makes the diffuse factor D =
-    // diffuse_scale 2 \int t mu dmu exactly 1, so a white plastic reflects E_spec(mu_i) + t(mu_i)
-    // <= 1. Mitsuba's mean over uniform nodes misses the total-internal-reflection jump of
-    // R_int at mu_c: it gave D = 1.002..1.010 at ior 0.1, roughness 0.0101..0.1 (the table's own
-    // over-estimate of t added the rest of the 2% gain). No Mitsuba result to match: its
-    // roughplastic rendered 1.32 at ior 0.5.
-    tables.nodes = PlasticBsdf::kTransmittanceCapacity;
-    adaptive_transmittance_table(distr, eta, tables.cosines, tables.transmittance);
-    const double external = table_diffuse_average(tables);
-    tables.internal_reflectance = float(1.0 - external / (double(eta) * eta));
-    tables.diffuse_scale = external > 0.0 ? float(1.0 / external) : 0.f;
-    return tables;
-  }
-  // eta >= 1: tabulate t(mu) at the grazing-clustered nodes (clamped away from 0) and average the
-  // internal reflectance 2 \int R_int(mu) mu dmu as the mean over mu = linspace(0, 1) -- Mitsuba
-  // 3's roughplastic takes the same mean (and tabulates t on uniform nodes), so the diffuse part
-  // matches it. That mean underestimates the average by about (fdr_int - R_int(1)) / 64, so the
-  // rough plastic returns less light than the smooth one (furnace at roughness 0.0101: 0.986 at
-  // ior 1.5, 0.83 at ior 10), not more.
-  tables.nodes = n;
-  const std::array<float, n> nodes = grazing_nodes();
-  std::copy(nodes.begin(), nodes.end(), tables.cosines.begin());
-  std::array<double, n> internal{};
-  tbb::parallel_for(0, n, [&](int i) {
-    tables.transmittance[i] =
-        rough_dielectric_transmittance(distr, std::max(1e-6f, tables.cosines[i]), eta);
-    const float mu = std::max(1e-6f, float(i) / float(n - 1));
-    internal[i] = rough_dielectric_reflectance(distr, mu, 1.f / eta) * mu;
-  });
-  double sum = 0.0;
-  for (double v : internal) sum += v;  // fixed order: the result does not depend on threads
-  const double reflectance = 2.0 * sum / n;
-  tables.internal_reflectance = float(reflectance);
-  tables.diffuse_scale = diffuse_scale(eta, 1.0 - reflectance);
-  return tables;
-}
-
-// The rough tables cost ~10^6 microfacet evaluations, the smooth ones a few hundred Fresnel
-// evaluations; they depend only on (alpha, eta) (alpha 0 for smooth), so every material (and
-// every scene a long-running server builds) with the same coating shares them.
-const CoatingTables& coating_tables(bool smooth, const GgxDistribution& distr, float eta) {
-  static std::mutex mutex;
-  static std::map<std::pair<float, float>, std::unique_ptr<CoatingTables>> cache;
-  const std::pair<float, float> key(smooth ? 0.f : distr.alpha(), eta);
-  {
-    std::lock_guard<std::mutex> lock(mutex);
-    if (auto it = cache.find(key); it != cache.end()) return *it->second;
-  }
-  // Built outside the lock: two threads may both build the same entry; the first one stays.
-  auto tables = std::make_unique<CoatingTables>(smooth ? smooth_coating_tables(eta)
-                                                       : rough_coating_tables(distr, eta));
-  std::lock_guard<std::mutex> lock(mutex);
-  auto [it, inserted] = cache.emplace(key, std::move(tables));
-  return *it->second;
-}
-
-}  // namespace
-
-PlasticBsdf::PlasticBsdf(const PlasticParams& params)
+PlasticBsdf::PlasticBsdf(const PlasticParams& params, CoatingTableCache* cache)
     : color_(params.color),
       eta_(params.ior),
       smooth_(roughness_to_alpha(params.roughness) < kMinMicrofacetAlpha),
@@ -217,7 +19,8 @@ PlasticBsdf::PlasticBsdf(const PlasticParams& params)
   const float d_mean = (color_.x + color_.y + color_.z) / 3.f;
   specular_sampling_weight_ = 1.f / (d_mean + 1.f);
 
-  const CoatingTables& tables = coating_tables(smooth_, distr_, eta_);
+  CoatingTableCache own;
+  const CoatingTables& tables = (cache ? *cache : own).get(smooth_, distr_, eta_);
   nodes_ = tables.nodes;
   cosines_ = tables.cosines;
   transmittance_ = tables.transmittance;

@@ -13,6 +13,7 @@
 #include <array>
 
 #include "renderer/materials/bsdf.h"
+#include "renderer/materials/coating_tables.h"
 #include "renderer/materials/material_params.h"
 #include "renderer/materials/microfacet.h"
 
@@ -21,13 +22,9 @@ namespace penumbra {
 // Front-side model (wi.z > 0); Material mirrors back-side queries to the front.
 class PlasticBsdf : public OpaqueBsdf {
  public:
-  // Table resolution of the rough transmittance over cos(theta) in [0, 1] (Mitsuba uses 64) for
-  // ior >= 1; below ior 1 the nodes are placed adaptively and twice as many are used. The nodes
-  // are not uniform (see plastic.cpp).
-  static constexpr int kTransmittanceRes = 64;
-  static constexpr int kTransmittanceCapacity = 2 * kTransmittanceRes;
-
-  explicit PlasticBsdf(const PlasticParams& params);
+  // `cache` shares the coating's tables between the materials of one scene build; without one
+  // they are computed for this material alone.
+  explicit PlasticBsdf(const PlasticParams& params, CoatingTableCache* cache = nullptr);
 
   bool smooth() const { return smooth_; }
   uint32_t lobes() const {
@@ -55,8 +52,8 @@ class PlasticBsdf : public OpaqueBsdf {
   float internal_reflectance_;  // fdr_int (smooth) or its rough counterpart
   float diffuse_scale_;         // 1 / (eta^2 (1 - internal_reflectance_)), computed in double
   int nodes_ = 0;                                       // used entries of the rough table
-  std::array<float, kTransmittanceCapacity> cosines_{};  // the rough table's nodes, increasing
-  std::array<float, kTransmittanceCapacity> transmittance_{};
+  std::array<float, kCoatingTableCapacity> cosines_{};  // the rough table's nodes, increasing
+  std::array<float, kCoatingTableCapacity> transmittance_{};
 };
 
 }  // namespace penumbra

@@ -6,6 +6,7 @@
 #include "renderer/embree/handles.h"
 #include "renderer/lights/area_light.h"
 #include "renderer/lights/make_light.h"
+#include "renderer/materials/coating_tables.h"
 #include "renderer/scene/scene.h"
 #include "renderer/shapes/make_shape.h"
 
@@ -25,8 +26,9 @@ class SceneBuilder {
   // Materials answer for themselves what the integrator must be compiled for.
   void materials() {
     s_.materials_.reserve(in_.materials.size());
+    CoatingTableCache coatings;  // shared by this build's plastics, gone with it
     for (const MaterialParams& params : in_.materials) {
-      const Material& m = s_.materials_.emplace_back(params);
+      const Material& m = s_.materials_.emplace_back(params, &coatings);
       if (m.has_transmission()) s_.features_.transmission = true;
       if (m.has_absorption()) s_.features_.absorption = true;
     }

@@ -1,0 +1,55 @@
+#pragma once
+// What a plastic's coating needs that depends only on (alpha, eta): computed once per distinct
+// coating of a scene build and copied into each PlasticBsdf.
+#include <array>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <utility>
+
+#include "renderer/materials/microfacet.h"
+
+namespace penumbra {
+
+// Capacity of the rough transmittance table over cos(theta) in [0, 1]: 64 nodes (as Mitsuba) for
+// ior >= 1; below ior 1 the nodes are placed adaptively and twice as many are used.
+inline constexpr int kCoatingTableRes = 64;
+inline constexpr int kCoatingTableCapacity = 2 * kCoatingTableRes;
+
+// What a coating needs that depends only on (alpha, eta): the rough coating's transmittance
+// table, the internal diffuse reflectance fdr_int and the diffuse factor 1 / (eta^2 (1 - fdr_int)).
+struct CoatingTables {
+  CoatingTables();
+  ~CoatingTables();
+  CoatingTables(const CoatingTables&);
+  CoatingTables& operator=(const CoatingTables&) = default;
+
+  // Rough coating only: t at the increasing cosines (nodes[0] = 0, nodes[n - 1] = 1).
+  int nodes = 0;
+  std::array<float, kCoatingTableCapacity> cosines{};
+  std::array<float, kCoatingTableCapacity> transmittance{};
+  float internal_reflectance = 0.f;
+  float diffuse_scale = 0.f;
+};
+
+// The tables of a smooth (alpha ignored) or rough GGX coating of relative ior eta.
+CoatingTables make_coating_tables(bool smooth, const GgxDistribution& distr, float eta);
+
+// Tables shared by the materials of one scene build. The rough tables cost ~10^6 microfacet
+// evaluations (the smooth ones a few hundred Fresnel evaluations) and depend only on
+// (alpha, eta), so every plastic with the same coating computes them once. The cache lives as
+// long as the build that owns it: a long-running service that renders many distinct materials
+// keeps nothing between scenes.
+class CoatingTableCache {
+ public:
+  const CoatingTables& get(bool smooth, const GgxDistribution& distr, float eta);
+  size_t size() const { return tables_.size(); }
+
+ private:
+  std::map<std::pair<float, float>, std::unique_ptr<CoatingTables>> tables_;
+};
+
+// How many CoatingTables exist in the process (a test checks that nothing accumulates).
+int64_t coating_tables_alive();
+
+}  // namespace penumbra
