@@ -23,7 +23,7 @@
 #include "renderer/render/render.h"
 #include "renderer/scene/scene.h"
 
-namespace penumbra {
+namespace penumbra::test {
 namespace {
 
 constexpr int kSeeds = 4;           // independent renders per scene
@@ -145,4 +145,4 @@ INSTANTIATE_TEST_SUITE_P(Scenes, MitsubaReference, ::testing::ValuesIn(kScenes),
                          [](const ::testing::TestParamInfo<std::string>& info) { return info.param; });
 
 }  // namespace
-}  // namespace penumbra
+}  // namespace penumbra::test

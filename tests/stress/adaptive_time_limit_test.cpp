@@ -5,7 +5,7 @@
 
 #include "tests/stress/stress_util.h"
 
-namespace penumbra::stress {
+namespace penumbra::test {
 namespace {
 
 // Half the image is a flat, directly lit floor (converges at once), half a glossy/glass region
@@ -87,4 +87,4 @@ TEST(TimeLimit, StopsEarlyWithAFiniteCompleteImage) {
 }
 
 }  // namespace
-}  // namespace penumbra::stress
+}  // namespace penumbra::test

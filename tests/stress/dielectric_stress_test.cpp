@@ -6,7 +6,7 @@
 
 #include "tests/stress/stress_util.h"
 
-namespace penumbra::stress {
+namespace penumbra::test {
 namespace {
 
 constexpr float kGlassIor = 1.5f;
@@ -146,4 +146,4 @@ TEST(DielectricStress, CoincidentGlassBoxesInFurnace) {
 }
 
 }  // namespace
-}  // namespace penumbra::stress
+}  // namespace penumbra::test

@@ -9,7 +9,7 @@
 
 #include "tests/stress/stress_util.h"
 
-namespace penumbra::stress {
+namespace penumbra::test {
 namespace {
 
 struct EnergyCase {
@@ -45,7 +45,7 @@ TEST_P(Furnace, NeverAboveOneAndOneWhereConserved) {
   const EnergyCase& c = cases[size_t(index)];
   RenderSettings s = settings(16, 16, 64);
   s.integrator = kind;
-  const RenderResult r = render_input(testing::furnace_with_sphere(c.material), s);
+  const RenderResult r = render_input(furnace_with_sphere(c.material), s);
   EXPECT_EQ(nonfinite_count(r), 0) << c.name;
   const MeanAndError m = image_mean(r);
   const double noise = 4 * m.stderr_of_mean;
@@ -71,4 +71,4 @@ INSTANTIATE_TEST_SUITE_P(EveryBsdf, Furnace,
                                                               IntegratorKind::kDistributed)));
 
 }  // namespace
-}  // namespace penumbra::stress
+}  // namespace penumbra::test

@@ -6,10 +6,9 @@
 
 #include "tests/stress/stress_util.h"
 
-namespace penumbra::stress {
+namespace penumbra::test {
 namespace {
 
-using testing::furnace_with_sphere;
 
 // Roughness 1e-4 maps to GGX alpha 1e-8, below the smooth cut-off (alpha 1e-4): it must render
 // exactly as roughness 0. Roughness 0.0101 (alpha just above the cut-off) is the sharpest rough
@@ -293,4 +292,4 @@ TEST(Extremes, ExtremeApertures) {
 }
 
 }  // namespace
-}  // namespace penumbra::stress
+}  // namespace penumbra::test

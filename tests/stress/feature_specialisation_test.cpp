@@ -11,7 +11,7 @@
 #include "renderer/render/thin_lens_camera.h"
 #include "tests/stress/stress_util.h"
 
-namespace penumbra::stress {
+namespace penumbra::test {
 namespace {
 
 // The render loop of renderer/render.cpp (same sampler dimensions, same accumulation order and
@@ -144,4 +144,4 @@ TEST(FeatureSpecialisation, ZeroVelocityAndApertureCountAsAbsent) {
 }
 
 }  // namespace
-}  // namespace penumbra::stress
+}  // namespace penumbra::test

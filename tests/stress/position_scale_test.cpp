@@ -16,7 +16,7 @@
 
 #include "tests/stress/stress_util.h"
 
-namespace penumbra::stress {
+namespace penumbra::test {
 namespace {
 
 struct Placement {
@@ -116,4 +116,4 @@ TEST(PositionScale, TranslatedBy1e6) { expect_same_image({1.0, 1e6}); }
 TEST(PositionScale, ScaledByOneThousandthAndTranslatedBy1e3) { expect_same_image({1e-3, 1e3}); }
 
 }  // namespace
-}  // namespace penumbra::stress
+}  // namespace penumbra::test

@@ -17,7 +17,7 @@
 #include "renderer/render/thin_lens_camera.h"
 #include "tests/stress/stress_util.h"
 
-namespace penumbra::stress {
+namespace penumbra::test {
 namespace {
 
 struct Placement {
@@ -436,4 +436,4 @@ TEST(LightLeakTouching, LightInOneOfTwoTouchingBoxesStaysInside) {
 }
 
 }  // namespace
-}  // namespace penumbra::stress
+}  // namespace penumbra::test

@@ -14,7 +14,7 @@
 #include "renderer/scene/scene_input.h"
 #include "tests/renderer/render/render_test_util.h"
 
-namespace penumbra::stress {
+namespace penumbra::test {
 
 inline RenderSettings settings(int w, int h, int spp, int max_depth = -1, uint64_t seed = 0) {
   RenderSettings s;
@@ -26,7 +26,6 @@ inline RenderSettings settings(int w, int h, int spp, int max_depth = -1, uint64
   return s;
 }
 
-using testing::render_input;
 
 // Loads JSON scene text with the public loader (asserting it is valid) and renders it.
 inline RenderResult render_json(const std::string& json, const RenderSettings* override_settings = nullptr) {
@@ -119,14 +118,13 @@ inline BlockComparison compare_blocks(const RenderResult& a, const RenderResult&
 }
 
 // Scene-building helpers shared with the renderer tests.
-using testing::camera_looking;
 inline ObjectDesc quad(const vec3& origin, const vec3& u, const vec3& v, uint32_t material,
                        const Spectrum& emission = Spectrum(0.f)) {
-  return testing::quad_object(origin, u, v, material, emission);
+  return quad_object(origin, u, v, material, emission);
 }
 inline ObjectDesc sphere(const vec3& center, float radius, uint32_t material,
                          const Spectrum& emission = Spectrum(0.f)) {
-  return testing::sphere_object(center, radius, material, emission);
+  return sphere_object(center, radius, material, emission);
 }
 
 inline ObjectDesc box(const vec3& lo, const vec3& hi, uint32_t material) {
@@ -166,4 +164,4 @@ inline MeshDesc uv_sphere_mesh(const vec3& center, float radius, int rings, int 
   return m;
 }
 
-}  // namespace penumbra::stress
+}  // namespace penumbra::test

@@ -5,7 +5,7 @@
 
 #include "tests/renderer/materials/bsdf_test_util.h"
 
-namespace penumbra {
+namespace penumbra::test {
 namespace {
 
 using test::Chi2Config;
@@ -65,4 +65,4 @@ INSTANTIATE_TEST_SUITE_P(BsdfAllMaterials, BsdfChi2Test,
                          ::testing::Range(0, int(chi2_cases().size())));
 
 }  // namespace
-}  // namespace penumbra
+}  // namespace penumbra::test

@@ -4,7 +4,7 @@
 
 #include "tests/renderer/materials/bsdf_test_util.h"
 
-namespace penumbra {
+namespace penumbra::test {
 namespace {
 
 std::vector<MaterialParams> all_materials() {
@@ -127,4 +127,4 @@ TEST(BsdfConsistency, AbsorptionOnlyForDielectrics) {
 }
 
 }  // namespace
-}  // namespace penumbra
+}  // namespace penumbra::test

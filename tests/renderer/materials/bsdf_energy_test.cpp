@@ -12,7 +12,7 @@
 #include "renderer/materials/plastic.h"
 #include "tests/renderer/materials/bsdf_test_util.h"
 
-namespace penumbra {
+namespace penumbra::test {
 namespace {
 
 struct Albedo {
@@ -211,4 +211,4 @@ TEST(BsdfEnergy, RoughPlasticBelowIorOneNeverGains) {
 }
 
 }  // namespace
-}  // namespace penumbra
+}  // namespace penumbra::test

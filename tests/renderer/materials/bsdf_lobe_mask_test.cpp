@@ -4,7 +4,7 @@
 
 #include "tests/renderer/materials/bsdf_test_util.h"
 
-namespace penumbra {
+namespace penumbra::test {
 namespace {
 
 TEST(BsdfLobeMask, EvalIsSumOverDisjointMasks) {
@@ -78,4 +78,4 @@ TEST(BsdfLobeMask, LobesMatchModel) {
 }
 
 }  // namespace
-}  // namespace penumbra
+}  // namespace penumbra::test

@@ -5,7 +5,7 @@
 
 #include "tests/renderer/materials/bsdf_test_util.h"
 
-namespace penumbra {
+namespace penumbra::test {
 namespace {
 
 TEST(BsdfReciprocity, ReflectionAndRefraction) {
@@ -44,4 +44,4 @@ TEST(BsdfReciprocity, ReflectionAndRefraction) {
 }
 
 }  // namespace
-}  // namespace penumbra
+}  // namespace penumbra::test

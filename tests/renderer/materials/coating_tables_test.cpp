@@ -29,7 +29,7 @@ SceneInput plastics_scene(int first, int count) {
 TEST(CoatingTables, ManyDistinctRoughPlasticsLeaveNothingBehind) {
   const int64_t before = coating_tables_alive();
   for (int scene = 0; scene < 24; ++scene) {
-    const RenderResult r = testing::render_input(plastics_scene(5 * scene, 5), testing::small_settings(8, 8, 1, 3));
+    const RenderResult r = render_input(plastics_scene(5 * scene, 5), small_settings(8, 8, 1, 3));
     ASSERT_EQ(r.stats.nonfinite_samples, 0u);
     EXPECT_EQ(coating_tables_alive(), before) << "after scene " << scene;
   }

@@ -7,7 +7,7 @@
 #include "renderer/core/quadrature.h"
 #include "tests/renderer/materials/bsdf_test_util.h"
 
-namespace penumbra {
+namespace penumbra::test {
 namespace {
 
 TEST(FresnelDielectric, KnownValues) {
@@ -132,4 +132,4 @@ TEST(MicrofacetGgx, NormalisedAndVisibleNormalsNormalised) {
 }
 
 }  // namespace
-}  // namespace penumbra
+}  // namespace penumbra::test

@@ -7,7 +7,7 @@
 
 #include "renderer/render/adaptive_sampling.h"
 
-namespace penumbra {
+namespace penumbra::test {
 namespace {
 
 constexpr int kW = 64, kH = 64;
@@ -87,4 +87,4 @@ TEST(AdaptiveSampleLimits, AnIsolatedQuietPixelIsJudgedByItsNeighbourhood) {
 }
 
 }  // namespace
-}  // namespace penumbra
+}  // namespace penumbra::test

@@ -3,7 +3,7 @@
 
 #include "renderer/render/thin_lens_camera.h"
 
-namespace penumbra {
+namespace penumbra::test {
 namespace {
 
 CameraDesc desc(float aperture) {
@@ -46,4 +46,4 @@ TEST(ThinLensCamera, LensRaysConvergeOnThePlaneOfFocus) {
 }
 
 }  // namespace
-}  // namespace penumbra
+}  // namespace penumbra::test

@@ -4,7 +4,7 @@
 
 #include "tests/renderer/render/render_test_util.h"
 
-namespace penumbra::testing {
+namespace penumbra::test {
 namespace {
 
 SceneInput busy_scene() {
@@ -51,4 +51,4 @@ TEST(RenderDeterminism, DifferentSeedGivesDifferentNoise) {
 }
 
 }  // namespace
-}  // namespace penumbra::testing
+}  // namespace penumbra::test

@@ -8,7 +8,7 @@
 #include "renderer/render/thin_lens_camera.h"
 #include "tests/renderer/render/render_test_util.h"
 
-namespace penumbra::testing {
+namespace penumbra::test {
 namespace {
 
 constexpr float kAlbedo = 0.5f;
@@ -161,4 +161,4 @@ TEST(RenderDirectLight, DistributedIntegratorMatchesForDiffuseDirectLight) {
 }
 
 }  // namespace
-}  // namespace penumbra::testing
+}  // namespace penumbra::test

@@ -4,7 +4,7 @@
 
 #include "tests/renderer/render/render_test_util.h"
 
-namespace penumbra::testing {
+namespace penumbra::test {
 namespace {
 
 // Every pixel's mean must lie within `k` standard errors of 1 (pooled over the image).
@@ -67,4 +67,4 @@ TEST(RenderFurnace, PlasticNeverGainsEnergy) {
 }
 
 }  // namespace
-}  // namespace penumbra::testing
+}  // namespace penumbra::test

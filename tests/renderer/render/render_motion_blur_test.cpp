@@ -4,7 +4,7 @@
 
 #include "tests/renderer/render/render_test_util.h"
 
-namespace penumbra::testing {
+namespace penumbra::test {
 namespace {
 
 struct Moments {
@@ -82,4 +82,4 @@ TEST(RenderMotionBlur, ZeroShutterPlacesObjectAtShutterTime) {
 }
 
 }  // namespace
-}  // namespace penumbra::testing
+}  // namespace penumbra::test

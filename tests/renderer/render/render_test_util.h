@@ -7,7 +7,7 @@
 #include "renderer/scene/scene.h"
 #include "renderer/scene/scene_input.h"
 
-namespace penumbra::testing {
+namespace penumbra::test {
 
 inline RenderSettings small_settings(int w, int h, int spp, int max_depth = -1) {
   RenderSettings s;
@@ -100,4 +100,4 @@ inline SceneInput furnace_with_sphere(const MaterialParams& material) {
   return in;
 }
 
-}  // namespace penumbra::testing
+}  // namespace penumbra::test

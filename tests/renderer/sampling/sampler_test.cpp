@@ -6,7 +6,7 @@
 
 #include "renderer/sampling/sampler.h"
 
-namespace penumbra {
+namespace penumbra::test {
 namespace {
 
 TEST(Sampler, ValuesAreInUnitInterval) {
@@ -76,9 +76,9 @@ TEST(Sampler, PixelsAndDimensionsAreDecorrelated) {
 }
 
 }  // namespace
-}  // namespace penumbra
+}  // namespace penumbra::test
 
-namespace penumbra {
+namespace penumbra::test {
 namespace {
 TEST(Sampler, TableDrivenSobolMatchesBitLoop) {
   uint32_t x = 12345;
@@ -90,4 +90,4 @@ TEST(Sampler, TableDrivenSobolMatchesBitLoop) {
             reverse_bits32(laine_karras_permutation(77u, 991u)));
 }
 }  // namespace
-}  // namespace penumbra
+}  // namespace penumbra::test

@@ -10,7 +10,7 @@
 #include "renderer/scene/scene.h"
 #include "tests/renderer/render/render_test_util.h"
 
-namespace penumbra::testing {
+namespace penumbra::test {
 namespace {
 
 struct Case {
@@ -117,9 +117,9 @@ INSTANTIATE_TEST_SUITE_P(
     [](const auto& info) { return std::string(info.param.name); });
 
 }  // namespace
-}  // namespace penumbra::testing
+}  // namespace penumbra::test
 
-namespace penumbra {
+namespace penumbra::test {
 namespace {
 TEST(NextFloat, MatchesNextafter) {
   for (float v : {0.f, -0.f, 1.f, -1.f, 1e-40f, -1e-40f, 3.5e6f, -2.25e-3f, 1e38f, -1e38f}) {
@@ -128,4 +128,4 @@ TEST(NextFloat, MatchesNextafter) {
   }
 }
 }  // namespace
-}  // namespace penumbra
+}  // namespace penumbra::test
