@@ -24,9 +24,8 @@ float diffuse_scale(double eta, double internal_transmittance) {
 CoatingTables smooth_coating_tables(float eta) {
   // Light inside the coating sees the relative ior 1/eta. The exact average makes
   // eta^2 (1 - fdr_int) equal the external diffuse transmittance 1 - fdr_ext (see
-  // fresnel_diffuse), so the smooth plastic with a white base reflects exactly 1 at every angle.
-  // (With Mitsuba's polynomial fit a white plastic rendered 1.016 in a furnace at ior 2.4, and
-  // at ior 4 the fit's fdr_int exceeds 1.)
+  // fresnel_diffuse), so the smooth plastic with a white base reflects exactly 1 at every angle;
+  // Mitsuba's polynomial fit gains energy at high ior (docs/design-notes.md).
   const DiffuseFresnel internal = fresnel_diffuse(1.0 / double(eta));
   CoatingTables tables;
   tables.internal_reflectance = float(internal.reflectance);
@@ -36,10 +35,9 @@ CoatingTables smooth_coating_tables(float eta) {
 
 // Cosines at which the rough coating's external transmittance t(mu) is tabulated for eta >= 1.
 // Where t varies fastest, linear interpolation between uniform nodes over-estimates it, and the
-// interpolated t added to the exactly evaluated glossy reflection then exceeds 1 (measured with
-// Mitsuba's uniform nodes: 1.004 at 89.9 degrees for ior 1.01, roughness 0.0101). So the nodes
+// interpolated t added to the exactly evaluated glossy reflection then exceeds 1. So the nodes
 // cluster at grazing incidence, where t has its steep foot: mu = x^2 for x uniform in [0, 1]
-// (measured: <= 1 for ior 1.0001..1e30, roughness 0.0101..1, 0..89.999 degrees).
+// (docs/design-notes.md has the range over which this keeps the sum <= 1).
 std::array<float, kCoatingTableRes> grazing_nodes() {
   constexpr int n = kCoatingTableRes;
   std::array<float, n> nodes{};
@@ -53,11 +51,10 @@ std::array<float, kCoatingTableRes> grazing_nodes() {
 
 // eta < 1 (the coating is the thinner medium): t rises from 0 (total reflection below the
 // critical cosine mu_c = sqrt(1 - eta^2) for a smooth coating) within a foot whose width scales
-// with alpha, down to ~1e-3 in mu at ior 0.1, roughness 0.05. Fixed clustering onto mu_c (cubic
-// below, quadratic above) left only ~2 nodes in that foot, and the interpolated t exceeded the
-// pointwise bound 1 - E_spec(mu) by up to 0.019 (ior 0.1, roughness 0.05, mu 0.9945): the
-// furnace gained 2%. So the nodes are placed adaptively: a coarse version of that clustering,
-// then repeated bisection of the cell whose midpoint value departs most from the chord (the
+// with alpha. A fixed clustering onto mu_c leaves too few nodes in a narrow foot and the
+// interpolated t then exceeds the bound 1 - E_spec(mu) (docs/design-notes.md). So the nodes are
+// placed adaptively: a coarse clustering (cubic below mu_c, quadratic above), then repeated
+// bisection of the cell whose midpoint value departs most from the chord (the
 // interpolation error of a piecewise-linear table, de Boor 1978 ch. III), which puts the nodes
 // where the foot's curvature is, whatever alpha and eta are.
 void adaptive_transmittance_table(const GgxDistribution& distr, float eta,
@@ -140,9 +137,7 @@ CoatingTables rough_coating_tables(const GgxDistribution& distr, float eta) {
     // coating. Taking the latter from the interpolated table itself makes the diffuse factor D =
     // diffuse_scale 2 \int t mu dmu exactly 1, so a white plastic reflects E_spec(mu_i) + t(mu_i)
     // <= 1. Mitsuba's mean over uniform nodes misses the total-internal-reflection jump of
-    // R_int at mu_c: it gave D = 1.002..1.010 at ior 0.1, roughness 0.0101..0.1 (the table's own
-    // over-estimate of t added the rest of the 2% gain). No Mitsuba result to match: its
-    // roughplastic rendered 1.32 at ior 0.5.
+    // R_int at mu_c and gains energy; there is no Mitsuba result to match below ior 1.
     tables.nodes = kCoatingTableCapacity;
     adaptive_transmittance_table(distr, eta, tables.cosines, tables.transmittance);
     const double external = table_diffuse_average(tables);
@@ -154,8 +149,7 @@ CoatingTables rough_coating_tables(const GgxDistribution& distr, float eta) {
   // internal reflectance 2 \int R_int(mu) mu dmu as the mean over mu = linspace(0, 1) -- Mitsuba
   // 3's roughplastic takes the same mean (and tabulates t on uniform nodes), so the diffuse part
   // matches it. That mean underestimates the average by about (fdr_int - R_int(1)) / 64, so the
-  // rough plastic returns less light than the smooth one (furnace at roughness 0.0101: 0.986 at
-  // ior 1.5, 0.83 at ior 10), not more.
+  // rough plastic returns less light than the smooth one, not more (docs/design-notes.md).
   tables.nodes = n;
   const std::array<float, n> nodes = grazing_nodes();
   std::copy(nodes.begin(), nodes.end(), tables.cosines.begin());

@@ -69,9 +69,8 @@ float integrate_visible_normals(const GgxDistribution& distr, float cos_i, int r
 }  // namespace
 
 float rough_dielectric_reflectance(const GgxDistribution& distr, float cos_i, float eta) {
-  // 64^2 Gauss-Legendre nodes (Mitsuba 3 uses 128^2 for the internal case): the averaged
-  // internal reflectance moves by at most 0.2% (alpha 0.01..1, ior 1.5) and the plastics
-  // reference image mean by 0.03%, while the tables of a rough plastic build 4x faster.
+  // 64^2 Gauss-Legendre nodes (Mitsuba 3 uses 128^2 for the internal case): a fraction of a
+  // percent on the averaged reflectance for a 4x faster table (docs/design-notes.md).
   const int res = eta > 1.f ? 32 : 64;
   return integrate_visible_normals(distr, cos_i, res, [&](const vec3& wi, const vec3& m) {
     const vec3 wo = reflect(wi, m);

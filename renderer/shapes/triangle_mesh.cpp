@@ -19,7 +19,7 @@ namespace {
 // point's error, so a ray can re-hit the triangle it leaves: the robust test accepts t == tnear
 // == 0 for a ray starting exactly on the plane (an exact hit point has a zero offset), and
 // Embree's plane distance carries an error of order eps times the distance of the triangle's
-// first vertex from the ray origin (docs/stability-and-features.md has the measurements).
+// first vertex from the ray origin (docs/design-notes.md has the measurements).
 // So every triangle hit passes this filter, which re-evaluates the sign of
 // t = ((p0 - o) . n) / (d . n) in double precision from the same float vertices hit points are
 // rebuilt from and keeps the hit only if t > 0. Products of floats are exact to 2^-53 in
