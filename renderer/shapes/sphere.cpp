@@ -147,11 +147,7 @@ ShapeSample sample_sphere(const vec3& center, float radius, const vec3& ref, con
     s.p = center + radius * n;
     s.n = n;
     s.p_error = gamma_bound(6) * (glm::abs(center) + glm::abs(n * radius));
-    const vec3 w = s.p - ref;
-    const float dist2 = glm::dot(w, w);
-    const float cos_l = std::abs(glm::dot(n, w)) / std::sqrt(dist2);
-    const float area = 4.f * kPi * r2;
-    s.pdf = cos_l > 0.f ? dist2 / (cos_l * area) : 0.f;
+    s.pdf = area_to_solid_angle(ref, s.p, n, 4.f * kPi * r2);
     return s;
   }
   const float dc = std::sqrt(dc2);
@@ -185,12 +181,7 @@ float sphere_pdf(const vec3& center, float radius, const vec3& ref, const vec3& 
   const vec3 to_center = center - ref;
   const float dc2 = glm::dot(to_center, to_center);
   const float r2 = radius * radius;
-  if (dc2 <= r2 * 1.0001f) {
-    const vec3 w = p - ref;
-    const float dist2 = glm::dot(w, w);
-    const float cos_l = std::abs(glm::dot(n, w)) / std::sqrt(dist2);
-    return cos_l > 0.f ? dist2 / (cos_l * 4.f * kPi * r2) : 0.f;
-  }
+  if (dc2 <= r2 * 1.0001f) return area_to_solid_angle(ref, p, n, 4.f * kPi * r2);
   const float sin2_max = r2 / dc2;
   const float one_minus_cos_max =
       sin2_max < 1e-3f ? sin2_max * 0.5f + sin2_max * sin2_max / 8.f : 1.f - safe_sqrt(1.f - sin2_max);

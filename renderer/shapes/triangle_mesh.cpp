@@ -53,6 +53,15 @@ int motion_time_steps(const Motion& motion, float span, float camera_distance) {
   return int(std::clamp(intervals, 1.f, 128.f)) + 1;
 }
 
+// The point b0 p0 + b1 p1 + b2 p2 and its error bound: pbrt-v4 section 6.8.4 bounds the error of
+// the barycentric sum by gamma(7).
+void barycentric_point(const vec3& p0, const vec3& p1, const vec3& p2, float b0, float b1, float b2,
+                       vec3* p, vec3* error) {
+  const vec3 t0 = b0 * p0, t1 = b1 * p1, t2 = b2 * p2;
+  *p = t0 + t1 + t2;
+  *error = gamma_bound(7) * (glm::abs(t0) + glm::abs(t1) + glm::abs(t2));
+}
+
 float triangle_area(const vec3& a, const vec3& b, const vec3& c) {
   return 0.5f * glm::length(glm::cross(b - a, c - a));
 }
@@ -160,10 +169,7 @@ void TriangleMesh::hit_geometry(const Ray& ray, float, uint32_t prim, const vec2
   const vec3 p1 = positions_[tri[1]] + disp;
   const vec3 p2 = positions_[tri[2]] + disp;
   const float b1 = uv.x, b2 = uv.y, b0 = 1.f - b1 - b2;
-  // pbrt-v4 section 6.8.4 bounds the error of the barycentric sum by gamma(7).
-  const vec3 t0 = b0 * p0, t1 = b1 * p1, t2 = b2 * p2;
-  hit->p = t0 + t1 + t2;
-  hit->p_error = gamma_bound(7) * (glm::abs(t0) + glm::abs(t1) + glm::abs(t2));
+  barycentric_point(p0, p1, p2, b0, b1, b2, &hit->p, &hit->p_error);
   vec3 ng = glm::cross(p1 - p0, p2 - p0);
   const float len = glm::length(ng);
   ng = len > 0.f ? ng / len : vec3(0.f, 0.f, 1.f);
@@ -191,9 +197,7 @@ bool TriangleMesh::sample(const vec3& ref, float time, const vec2& u, ShapeSampl
   const uint32_t* tri = &indices_[3 * t];
   const vec3 p0 = positions_[tri[0]] + disp, p1 = positions_[tri[1]] + disp,
              p2 = positions_[tri[2]] + disp;
-  const vec3 t0 = (1.f - b.x - b.y) * p0, t1 = b.x * p1, t2 = b.y * p2;
-  out->p = t0 + t1 + t2;
-  out->p_error = gamma_bound(7) * (glm::abs(t0) + glm::abs(t1) + glm::abs(t2));
+  barycentric_point(p0, p1, p2, 1.f - b.x - b.y, b.x, b.y, &out->p, &out->p_error);
   const vec3 ng = glm::cross(p1 - p0, p2 - p0);
   const float len = glm::length(ng);
   if (!(len > 0.f)) return false;
