@@ -33,7 +33,6 @@ inline vec3 flip_z(const vec3& v) { return vec3(v.x, v.y, -v.z); }
 }  // namespace
 
 struct Material::Impl {
-  MaterialParams params;
   BsdfModel model;
   bool two_sided;
 };
@@ -41,7 +40,7 @@ struct Material::Impl {
 Material::Material(const MaterialParams& params, CoatingTableCache* cache) {
   BsdfModel model = make_model(params, cache);
   const bool two_sided = std::visit([](const auto& m) { return m.two_sided(); }, model);
-  impl_ = std::make_unique<Impl>(Impl{params, std::move(model), two_sided});
+  impl_ = std::make_unique<Impl>(Impl{std::move(model), two_sided});
 }
 Material::~Material() = default;
 Material::Material(Material&&) noexcept = default;
@@ -82,7 +81,5 @@ Spectrum Material::absorption() const {
 }
 
 bool Material::two_sided() const { return impl_->two_sided; }
-
-const MaterialParams& Material::params() const { return impl_->params; }
 
 }  // namespace penumbra

@@ -33,7 +33,6 @@ class Material {
   // Beer-Lambert sigma_a of the interior, zero for everything that does not absorb inside.
   Spectrum absorption() const;
   bool has_absorption() const { return !is_black(absorption()); }
-  const MaterialParams& params() const;
 
  private:
   struct Impl;
