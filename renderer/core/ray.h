@@ -67,6 +67,7 @@ struct SurfaceHit {
   vec3 p_error;    // absolute error bound of p per component
   vec3 ng;         // unit geometric normal, the shape's front side (u x v, CCW, outside)
   vec3 ns;         // unit shading normal, same hemisphere as ng
+  vec2 uv{0.f};    // surface coordinates for textures (each shape documents its mapping)
   uint32_t object = 0;
   uint32_t primitive = 0;
 };

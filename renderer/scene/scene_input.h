@@ -38,6 +38,8 @@ struct MeshDesc {
   std::vector<vec3> positions;
   std::vector<uint32_t> indices;  // 3 per triangle
   std::vector<vec3> normals;
+  // Empty or one per position. (0, 0) is an image's top-left corner (glTF and Mitsuba 3).
+  std::vector<vec2> uvs;
 };
 using ShapeDesc = std::variant<SphereDesc, QuadDesc, MeshDesc>;
 

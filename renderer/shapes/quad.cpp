@@ -5,7 +5,8 @@ namespace {
 
 MeshDesc two_triangles(const QuadDesc& q) {
   const vec3 o = q.origin;
-  return MeshDesc{{o, o + q.u, o + q.u + q.v, o + q.v}, {0, 1, 2, 0, 2, 3}, {}};
+  // uv at o + s u + t v is (s, t).
+  return MeshDesc{{o, o + q.u, o + q.u + q.v, o + q.v}, {0, 1, 2, 0, 2, 3}, {}, {vec2(0, 0), vec2(1, 0), vec2(1, 1), vec2(0, 1)}};
 }
 
 QuadDesc moved(QuadDesc q, const vec3& offset) {

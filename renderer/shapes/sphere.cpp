@@ -95,6 +95,12 @@ Bounds3 Sphere::embree_bounds() const {
 
 void Sphere::hit_geometry(const Ray& ray, float t, uint32_t, const vec2&, SurfaceHit* hit) const {
   sphere_hit_geometry(center_at(ray.time), radius_, ray.origin + ray.direction * t, hit);
+  // Mitsuba 3's sphere: u = phi / 2 pi with phi = atan2(y, x) in [0, 2 pi), v = theta / pi from
+  // +z, in the sphere's frame (ours is unrotated).
+  const vec3 n = hit->ng;
+  float phi = std::atan2(n.y, n.x);
+  if (phi < 0.f) phi += 2.f * kPi;
+  hit->uv = vec2(phi * kInv2Pi, std::acos(std::clamp(n.z, -1.f, 1.f)) * kInvPi);
 }
 
 bool Sphere::sample(const vec3& ref, float time, const vec2& u, ShapeSample* out) const {

@@ -69,7 +69,7 @@ float triangle_area(const vec3& a, const vec3& b, const vec3& c) {
 }  // namespace
 
 TriangleMesh::TriangleMesh(const MeshDesc& desc, const ShapeContext& ctx)
-    : positions_(desc.positions), indices_(desc.indices), normals_(desc.normals) {
+    : positions_(desc.positions), indices_(desc.indices), normals_(desc.normals), uvs_(desc.uvs) {
   for (vec3& p : positions_) p += ctx.offset;
   const size_t n = indices_.size() / 3;
   std::vector<float> areas(n);
@@ -170,6 +170,7 @@ void TriangleMesh::hit_geometry(const Ray& ray, float, uint32_t prim, const vec2
   const vec3 p2 = positions_[tri[2]] + disp;
   const float b1 = uv.x, b2 = uv.y, b0 = 1.f - b1 - b2;
   barycentric_point(p0, p1, p2, b0, b1, b2, &hit->p, &hit->p_error);
+  hit->uv = uvs_.empty() ? vec2(b1, b2) : b0 * uvs_[tri[0]] + b1 * uvs_[tri[1]] + b2 * uvs_[tri[2]];
   vec3 ng = glm::cross(p1 - p0, p2 - p0);
   const float len = glm::length(ng);
   ng = len > 0.f ? ng / len : vec3(0.f, 0.f, 1.f);

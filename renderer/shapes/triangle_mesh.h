@@ -1,6 +1,7 @@
 #pragma once
 // A triangle mesh: Embree's watertight triangle test with the sign of t settled exactly, hit
-// points rebuilt from barycentrics, shading normals interpolated, uniform sampling by area.
+// points rebuilt from barycentrics, shading normals and uvs interpolated (without uvs a hit's uv
+// is its barycentrics (b1, b2), as Mitsuba 3), uniform sampling by area.
 #include <vector>
 
 #include "renderer/scene/scene_input.h"
@@ -42,6 +43,7 @@ class TriangleMesh : public Shape {
   std::vector<vec3> positions_;  // world space at time 0
   std::vector<uint32_t> indices_;
   std::vector<vec3> normals_;  // empty or one per position
+  std::vector<vec2> uvs_;      // empty or one per position
   std::vector<float> triangle_cdf_;  // emitters: cumulative triangle areas, normalised
   float area_ = 0.f;
   Bounds3 bounds_;

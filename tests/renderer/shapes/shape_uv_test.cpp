@@ -1,0 +1,55 @@
+// Surface coordinates of hits: a quad's (s, t), a sphere's Mitsuba 3 mapping, a mesh's
+// interpolated uvs (barycentrics without them).
+#include <gtest/gtest.h>
+
+#include "renderer/scene/scene.h"
+
+namespace penumbra::test {
+namespace {
+
+SurfaceHit hit_from_above(const ShapeDesc& shape, const vec3& target) {
+  SceneInput in;
+  in.materials = {DiffuseParams{}};
+  ObjectDesc o;
+  o.shape = shape;
+  in.objects = {o};
+  const auto scene = Scene::build(in);
+  SurfaceHit hit;
+  EXPECT_TRUE(scene->intersect(Ray{target + vec3(0.f, 0.f, 5.f), vec3(0.f, 0.f, -1.f), 0.f}, &hit));
+  return hit;
+}
+
+TEST(ShapeUv, QuadUvIsSAndT) {
+  const QuadDesc q{vec3(1.f, 2.f, 0.f), vec3(2.f, 0.f, 0.f), vec3(0.5f, 1.f, 0.f)};
+  for (const vec2 st : {vec2(0.25f, 0.75f), vec2(0.8f, 0.1f), vec2(0.5f, 0.5f)}) {
+    const SurfaceHit h = hit_from_above(q, q.origin + st.x * q.u + st.y * q.v);
+    EXPECT_NEAR(h.uv.x, st.x, 1e-5f);
+    EXPECT_NEAR(h.uv.y, st.y, 1e-5f);
+  }
+}
+
+TEST(ShapeUv, SphereUvFollowsMitsuba) {
+  // From +z straight down onto the pole: theta = 0. Off the pole towards +y: phi = pi/2.
+  const SurfaceHit pole = hit_from_above(SphereDesc{vec3(0.f), 1.f}, vec3(0.f));
+  EXPECT_NEAR(pole.uv.y, 0.f, 1e-3f);
+  const float s = std::sin(0.5f);
+  const SurfaceHit side = hit_from_above(SphereDesc{vec3(0.f), 1.f}, vec3(0.f, s, 0.f));
+  EXPECT_NEAR(side.uv.x, 0.25f, 1e-5f);
+  EXPECT_NEAR(side.uv.y, 0.5f / kPi, 1e-4f);
+  const SurfaceHit neg = hit_from_above(SphereDesc{vec3(0.f), 1.f}, vec3(0.f, -s, 0.f));
+  EXPECT_NEAR(neg.uv.x, 0.75f, 1e-5f);  // phi wrapped into [0, 2 pi)
+}
+
+TEST(ShapeUv, MeshInterpolatesItsUvsOrGivesBarycentrics) {
+  MeshDesc m{{vec3(0.f), vec3(1.f, 0.f, 0.f), vec3(0.f, 1.f, 0.f)}, {0, 1, 2}, {}, {}};
+  const SurfaceHit bary = hit_from_above(m, vec3(0.2f, 0.3f, 0.f));
+  EXPECT_NEAR(bary.uv.x, 0.2f, 1e-5f);
+  EXPECT_NEAR(bary.uv.y, 0.3f, 1e-5f);
+  m.uvs = {vec2(0.5f, 0.5f), vec2(1.f, 0.5f), vec2(0.5f, 0.f)};
+  const SurfaceHit mapped = hit_from_above(m, vec3(0.2f, 0.3f, 0.f));
+  EXPECT_NEAR(mapped.uv.x, 0.5f + 0.5f * 0.2f, 1e-5f);
+  EXPECT_NEAR(mapped.uv.y, 0.5f - 0.5f * 0.3f, 1e-5f);
+}
+
+}  // namespace
+}  // namespace penumbra::test
