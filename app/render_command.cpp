@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include "api/scene_loader.h"
+#include "api/version.h"
 #include "app/commands.h"
 #include "app/option_parsing.h"
 #include "renderer/io/image_io.h"
@@ -121,7 +122,7 @@ int run_render(int argc, char** argv) {
       {"penumbra:render_seconds", std::to_string(st.seconds)},
       {"penumbra:seed", std::to_string(settings.seed)},
       {"penumbra:integrator", settings.integrator == IntegratorKind::kPath ? "path" : "distributed"},
-      {"Software", "penumbra 0.1.0"},
+      {"Software", api::kSoftwareName},
   };
   try {
     write_image_file(output, result.image, meta);
