@@ -4,6 +4,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <string>
+#include <vector>
 #include <unistd.h>
 
 #include "api/scene_loader.h"
@@ -20,13 +21,14 @@ const char* kUsage =
     "usage: penumbra render SCENE.json -o OUT.{png,exr} [options]\n"
     "\n"
     "Renders a scene (format v1, see docs/scene-format.md). Options override the scene's\n"
-    "\"render\" settings:\n"
+    "\"render\" settings and are checked as those fields are, with the same limits:\n"
     "  -o, --output FILE        output image; .png (sRGB 8-bit) or .exr (linear float)\n"
     "  --spp N                  samples per pixel\n"
     "  --width N, --height N    image size in pixels\n"
     "  --seed N                 sampler seed (same seed, same image, any thread count)\n"
     "  --threads N              render threads (default: all cores)\n"
     "  --max-depth N            path segments (-1 = unlimited)\n"
+    "  --rr-depth N             depth at which Russian roulette starts\n"
     "  --integrator NAME        path | distributed\n"
     "  --time-limit SECONDS     stop at this budget with a correct (less converged) image\n"
     "  --noise-threshold X      adaptive sampling: aim for this relative RMS error (0.05 = 5%);\n"
@@ -46,7 +48,7 @@ std::string format_duration(double s) {
 int run_render(int argc, char** argv) {
   std::string scene_path, output;
   bool quiet = false;
-  OptionalOverrides ov;
+  std::vector<api::RenderOverride> overrides;
   OptionParser p(argc, argv);
   while (p.next()) {
     if (p.is("-h") || p.is("--help")) {
@@ -56,7 +58,7 @@ int run_render(int argc, char** argv) {
       if (!p.value(&output)) return p.fail(kUsage);
     } else if (p.is("-q") || p.is("--quiet")) {
       quiet = true;
-    } else if (ov.parse(p)) {
+    } else if (parse_render_override(p, overrides)) {
       if (p.failed()) return p.fail(kUsage);
     } else if (p.positional()) {
       if (!scene_path.empty()) return p.fail(kUsage, "more than one scene given");
@@ -75,7 +77,7 @@ int run_render(int argc, char** argv) {
     return 2;
   }
 
-  api::LoadResult loaded = api::load_scene_file(scene_path);
+  api::LoadResult loaded = api::load_scene_file(scene_path, {}, overrides);
   for (const auto& w : loaded.warnings)
     std::fprintf(stderr, "%s: warning: %s\n", scene_path.c_str(), w.to_string().c_str());
   if (!loaded.ok()) {
@@ -83,11 +85,7 @@ int run_render(int argc, char** argv) {
       std::fprintf(stderr, "%s: %s\n", scene_path.c_str(), e.to_string().c_str());
     return 1;
   }
-  RenderSettings settings = loaded.request->settings;
-  if (const std::string err = ov.apply(&settings); !err.empty()) {
-    std::fprintf(stderr, "penumbra render: %s\n", err.c_str());
-    return 2;
-  }
+  const RenderSettings& settings = loaded.request->settings;
 
   const auto build_start = std::chrono::steady_clock::now();
   const auto scene = Scene::build(loaded.request->scene);
