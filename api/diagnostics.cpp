@@ -4,14 +4,40 @@
 
 namespace penumbra::api {
 
+namespace {
+void attribute(Diagnostic& d, const std::vector<std::pair<std::string, std::string>>& flags) {
+  for (const auto& [pointer, flag] : flags)
+    if (d.flag.empty() && d.pointer == pointer) d.flag = flag;
+}
+}  // namespace
+
+std::string Diagnostic::to_string() const {
+  const std::string where = pointer.empty() ? "/" : pointer;
+  if (flag.empty()) return where + ": " + message;
+  return flag + (pointer.empty() ? "" : " (" + pointer + ")") + ": " + message;
+}
+
 void Diagnostics::error(std::string pointer, std::string message) {
+  error(Diagnostic{std::move(pointer), std::move(message)});
+}
+
+void Diagnostics::error(Diagnostic diagnostic) {
   ++error_count_;
-  if (errors_.size() < kMaxReported) errors_.push_back({std::move(pointer), std::move(message)});
+  if (errors_.size() >= kMaxReported) return;
+  attribute(diagnostic, flags_);
+  errors_.push_back(std::move(diagnostic));
 }
 
 void Diagnostics::warning(std::string pointer, std::string message) {
   ++warning_count_;
-  if (warnings_.size() < kMaxReported) warnings_.push_back({std::move(pointer), std::move(message)});
+  if (warnings_.size() >= kMaxReported) return;
+  Diagnostic diagnostic{std::move(pointer), std::move(message)};
+  attribute(diagnostic, flags_);
+  warnings_.push_back(std::move(diagnostic));
+}
+
+void Diagnostics::attribute_to_flag(std::string pointer, std::string flag) {
+  flags_.emplace_back(std::move(pointer), std::move(flag));
 }
 
 std::vector<Diagnostic> Diagnostics::take_errors() {

@@ -4,6 +4,7 @@
 #include <cstddef>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "api/scene_loader.h"
@@ -15,7 +16,13 @@ class Diagnostics {
   static constexpr std::size_t kMaxReported = 100;
 
   void error(std::string pointer, std::string message);
+  void error(Diagnostic diagnostic);
   void warning(std::string pointer, std::string message);
+
+  // From now on, diagnostics on `pointer` are about a value the command-line flag `flag`
+  // supplied, and carry it (Diagnostic::flag). Earlier ones, such as a duplicate key in the JSON
+  // text, stay about the JSON.
+  void attribute_to_flag(std::string pointer, std::string flag);
 
   std::size_t error_count() const { return error_count_; }
   bool has_errors() const { return error_count_ > 0; }
@@ -27,6 +34,7 @@ class Diagnostics {
  private:
   std::vector<Diagnostic> errors_;
   std::vector<Diagnostic> warnings_;
+  std::vector<std::pair<std::string, std::string>> flags_;  // pointer -> flag
   std::size_t error_count_ = 0;
   std::size_t warning_count_ = 0;
 };

@@ -145,6 +145,14 @@ std::optional<glm::dvec3> read_vec3(const Json& value, const std::string& pointe
   return result;
 }
 
+bool within_count_limit(std::size_t count, int64_t limit, std::string_view what,
+                        std::string_view limit_name, const std::string& pointer, Diagnostics& diag) {
+  if (count <= uint64_t(limit)) return true;
+  diag.error(pointer, std::to_string(count) + " " + std::string(what) + " exceed the limit of " +
+                          std::to_string(limit) + " (" + std::string(limit_name) + ")");
+  return false;
+}
+
 ObjectReader::ObjectReader(const Json& value, std::string pointer, Diagnostics& diag)
     : pointer_(std::move(pointer)), diag_(diag) {
   if (value.is_object())

@@ -59,6 +59,11 @@ std::optional<std::string> read_string(const Json& value, const std::string& poi
 std::optional<glm::dvec3> read_vec3(const Json& value, const std::string& pointer,
                                     Diagnostics& diag, const Range& range = Range::any());
 
+// A collection's size against its limit, checked before any element is read: over it, reports
+// "<count> <what> exceed the limit of <limit> (<limit_name>)" on `pointer` and returns false.
+bool within_count_limit(std::size_t count, int64_t limit, std::string_view what,
+                        std::string_view limit_name, const std::string& pointer, Diagnostics& diag);
+
 enum class Presence { kOptional, kRequired };
 
 class ObjectReader {

@@ -63,11 +63,9 @@ ParsedMaterials parse_materials(const Json* materials, const std::string& pointe
     diag.error(pointer, "must be an object mapping material names to materials");
     return parsed;
   }
-  if (materials->size() > std::size_t(limits.max_materials)) {
-    diag.error(pointer, std::to_string(materials->size()) + " materials exceed the limit of " +
-                            std::to_string(limits.max_materials) + " (max_materials)");
+  if (!within_count_limit(materials->size(), limits.max_materials, "materials", "max_materials",
+                          pointer, diag))
     return parsed;
-  }
   for (const auto& [name, value] : materials->items()) {
     const auto material = parse_material(value, child_pointer(pointer, name), diag);
     parsed.index[name] = uint32_t(parsed.names.size());

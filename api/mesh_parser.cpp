@@ -91,9 +91,9 @@ std::optional<MeshDesc> parse_mesh(ObjectReader& reader, const AffineTransform& 
   if (positions_json->empty()) {
     reader.error("positions", "must contain at least one vertex");
     sizes_ok = false;
-  } else if (vertex_count > max_vertices) {
-    reader.error("positions", std::to_string(vertex_count) + " vertices exceed the limit of " +
-                                  std::to_string(max_vertices) + " (3 x max_triangles)");
+  } else if (!within_count_limit(vertex_count, int64_t(max_vertices), "vertices",
+                                 "3 x max_triangles", reader.pointer_of("positions"),
+                                 reader.diagnostics())) {
     sizes_ok = false;
   }
   const std::size_t triangle_count = indices_json->size() / 3;

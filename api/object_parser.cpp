@@ -88,11 +88,9 @@ ParsedObjects parse_objects(const Json* objects, const std::string& pointer,
     diag.error(pointer, "must be an array of objects");
     return parsed;
   }
-  if (objects->size() > std::size_t(limits.max_objects)) {
-    diag.error(pointer, std::to_string(objects->size()) + " objects exceed the limit of " +
-                            std::to_string(limits.max_objects) + " (max_objects)");
+  if (!within_count_limit(objects->size(), limits.max_objects, "objects", "max_objects", pointer,
+                          diag))
     return parsed;
-  }
 
   for (std::size_t i = 0; i < objects->size(); ++i) {
     ObjectReader reader((*objects)[i], child_pointer(pointer, i), diag);

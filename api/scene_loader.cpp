@@ -7,11 +7,13 @@
 
 #include "api/diagnostics.h"
 #include "api/json_document.h"
+#include "api/render_overrides.h"
 #include "api/scene_parser.h"
 
 namespace penumbra::api {
 
-LoadResult load_scene(std::string_view json_text, const Limits& limits) {
+LoadResult load_scene(std::string_view json_text, const Limits& limits,
+                      std::span<const RenderOverride> overrides) {
   LoadResult result;
   Diagnostics diag;
   try {
@@ -20,7 +22,9 @@ LoadResult load_scene(std::string_view json_text, const Limits& limits) {
       result.kind = LoadErrorKind::kSyntax;
     } else {
       // Duplicate keys were reported by the document parser; keep checking everything else.
+      const std::optional<int> threads = apply_render_overrides(*document.value, overrides, diag);
       auto request = parse_scene(*document.value, limits, diag);
+      if (request && threads) request->settings.threads = *threads;
       if (!diag.has_errors()) result.request = std::move(request);
     }
   } catch (const std::bad_alloc&) {
@@ -39,7 +43,8 @@ LoadResult load_scene(std::string_view json_text, const Limits& limits) {
   return result;
 }
 
-LoadResult load_scene_file(const std::string& path, const Limits& limits) {
+LoadResult load_scene_file(const std::string& path, const Limits& limits,
+                           std::span<const RenderOverride> overrides) {
   std::error_code ec;
   std::ifstream file;
   if (!std::filesystem::is_directory(path, ec)) file.open(path, std::ios::binary);
@@ -51,7 +56,7 @@ LoadResult load_scene_file(const std::string& path, const Limits& limits) {
     result.errors.push_back({"", "cannot read file '" + path + "'"});
     return result;
   }
-  return load_scene(text.str(), limits);
+  return load_scene(text.str(), limits, overrides);
 }
 
 }  // namespace penumbra::api

@@ -4,6 +4,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -15,7 +16,11 @@ namespace penumbra::api {
 struct Diagnostic {
   std::string pointer;  // RFC 6901 JSON pointer, "" for the document root
   std::string message;
-  std::string to_string() const { return (pointer.empty() ? std::string("/") : pointer) + ": " + message; }
+  // The command-line flag that supplied the value ("--width"), when one did: the CLI's user
+  // typed no JSON there, so the message must name what they did type.
+  std::string flag = {};
+  // "/render/width: must be ...", or with a flag "--width (/render/width): must be ...".
+  std::string to_string() const;
 };
 
 // Caps on what one scene may ask for; each documented in docs/scene-format.md.
@@ -56,8 +61,19 @@ struct LoadResult {
   bool ok() const { return errors.empty(); }
 };
 
-LoadResult load_scene(std::string_view json_text, const Limits& limits = {});
+// A command-line flag overriding a member of the scene's "render" block, as typed ("--width",
+// "640"); api/render_overrides.h lists the flags and says how they are checked.
+struct RenderOverride {
+  std::string flag;
+  std::string value;
+};
+
+// `overrides` (the CLI's render flags; none for the service) are written into the document
+// before it is checked, so they meet the same checks and limits as the JSON they replace.
+LoadResult load_scene(std::string_view json_text, const Limits& limits = {},
+                      std::span<const RenderOverride> overrides = {});
 // Reads the file (a read failure is reported as an error on pointer "") and calls load_scene.
-LoadResult load_scene_file(const std::string& path, const Limits& limits = {});
+LoadResult load_scene_file(const std::string& path, const Limits& limits = {},
+                           std::span<const RenderOverride> overrides = {});
 
 }  // namespace penumbra::api

@@ -146,11 +146,8 @@ void parse_lights(const Json* value, const Limits& limits, const glm::dvec3& ori
     diag.error("/lights", "must be an array of lights");
     return;
   }
-  if (value->size() > std::size_t(limits.max_lights)) {
-    diag.error("/lights", std::to_string(value->size()) + " lights exceed the limit of " +
-                              std::to_string(limits.max_lights) + " (max_lights)");
+  if (!within_count_limit(value->size(), limits.max_lights, "lights", "max_lights", "/lights", diag))
     return;
-  }
   const Range coordinate = Range::closed(-kMaxCoordinate, kMaxCoordinate);
   for (std::size_t i = 0; i < value->size(); ++i) {
     ObjectReader r((*value)[i], child_pointer("/lights", i), diag);

@@ -4,6 +4,7 @@
 #include <exception>
 #include <string>
 
+#include "api/version.h"
 #include "app/commands.h"
 #ifdef PENUMBRA_HAVE_SERVER
 #include "server/serve_command.h"
@@ -41,7 +42,7 @@ int main(int argc, char** argv) {
     if (command == "serve") return penumbra::server::run_serve(argc - 1, argv + 1);
 #endif
     if (command == "--version") {
-      std::printf("penumbra 0.1.0\n");
+      std::printf("%s\n", penumbra::api::kSoftwareName);
       return 0;
     }
   } catch (const std::exception& e) {

@@ -2,8 +2,9 @@
 // Small command-line parsing helpers shared by the subcommands.
 #include <optional>
 #include <string>
+#include <vector>
 
-#include "renderer/scene/scene_input.h"
+#include "api/scene_loader.h"
 
 namespace penumbra::app {
 
@@ -17,7 +18,6 @@ class OptionParser {
   bool positional() const { return current_.empty() || current_[0] != '-' || current_ == "-"; }
   bool value(std::string* out);      // the option's value, false if missing
   bool int_value(long long lo, long long hi, long long* out);
-  bool double_value(double lo, double hi, double* out);
   bool failed() const { return failed_; }
   // Prints the error (if any) and usage to stderr, returns exit code 2.
   int fail(const char* usage, const std::string& error = "");
@@ -32,17 +32,9 @@ class OptionParser {
   std::string error_;
 };
 
-// Flags that override a scene's "render" block: --spp --width --height --seed --threads
-// --max-depth --integrator --time-limit --noise-threshold.
-struct OptionalOverrides {
-  std::optional<long long> spp, width, height, seed, threads, max_depth;
-  std::optional<std::string> integrator;
-  std::optional<double> time_limit, noise_threshold;
-
-  // True if the current option is one of these (check p.failed() for a bad value).
-  bool parse(OptionParser& p);
-  // Applies them; returns an error message or "".
-  std::string apply(RenderSettings* settings) const;
-};
+// If the current option overrides the scene's "render" block (api/render_overrides.h), appends
+// it as typed and returns true (check p.failed() for a missing value). Its value is checked by
+// api/ with the scene, by the same code and limits as the JSON field.
+bool parse_render_override(OptionParser& p, std::vector<api::RenderOverride>& overrides);
 
 }  // namespace penumbra::app

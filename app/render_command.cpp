@@ -4,9 +4,11 @@
 #include <cstdlib>
 #include <cstring>
 #include <string>
+#include <vector>
 #include <unistd.h>
 
 #include "api/scene_loader.h"
+#include "api/version.h"
 #include "app/commands.h"
 #include "app/option_parsing.h"
 #include "renderer/io/image_io.h"
@@ -19,13 +21,14 @@ const char* kUsage =
     "usage: penumbra render SCENE.json -o OUT.{png,exr} [options]\n"
     "\n"
     "Renders a scene (format v1, see docs/scene-format.md). Options override the scene's\n"
-    "\"render\" settings:\n"
+    "\"render\" settings and are checked as those fields are, with the same limits:\n"
     "  -o, --output FILE        output image; .png (sRGB 8-bit) or .exr (linear float)\n"
     "  --spp N                  samples per pixel\n"
     "  --width N, --height N    image size in pixels\n"
     "  --seed N                 sampler seed (same seed, same image, any thread count)\n"
     "  --threads N              render threads (default: all cores)\n"
     "  --max-depth N            path segments (-1 = unlimited)\n"
+    "  --rr-depth N             depth at which Russian roulette starts\n"
     "  --integrator NAME        path | distributed\n"
     "  --time-limit SECONDS     stop at this budget with a correct (less converged) image\n"
     "  --noise-threshold X      adaptive sampling: aim for this relative RMS error (0.05 = 5%);\n"
@@ -45,7 +48,7 @@ std::string format_duration(double s) {
 int run_render(int argc, char** argv) {
   std::string scene_path, output;
   bool quiet = false;
-  OptionalOverrides ov;
+  std::vector<api::RenderOverride> overrides;
   OptionParser p(argc, argv);
   while (p.next()) {
     if (p.is("-h") || p.is("--help")) {
@@ -55,7 +58,7 @@ int run_render(int argc, char** argv) {
       if (!p.value(&output)) return p.fail(kUsage);
     } else if (p.is("-q") || p.is("--quiet")) {
       quiet = true;
-    } else if (ov.parse(p)) {
+    } else if (parse_render_override(p, overrides)) {
       if (p.failed()) return p.fail(kUsage);
     } else if (p.positional()) {
       if (!scene_path.empty()) return p.fail(kUsage, "more than one scene given");
@@ -74,7 +77,7 @@ int run_render(int argc, char** argv) {
     return 2;
   }
 
-  api::LoadResult loaded = api::load_scene_file(scene_path);
+  api::LoadResult loaded = api::load_scene_file(scene_path, {}, overrides);
   for (const auto& w : loaded.warnings)
     std::fprintf(stderr, "%s: warning: %s\n", scene_path.c_str(), w.to_string().c_str());
   if (!loaded.ok()) {
@@ -82,11 +85,7 @@ int run_render(int argc, char** argv) {
       std::fprintf(stderr, "%s: %s\n", scene_path.c_str(), e.to_string().c_str());
     return 1;
   }
-  RenderSettings settings = loaded.request->settings;
-  if (const std::string err = ov.apply(&settings); !err.empty()) {
-    std::fprintf(stderr, "penumbra render: %s\n", err.c_str());
-    return 2;
-  }
+  const RenderSettings& settings = loaded.request->settings;
 
   const auto build_start = std::chrono::steady_clock::now();
   const auto scene = Scene::build(loaded.request->scene);
@@ -121,7 +120,7 @@ int run_render(int argc, char** argv) {
       {"penumbra:render_seconds", std::to_string(st.seconds)},
       {"penumbra:seed", std::to_string(settings.seed)},
       {"penumbra:integrator", settings.integrator == IntegratorKind::kPath ? "path" : "distributed"},
-      {"Software", "penumbra 0.1.0"},
+      {"Software", api::kSoftwareName},
   };
   try {
     write_image_file(output, result.image, meta);

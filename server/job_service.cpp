@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "api/version.h"
 #include "renderer/io/image_io.h"
 
 namespace penumbra::server {
@@ -273,7 +274,7 @@ void JobService::run_job(const std::string& id, const std::shared_ptr<JobRuntime
           {"penumbra:spp_mean", std::to_string(outcome.stats.spp_mean)},
           {"penumbra:render_seconds", std::to_string(outcome.stats.seconds)},
           {"penumbra:seed", std::to_string(outcome.settings.seed)},
-          {"Software", "penumbra 0.1.0"},
+          {"Software", api::kSoftwareName},
       };
       // Files first, then the record: a crash in between reruns the job, never serves a
       // missing file.

@@ -1,7 +1,7 @@
 // Camera fields, defaults and degenerate configurations.
 #include "tests/api/scene_test_util.h"
 
-namespace penumbra::api::test {
+namespace penumbra::test {
 namespace {
 
 TEST(Camera, DefaultsAndDerivedFocusDistance) {
@@ -79,4 +79,4 @@ TEST(Camera, Shutter) {
 }
 
 }  // namespace
-}  // namespace penumbra::api::test
+}  // namespace penumbra::test

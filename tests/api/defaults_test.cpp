@@ -1,7 +1,7 @@
 // What a minimal scene gets when fields are left out, and the warning for an unlit scene.
 #include "tests/api/scene_test_util.h"
 
-namespace penumbra::api::test {
+namespace penumbra::test {
 namespace {
 
 TEST(Defaults, RenderSettings) {
@@ -87,4 +87,4 @@ TEST(Defaults, LightsAreConverted) {
 }
 
 }  // namespace
-}  // namespace penumbra::api::test
+}  // namespace penumbra::test

@@ -3,8 +3,10 @@
 
 #include <gtest/gtest.h>
 
-namespace penumbra::api {
+namespace penumbra::test {
 namespace {
+
+using namespace api;
 
 TEST(Diagnostics, PointerTokensFollowRfc6901) {
   EXPECT_EQ(escape_pointer_token("plain"), "plain");
@@ -46,4 +48,4 @@ TEST(Diagnostics, CapKeepsTheCount) {
 }
 
 }  // namespace
-}  // namespace penumbra::api
+}  // namespace penumbra::test

@@ -3,7 +3,7 @@
 
 #include "tests/api/scene_test_util.h"
 
-namespace penumbra::api::test {
+namespace penumbra::test {
 namespace {
 
 TEST(ExampleScenes, AllLoadCleanly) {
@@ -37,4 +37,4 @@ TEST(ExampleScenes, MissingFileIsAnErrorOnTheRoot) {
 }
 
 }  // namespace
-}  // namespace penumbra::api::test
+}  // namespace penumbra::test

@@ -4,7 +4,7 @@
 
 #include "tests/api/scene_test_util.h"
 
-namespace penumbra::api::test {
+namespace penumbra::test {
 namespace {
 
 Json mesh(Json positions, Json indices) {
@@ -131,4 +131,4 @@ TEST(Geometry, SphereIsPassedThrough) {
 }
 
 }  // namespace
-}  // namespace penumbra::api::test
+}  // namespace penumbra::test

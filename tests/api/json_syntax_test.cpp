@@ -3,7 +3,7 @@
 
 #include "tests/api/scene_test_util.h"
 
-namespace penumbra::api::test {
+namespace penumbra::test {
 namespace {
 
 TEST(JsonSyntax, MalformedTextIsSyntaxError) {
@@ -108,4 +108,4 @@ TEST(JsonSyntax, GarbageBytesNeverCrash) {
 }
 
 }  // namespace
-}  // namespace penumbra::api::test
+}  // namespace penumbra::test

@@ -2,7 +2,7 @@
 // limit's value in the message.
 #include "tests/api/scene_test_util.h"
 
-namespace penumbra::api::test {
+namespace penumbra::test {
 namespace {
 
 Json sphere(int i) {
@@ -121,4 +121,4 @@ TEST(Limits, HugeMeshIsRejectedBeforeReadingElements) {
 }
 
 }  // namespace
-}  // namespace penumbra::api::test
+}  // namespace penumbra::test

@@ -3,7 +3,7 @@
 
 #include "tests/api/scene_test_util.h"
 
-namespace penumbra::api::test {
+namespace penumbra::test {
 namespace {
 
 TEST(Materials, UnknownReferenceSuggestsClosestName) {
@@ -85,4 +85,4 @@ TEST(Materials, BrokenMaterialGivesOneErrorNotTwo) {
 }
 
 }  // namespace
-}  // namespace penumbra::api::test
+}  // namespace penumbra::test

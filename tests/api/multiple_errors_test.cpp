@@ -1,7 +1,7 @@
 // All errors of a scene are reported in one pass, and their number is bounded.
 #include "tests/api/scene_test_util.h"
 
-namespace penumbra::api::test {
+namespace penumbra::test {
 namespace {
 
 TEST(MultipleErrors, AreAllCollected) {
@@ -45,4 +45,4 @@ TEST(MultipleErrors, ToStringUsesSlashForTheRoot) {
 }
 
 }  // namespace
-}  // namespace penumbra::api::test
+}  // namespace penumbra::test

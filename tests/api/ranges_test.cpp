@@ -1,7 +1,7 @@
 // Numbers outside their ranges: negative, zero, huge, non-integral where integers are meant.
 #include "tests/api/scene_test_util.h"
 
-namespace penumbra::api::test {
+namespace penumbra::test {
 namespace {
 
 TEST(Ranges, IntegersMustBeIntegral) {
@@ -130,4 +130,4 @@ TEST(Ranges, MotionCannotOverflowWithinTheShutter) {
 }
 
 }  // namespace
-}  // namespace penumbra::api::test
+}  // namespace penumbra::test

@@ -2,7 +2,7 @@
 // precision, so a scene far from the JSON origin keeps single-precision accuracy.
 #include "tests/api/scene_test_util.h"
 
-namespace penumbra::api::test {
+namespace penumbra::test {
 namespace {
 
 TEST(Rebasing, PositionsAreRelativeToTheCamera) {
@@ -29,4 +29,4 @@ TEST(Rebasing, PositionsAreRelativeToTheCamera) {
 }
 
 }  // namespace
-}  // namespace penumbra::api::test
+}  // namespace penumbra::test

@@ -8,8 +8,10 @@
 
 #include "api/scene_loader.h"
 
-namespace penumbra::api::test {
+namespace penumbra::test {
 
+// The api tests name api's types and functions as its own code does.
+using namespace api;
 using Json = nlohmann::json;
 
 // Valid, lit, minimal: one emitting sphere, one material.
@@ -59,7 +61,7 @@ inline bool has(const std::vector<Diagnostic>& list, const std::string& pointer,
   return false;
 }
 
-}  // namespace penumbra::api::test
+}  // namespace penumbra::test
 
 // Asserts an error at `pointer` (message containing `fragment`) and that the load failed.
 #define EXPECT_ERROR(result, pointer, fragment)                                           \
@@ -67,15 +69,15 @@ inline bool has(const std::vector<Diagnostic>& list, const std::string& pointer,
     const auto& r_ = (result);                                                            \
     EXPECT_FALSE(r_.ok());                                                                \
     EXPECT_FALSE(r_.request.has_value());                                                 \
-    EXPECT_TRUE(::penumbra::api::test::has(r_.errors, pointer, fragment))                 \
+    EXPECT_TRUE(::penumbra::test::has(r_.errors, pointer, fragment))                 \
         << "expected error at " << (pointer) << " containing '" << (fragment) << "', got:\n" \
-        << ::penumbra::api::test::describe(r_.errors);                                    \
+        << ::penumbra::test::describe(r_.errors);                                    \
   } while (0)
 
 #define EXPECT_LOADS(result)                                                                \
   do {                                                                                      \
     const auto& r_ = (result);                                                              \
-    EXPECT_TRUE(r_.ok()) << ::penumbra::api::test::describe(r_.errors);                     \
+    EXPECT_TRUE(r_.ok()) << ::penumbra::test::describe(r_.errors);                     \
     EXPECT_EQ(r_.kind, ::penumbra::api::LoadErrorKind::kNone);                              \
     EXPECT_TRUE(r_.request.has_value());                                                    \
   } while (0)

@@ -5,8 +5,10 @@
 
 #include "api/embedded_documents.h"
 
-namespace penumbra::api {
+namespace penumbra::test {
 namespace {
+
+using namespace api;
 
 using Json = nlohmann::json;
 
@@ -70,4 +72,4 @@ TEST(Schema, DocumentsEveryField) {
 }
 
 }  // namespace
-}  // namespace penumbra::api
+}  // namespace penumbra::test

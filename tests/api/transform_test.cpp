@@ -4,7 +4,7 @@
 
 #include "tests/api/scene_test_util.h"
 
-namespace penumbra::api::test {
+namespace penumbra::test {
 namespace {
 
 void expect_near(const vec3& a, const vec3& b, float tolerance = 1e-5f) {
@@ -124,4 +124,4 @@ TEST(Transform, SphereRejectsNonSimilarity) {
 }
 
 }  // namespace
-}  // namespace penumbra::api::test
+}  // namespace penumbra::test

@@ -1,7 +1,7 @@
 // Wrong JSON types and missing required fields, each reported on the field's own pointer.
 #include "tests/api/scene_test_util.h"
 
-namespace penumbra::api::test {
+namespace penumbra::test {
 namespace {
 
 TEST(TypeErrors, WrongTypesNameTheField) {
@@ -92,4 +92,4 @@ TEST(MissingFields, VersionMustBeOne) {
 }
 
 }  // namespace
-}  // namespace penumbra::api::test
+}  // namespace penumbra::test

@@ -1,7 +1,7 @@
 // Unknown keys are errors (they are usually typos of an optional field), with a suggestion.
 #include "tests/api/scene_test_util.h"
 
-namespace penumbra::api::test {
+namespace penumbra::test {
 namespace {
 
 TEST(UnknownKeys, AreErrorsWithSuggestions) {
@@ -65,4 +65,4 @@ TEST(UnknownKeys, UnknownTypesSuggestTheClosest) {
 }
 
 }  // namespace
-}  // namespace penumbra::api::test
+}  // namespace penumbra::test
