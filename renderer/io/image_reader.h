@@ -1,0 +1,39 @@
+#pragma once
+// Reading image assets (textures, environment maps) from untrusted files: the header is checked
+// against explicit limits before any pixel is decoded, so a file that claims 100k x 100k pixels
+// costs nothing; every error names the file.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "renderer/io/image_io.h"
+
+namespace penumbra {
+
+struct ImageReadLimits {
+  int64_t max_pixels = int64_t(16384) * 8192;  // per image (a 16k x 8k environment map)
+  int max_dimension = 65536;                   // per side
+  int max_channels = 4;                        // channels kept (more are dropped, not an error)
+};
+
+// Pixels as stored, converted to float, channel-interleaved, row 0 = the image's top row.
+struct AssetImage {
+  int width = 0;
+  int height = 0;
+  int channels = 0;
+  bool is_float = false;  // the file stores floating-point values (EXR, HDR, float TIFF):
+                          // linear by convention; integer formats are usually sRGB-encoded
+  std::vector<float> pixels;
+  size_t bytes() const { return pixels.size() * sizeof(float); }
+};
+
+// Throws ImageIoError ("<path>: <reason>") for unreadable files, unknown formats, and images
+// over the limits. Non-finite float pixels are replaced by 0 (a NaN texel would poison every
+// image that samples it).
+AssetImage read_asset_image(const std::string& path, const ImageReadLimits& limits = {});
+
+// IEC 61966-2-1: sRGB-encoded values in [0, 1] to linear, in place, on the first 3 channels
+// (alpha is linear already).
+void srgb_to_linear_in_place(AssetImage& image);
+
+}  // namespace penumbra
