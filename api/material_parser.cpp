@@ -56,7 +56,7 @@ std::optional<MaterialParams> parse_material(const Json& value, const std::strin
 }  // namespace
 
 ParsedMaterials parse_materials(const Json* materials, const std::string& pointer,
-                                const Limits& limits, Diagnostics& diag) {
+                                const Limits& limits, const AssetFolder& assets, Diagnostics& diag) {
   ParsedMaterials parsed;
   if (!materials) return parsed;
   if (!materials->is_object()) {

@@ -4,9 +4,11 @@
 #include <string>
 #include <vector>
 
+#include "api/asset_path.h"
 #include "api/json_reader.h"
 #include "api/scene_loader.h"
 #include "renderer/materials/material_params.h"
+
 
 namespace penumbra::api {
 
@@ -19,6 +21,6 @@ struct ParsedMaterials {
 // Materials with errors are left out of the result (their errors are in `diag`), but their
 // names are kept in `index` so objects naming them get no second, misleading error.
 ParsedMaterials parse_materials(const Json* materials, const std::string& pointer,
-                                const Limits& limits, Diagnostics& diag);
+                                const Limits& limits, const AssetFolder& assets, Diagnostics& diag);
 
 }  // namespace penumbra::api

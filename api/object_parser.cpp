@@ -79,8 +79,8 @@ std::optional<QuadDesc> parse_quad(ObjectReader& reader, const AffineTransform& 
 
 ParsedObjects parse_objects(const Json* objects, const std::string& pointer,
                             const ParsedMaterials& materials, double shutter_extent,
-                            const glm::dvec3& origin,
-                            const Limits& limits, Diagnostics& diag) {
+                            const glm::dvec3& origin, const Limits& limits,
+                            const AssetFolder& assets, Diagnostics& diag) {
   ParsedObjects parsed;
   parsed.material_used.assign(materials.names.size(), false);
   if (!objects) return parsed;

@@ -5,10 +5,12 @@
 #include <string>
 #include <vector>
 
+#include "api/asset_path.h"
 #include "api/json_reader.h"
 #include "api/material_parser.h"
 #include "api/scene_loader.h"
 #include "renderer/scene/scene_input.h"
+
 
 namespace penumbra::api {
 
@@ -27,7 +29,7 @@ struct ParsedObjects {
 // `origin` (the camera position) is subtracted from every position, in double precision.
 ParsedObjects parse_objects(const Json* objects, const std::string& pointer,
                             const ParsedMaterials& materials, double shutter_extent,
-                            const glm::dvec3& origin,
-                            const Limits& limits, Diagnostics& diag);
+                            const glm::dvec3& origin, const Limits& limits,
+                            const AssetFolder& assets, Diagnostics& diag);
 
 }  // namespace penumbra::api

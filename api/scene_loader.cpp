@@ -13,7 +13,7 @@
 namespace penumbra::api {
 
 LoadResult load_scene(std::string_view json_text, const Limits& limits,
-                      std::span<const RenderOverride> overrides) {
+                      std::span<const RenderOverride> overrides, const AssetFolder& assets) {
   LoadResult result;
   Diagnostics diag;
   try {
@@ -23,7 +23,7 @@ LoadResult load_scene(std::string_view json_text, const Limits& limits,
     } else {
       // Duplicate keys were reported by the document parser; keep checking everything else.
       const std::optional<int> threads = apply_render_overrides(*document.value, overrides, diag);
-      auto request = parse_scene(*document.value, limits, diag);
+      auto request = parse_scene(*document.value, limits, assets, diag);
       if (request && threads) request->settings.threads = *threads;
       if (!diag.has_errors()) result.request = std::move(request);
     }
@@ -56,7 +56,9 @@ LoadResult load_scene_file(const std::string& path, const Limits& limits,
     result.errors.push_back({"", "cannot read file '" + path + "'"});
     return result;
   }
-  return load_scene(text.str(), limits, overrides);
+  AssetFolder assets;
+  assets.root = std::filesystem::absolute(std::filesystem::path(path)).parent_path();
+  return load_scene(text.str(), limits, overrides, assets);
 }
 
 }  // namespace penumbra::api

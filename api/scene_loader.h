@@ -9,6 +9,7 @@
 #include <string_view>
 #include <vector>
 
+#include "api/asset_path.h"
 #include "renderer/scene/scene_input.h"
 
 namespace penumbra::api {
@@ -70,9 +71,12 @@ struct RenderOverride {
 
 // `overrides` (the CLI's render flags; none for the service) are written into the document
 // before it is checked, so they meet the same checks and limits as the JSON they replace.
+// `assets` is the folder files named in the scene are read from (empty: the scene may name none).
 LoadResult load_scene(std::string_view json_text, const Limits& limits = {},
-                      std::span<const RenderOverride> overrides = {});
-// Reads the file (a read failure is reported as an error on pointer "") and calls load_scene.
+                      std::span<const RenderOverride> overrides = {},
+                      const AssetFolder& assets = {});
+// Reads the file (a read failure is reported as an error on pointer "") and calls load_scene
+// with the file's folder as the asset folder.
 LoadResult load_scene_file(const std::string& path, const Limits& limits = {},
                            std::span<const RenderOverride> overrides = {});
 

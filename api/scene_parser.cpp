@@ -184,7 +184,7 @@ void parse_lights(const Json* value, const Limits& limits, const glm::dvec3& ori
 }  // namespace
 
 std::optional<SceneRequest> parse_scene(const Json& document, const Limits& limits,
-                                        Diagnostics& diag) {
+                                        const AssetFolder& assets, Diagnostics& diag) {
   ObjectReader root(document, "", diag);
   if (!root.valid()) return std::nullopt;
   SceneRequest request;
@@ -210,12 +210,14 @@ std::optional<SceneRequest> parse_scene(const Json& document, const Limits& limi
     r.report_unknown_keys();
   }
 
-  ParsedMaterials materials = parse_materials(root.get("materials"), "/materials", limits, diag);
+  ParsedMaterials materials =
+      parse_materials(root.get("materials"), "/materials", limits, assets, diag);
   const auto& camera = request.scene.camera;
   const double shutter_extent =
       std::max(std::abs(double(camera.shutter_open)), std::abs(double(camera.shutter_close)));
   ParsedObjects objects =
-      parse_objects(root.get("objects"), "/objects", materials, shutter_extent, origin, limits, diag);
+      parse_objects(root.get("objects"), "/objects", materials, shutter_extent, origin, limits,
+                    assets, diag);
 
   bool lights_lit = false;
   parse_lights(root.get("lights"), limits, origin, request.scene.lights, lights_lit, diag);
