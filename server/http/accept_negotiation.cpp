@@ -10,7 +10,8 @@ namespace {
 // The format a media range (lower case, no parameters) asks for, if the service makes it.
 std::optional<ImageFormat> format_for_range(std::string_view range) {
   if (range == "image/png" || range == "image/*" || range == "*/*") return ImageFormat::kPng;
-  if (range == "image/x-exr" || range == "image/exr" || range == "image/aces") return ImageFormat::kExr;
+  if (range == "image/x-exr" || range == "image/exr" || range == "image/aces")
+    return ImageFormat::kExr;
   return std::nullopt;
 }
 
@@ -22,7 +23,8 @@ bool refused(std::string_view params) {
     params.remove_prefix(std::min(semi + 1, params.size()));
     const std::size_t eq = param.find('=');
     if (eq == std::string_view::npos) continue;
-    if (trim_ows(param.substr(0, eq)) == "q" && is_zero_qvalue(trim_ows(param.substr(eq + 1)))) return true;
+    if (trim_ows(param.substr(0, eq)) == "q" && is_zero_qvalue(trim_ows(param.substr(eq + 1))))
+      return true;
   }
   return false;
 }
@@ -35,8 +37,9 @@ bool is_zero_qvalue(std::string_view v) {
   return v[1] == '.' && std::all_of(v.begin() + 2, v.end(), [](char c) { return c == '0'; });
 }
 
-std::variant<ImageFormat, Problem> negotiate_image_format(const std::optional<std::string>& format_param,
-                                                          const std::optional<std::string>& accept_header) {
+std::variant<ImageFormat, Problem> negotiate_image_format(
+    const std::optional<std::string>& format_param,
+    const std::optional<std::string>& accept_header) {
   if (format_param) {
     const std::string f = ascii_lower(*format_param);
     if (f == "png") return ImageFormat::kPng;
@@ -62,7 +65,9 @@ std::variant<ImageFormat, Problem> negotiate_image_format(const std::optional<st
                       "results are image/png or image/x-exr (or use ?format=png|exr)");
 }
 
-const char* mime_type(ImageFormat f) { return f == ImageFormat::kPng ? "image/png" : "image/x-exr"; }
+const char* mime_type(ImageFormat f) {
+  return f == ImageFormat::kPng ? "image/png" : "image/x-exr";
+}
 const char* file_extension(ImageFormat f) { return f == ImageFormat::kPng ? "png" : "exr"; }
 
 }  // namespace penumbra::server

@@ -14,8 +14,8 @@ namespace penumbra::server {
 
 // format_param: the ?format= value if present; accept: the Accept header if present.
 // A Problem is 400 (bad format value) or 406 (Accept names nothing the service makes).
-std::variant<ImageFormat, Problem> negotiate_image_format(const std::optional<std::string>& format_param,
-                                                          const std::optional<std::string>& accept);
+std::variant<ImageFormat, Problem> negotiate_image_format(
+    const std::optional<std::string>& format_param, const std::optional<std::string>& accept);
 
 // True for a qvalue of zero: "0", "0.", "0.0" ... (RFC 9110 section 12.4.2).
 bool is_zero_qvalue(std::string_view value);

@@ -1,8 +1,8 @@
 #include "server/http/http_server.h"
 
-#include <cstdio>
-
 #include <httplib.h>
+
+#include <cstdio>
 
 #include "server/http/problem.h"
 #include "server/http/request_guard.h"
@@ -48,41 +48,45 @@ void HttpServer::install_handlers() {
   });
   // Turns the library's own error answers (404, 400, 413 ...) into problem documents; 404 on a
   // known path with another method is 405.
-  s.set_error_handler(httplib::Server::HandlerWithResponse([](const httplib::Request& req,
-                                                             httplib::Response& res) {
-    if (!res.body.empty() || res.content_length_ > 0) return httplib::Server::HandlerResponse::Unhandled;
-    const std::string route = route_template(req.path);
-    if (res.status == 404 && route != "other") {
-      std::string allow;
-      for (const auto& m : allowed_methods(route)) allow += (allow.empty() ? "" : ", ") + m;
-      res.set_header("Allow", allow);
-      send_problem(res, req, status_problem(405, req.method + " is not allowed here; allowed: " + allow));
-    } else if (res.status == 404) {
-      send_problem(res, req, status_problem(404, "no such resource"));
-    } else {
-      send_problem(res, req, status_problem(res.status, ""));
-    }
-    return httplib::Server::HandlerResponse::Handled;
-  }));
-  s.set_exception_handler([](const httplib::Request& req, httplib::Response& res, std::exception_ptr ep) {
-    // The text goes to the log only: exception messages can hold paths and internals.
-    std::string what = "unknown exception";
-    try {
-      if (ep) std::rethrow_exception(ep);
-    } catch (const std::exception& e) {
-      what = e.what();
-    } catch (...) {
-      // not a std::exception: nothing more to say than "unknown exception", logged below
-    }
-    std::fprintf(stderr, "penumbra serve: %s %s: internal error: %s\n", req.method.c_str(),
-                 route_template(req.path).c_str(), what.c_str());
-    res.headers.clear();
-    send_problem(res, req, status_problem(500, "internal error; see the server log"));
-  });
+  s.set_error_handler(
+      httplib::Server::HandlerWithResponse([](const httplib::Request& req, httplib::Response& res) {
+        if (!res.body.empty() || res.content_length_ > 0)
+          return httplib::Server::HandlerResponse::Unhandled;
+        const std::string route = route_template(req.path);
+        if (res.status == 404 && route != "other") {
+          std::string allow;
+          for (const auto& m : allowed_methods(route)) allow += (allow.empty() ? "" : ", ") + m;
+          res.set_header("Allow", allow);
+          send_problem(res, req,
+                       status_problem(405, req.method + " is not allowed here; allowed: " + allow));
+        } else if (res.status == 404) {
+          send_problem(res, req, status_problem(404, "no such resource"));
+        } else {
+          send_problem(res, req, status_problem(res.status, ""));
+        }
+        return httplib::Server::HandlerResponse::Handled;
+      }));
+  s.set_exception_handler(
+      [](const httplib::Request& req, httplib::Response& res, std::exception_ptr ep) {
+        // The text goes to the log only: exception messages can hold paths and internals.
+        std::string what = "unknown exception";
+        try {
+          if (ep) std::rethrow_exception(ep);
+        } catch (const std::exception& e) {
+          what = e.what();
+        } catch (...) {
+          // not a std::exception: nothing more to say than "unknown exception", logged below
+        }
+        std::fprintf(stderr, "penumbra serve: %s %s: internal error: %s\n", req.method.c_str(),
+                     route_template(req.path).c_str(), what.c_str());
+        res.headers.clear();
+        send_problem(res, req, status_problem(500, "internal error; see the server log"));
+      });
   const bool access_log = config_.access_log;
   s.set_logger([this, access_log](const httplib::Request& req, const httplib::Response& res) {
     metrics_.count_request(req.method, route_template(req.path), res.status);
-    if (access_log) std::fprintf(stderr, "%s %s %d\n", req.method.c_str(), req.path.c_str(), res.status);
+    if (access_log)
+      std::fprintf(stderr, "%s %s %d\n", req.method.c_str(), req.path.c_str(), res.status);
   });
 }
 

@@ -1,8 +1,7 @@
 #pragma once
 // The JSON shape of a job in API answers (documented in api/openapi.json, schema "Job").
-#include <string>
-
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "server/jobs/job_service.h"
 

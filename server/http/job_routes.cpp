@@ -1,7 +1,7 @@
 // POST /v1/jobs (submit), GET /v1/jobs (list), GET and DELETE /v1/jobs/{id}.
-#include <cmath>
-
 #include <httplib.h>
+
+#include <cmath>
 
 #include "server/http/idempotency_key.h"
 #include "server/http/job_json.h"
@@ -82,11 +82,14 @@ void cancel_or_delete(const RouteContext& c, const httplib::Request& req, httpli
 }  // namespace
 
 void add_job_routes(httplib::Server& s, const RouteContext& c) {
-  s.Post("/v1/jobs", [&c](const httplib::Request& req, httplib::Response& res) { submit(c, req, res); });
-  s.Get("/v1/jobs", [&c](const httplib::Request& req, httplib::Response& res) { list(c, req, res); });
+  s.Post("/v1/jobs",
+         [&c](const httplib::Request& req, httplib::Response& res) { submit(c, req, res); });
+  s.Get("/v1/jobs",
+        [&c](const httplib::Request& req, httplib::Response& res) { list(c, req, res); });
   s.Get(kJobRoute, [&c](const httplib::Request& req, httplib::Response& res) { get(c, req, res); });
-  s.Delete(kJobRoute,
-           [&c](const httplib::Request& req, httplib::Response& res) { cancel_or_delete(c, req, res); });
+  s.Delete(kJobRoute, [&c](const httplib::Request& req, httplib::Response& res) {
+    cancel_or_delete(c, req, res);
+  });
 }
 
 }  // namespace penumbra::server

@@ -8,7 +8,8 @@ void send_json(httplib::Response& res, int status, const nlohmann::ordered_json&
   using json = nlohmann::ordered_json;
   res.status = status;
   // Invalid UTF-8 (from a scene's strings) is replaced, never thrown from here.
-  res.set_content(body.dump(2, ' ', false, json::error_handler_t::replace) + "\n", "application/json");
+  res.set_content(body.dump(2, ' ', false, json::error_handler_t::replace) + "\n",
+                  "application/json");
 }
 
 nlohmann::ordered_json diagnostics_json(const std::vector<api::Diagnostic>& ds) {

@@ -1,8 +1,7 @@
 #pragma once
 // JSON answers: the body pretty-printed as the API documents show it.
-#include <vector>
-
 #include <nlohmann/json.hpp>
+#include <vector>
 
 #include "api/scene_loader.h"
 

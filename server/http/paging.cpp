@@ -8,7 +8,8 @@ namespace penumbra::server {
 namespace {
 
 bool all_of(const std::string& s, int (*pred)(int)) {
-  return std::all_of(s.begin(), s.end(), [pred](char c) { return pred(static_cast<unsigned char>(c)) != 0; });
+  return std::all_of(s.begin(), s.end(),
+                     [pred](char c) { return pred(static_cast<unsigned char>(c)) != 0; });
 }
 
 }  // namespace
@@ -20,13 +21,16 @@ std::variant<ListQuery, Problem> parse_list_query(const ListParams& params) {
     // At most 4 digits, so stoi cannot overflow.
     const bool ok = !v.empty() && v.size() <= 4 && all_of(v, ::isdigit) && std::stoi(v) >= 1 &&
                     std::stoi(v) <= kMaxPageSize;
-    if (!ok) return invalid_parameter("limit", "must be an integer from 1 to " + std::to_string(kMaxPageSize));
+    if (!ok)
+      return invalid_parameter("limit",
+                               "must be an integer from 1 to " + std::to_string(kMaxPageSize));
     q.limit = std::stoi(v);
   }
   if (params.state) {
     q.state = job_state_from_string(*params.state);
     if (!q.state || *q.state == JobState::kDeleted)
-      return invalid_parameter("state", "must be one of queued, running, succeeded, failed, cancelled");
+      return invalid_parameter("state",
+                               "must be one of queued, running, succeeded, failed, cancelled");
   }
   if (params.page_token) {
     const std::string& t = *params.page_token;

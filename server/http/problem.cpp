@@ -1,30 +1,47 @@
 #include "server/http/problem.h"
 
-#include <cmath>
-
 #include <httplib.h>
+
+#include <cmath>
 
 namespace penumbra::server {
 
 const char* status_reason(int status) {
   switch (status) {
-    case 400: return "Bad Request";
-    case 401: return "Unauthorized";
-    case 403: return "Forbidden";
-    case 404: return "Not Found";
-    case 405: return "Method Not Allowed";
-    case 406: return "Not Acceptable";
-    case 409: return "Conflict";
-    case 411: return "Length Required";
-    case 413: return "Content Too Large";
-    case 414: return "URI Too Long";
-    case 415: return "Unsupported Media Type";
-    case 416: return "Range Not Satisfiable";
-    case 422: return "Unprocessable Content";
-    case 429: return "Too Many Requests";
-    case 500: return "Internal Server Error";
-    case 503: return "Service Unavailable";
-    default: return "Error";
+    case 400:
+      return "Bad Request";
+    case 401:
+      return "Unauthorized";
+    case 403:
+      return "Forbidden";
+    case 404:
+      return "Not Found";
+    case 405:
+      return "Method Not Allowed";
+    case 406:
+      return "Not Acceptable";
+    case 409:
+      return "Conflict";
+    case 411:
+      return "Length Required";
+    case 413:
+      return "Content Too Large";
+    case 414:
+      return "URI Too Long";
+    case 415:
+      return "Unsupported Media Type";
+    case 416:
+      return "Range Not Satisfiable";
+    case 422:
+      return "Unprocessable Content";
+    case 429:
+      return "Too Many Requests";
+    case 500:
+      return "Internal Server Error";
+    case 503:
+      return "Service Unavailable";
+    default:
+      return "Error";
   }
 }
 
@@ -48,8 +65,10 @@ Problem status_problem(int status, const std::string& detail) {
 }
 
 Problem invalid_parameter(const std::string& parameter, const std::string& what) {
-  Problem p = make_problem(400, "invalid-parameter", "Invalid query parameter", parameter + " " + what);
-  p.extensions["errors"] = nlohmann::ordered_json::array({{{"parameter", parameter}, {"detail", what}}});
+  Problem p =
+      make_problem(400, "invalid-parameter", "Invalid query parameter", parameter + " " + what);
+  p.extensions["errors"] =
+      nlohmann::ordered_json::array({{{"parameter", parameter}, {"detail", what}}});
   return p;
 }
 
@@ -66,7 +85,8 @@ void send_problem(httplib::Response& res, const Problem& p, const std::string& i
   if (p.retry_after_seconds > 0)
     res.set_header("Retry-After", std::to_string(long(std::ceil(p.retry_after_seconds))));
   // The request path is user input: dump() escapes it, and invalid UTF-8 is replaced, not thrown.
-  res.set_content(problem_json(p, instance).dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace),
+  res.set_content(problem_json(p, instance)
+                      .dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace),
                   "application/problem+json");
 }
 

@@ -1,24 +1,24 @@
 #pragma once
 // RFC 9457 problem details: every error answer of the service is application/problem+json.
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 namespace httplib {
 struct Request;
 struct Response;
-}
+}  // namespace httplib
 
 namespace penumbra::server {
 
 struct Problem {
   int status = 500;
-  std::string type;   // a stable URN naming the kind of problem; "about:blank" for plain statuses
-  std::string title;  // short, the same for every occurrence of the type
+  std::string type;    // a stable URN naming the kind of problem; "about:blank" for plain statuses
+  std::string title;   // short, the same for every occurrence of the type
   std::string detail;  // this occurrence, meant for people
-  nlohmann::ordered_json extensions = nlohmann::ordered_json::object();  // e.g. "errors": [{pointer, detail}]
-  double retry_after_seconds = 0;  // > 0 adds a Retry-After header
+  nlohmann::ordered_json extensions =
+      nlohmann::ordered_json::object();  // e.g. "errors": [{pointer, detail}]
+  double retry_after_seconds = 0;        // > 0 adds a Retry-After header
 };
 
 // A problem of one of the service's own types, "urn:penumbra:problem:<slug>".

@@ -1,8 +1,8 @@
 // POST /v1/render: submits an ordinary job, waits for it on the HTTP thread and answers its
 // image. Waiting requests are bounded so HTTP threads stay free for polls.
-#include <memory>
-
 #include <httplib.h>
+
+#include <memory>
 
 #include "server/http/accept_negotiation.h"
 #include "server/http/idempotency_key.h"
@@ -20,7 +20,8 @@ constexpr auto kMaxWait = std::chrono::hours(24);
 
 void render(const RouteContext& c, std::atomic<int>& waiters, const httplib::Request& req,
             httplib::Response& res) {
-  const auto format = negotiate_image_format(param_value(req, "format"), header_value(req, "Accept"));
+  const auto format =
+      negotiate_image_format(param_value(req, "format"), header_value(req, "Accept"));
   if (const auto* p = std::get_if<Problem>(&format)) return send_problem(res, req, *p);
   const auto key = parse_idempotency_key(header_value(req, "Idempotency-Key"));
   if (const auto* p = std::get_if<Problem>(&key)) return send_problem(res, req, *p);
@@ -48,7 +49,8 @@ void render(const RouteContext& c, std::atomic<int>& waiters, const httplib::Req
   Problem p;
   if (done->state == JobState::kFailed) {
     p = make_problem(500, "render-failed", "Render failed", "the render of job " + id + " failed");
-    if (!done->error_json.empty()) p.extensions["error"] = nlohmann::ordered_json::parse(done->error_json);
+    if (!done->error_json.empty())
+      p.extensions["error"] = nlohmann::ordered_json::parse(done->error_json);
   } else if (done->state == JobState::kCancelled) {
     p = make_problem(409, "cancelled", "Cancelled", "job " + id + " was cancelled");
   } else {

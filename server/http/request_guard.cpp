@@ -1,10 +1,11 @@
 #include "server/http/request_guard.h"
-#include "server/http/text_util.h"
+
+#include <httplib.h>
 
 #include <cctype>
 #include <string>
 
-#include <httplib.h>
+#include "server/http/text_util.h"
 
 namespace penumbra::server {
 namespace {
@@ -21,7 +22,8 @@ bool is_digits(const std::string& s) {
 std::optional<Problem> guard_request(const httplib::Request& req, const GuardSettings& settings,
                                      const BearerAuth& auth) {
   // Liveness must answer whatever the token: orchestrators probe it without credentials.
-  if (auth.enabled() && req.path != "/healthz" && !auth.allows(req.get_header_value("Authorization"))) {
+  if (auth.enabled() && req.path != "/healthz" &&
+      !auth.allows(req.get_header_value("Authorization"))) {
     Problem p = make_problem(401, "unauthorized", "Unauthorized",
                              "send 'Authorization: Bearer <token>' (the server's --token)");
     return p;
@@ -34,10 +36,12 @@ std::optional<Problem> guard_request(const httplib::Request& req, const GuardSet
   if (req.get_header_value_count("Content-Length") > 1)
     return make_problem(400, "bad-framing", "Bad Request", "more than one Content-Length header");
   if (req.has_header("Content-Encoding")) {
-    const std::string enc = ascii_lower(std::string(trim_ows(req.get_header_value("Content-Encoding"))));
+    const std::string enc =
+        ascii_lower(std::string(trim_ows(req.get_header_value("Content-Encoding"))));
     if (enc != "identity")
-      return make_problem(415, "unsupported-content-encoding", "Unsupported Media Type",
-                          "Content-Encoding '" + enc + "' is not accepted; send the body uncompressed");
+      return make_problem(
+          415, "unsupported-content-encoding", "Unsupported Media Type",
+          "Content-Encoding '" + enc + "' is not accepted; send the body uncompressed");
   }
   const bool has_length = req.has_header("Content-Length");
   const std::string length_text(trim_ows(req.get_header_value("Content-Length")));
@@ -70,14 +74,15 @@ std::optional<Problem> guard_request(const httplib::Request& req, const GuardSet
     // Checked before the body is read: the library would otherwise parse multipart bodies.
     std::string type = ascii_lower(req.get_header_value("Content-Type"));
     type = std::string(trim_ows(type.substr(0, type.find(';'))));
-    const bool json_like = type == "application/json" ||
-                           (type.rfind("application/", 0) == 0 && type.size() > 5 &&
-                            type.compare(type.size() - 5, 5, "+json") == 0);
+    const bool json_like =
+        type == "application/json" || (type.rfind("application/", 0) == 0 && type.size() > 5 &&
+                                       type.compare(type.size() - 5, 5, "+json") == 0);
     // curl --data-binary sends application/x-www-form-urlencoded unless told otherwise; it is
     // read as JSON too so the one-line curl of the README works.
     if (!json_like && type != "application/x-www-form-urlencoded")
-      return make_problem(415, "unsupported-media-type", "Unsupported Media Type",
-                          "the body must be a JSON scene (Content-Type: application/json), not " + type);
+      return make_problem(
+          415, "unsupported-media-type", "Unsupported Media Type",
+          "the body must be a JSON scene (Content-Type: application/json), not " + type);
   }
   return std::nullopt;
 }

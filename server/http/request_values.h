@@ -1,9 +1,9 @@
 #pragma once
 // A header or query parameter of a request as an optional: absent is not the same as empty.
+#include <httplib.h>
+
 #include <optional>
 #include <string>
-
-#include <httplib.h>
 
 namespace penumbra::server {
 

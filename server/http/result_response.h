@@ -14,6 +14,7 @@ namespace penumbra::server {
 // False when the job has no stored result in that format. The stream stays open, so a
 // concurrent DELETE of the job does not cut the answer short. The status is left unset: the
 // library answers 206 for a (single) Range request, else 200.
-bool send_result(httplib::Response& res, const JobService& jobs, const std::string& id, ImageFormat format);
+bool send_result(httplib::Response& res, const JobService& jobs, const std::string& id,
+                 ImageFormat format);
 
 }  // namespace penumbra::server

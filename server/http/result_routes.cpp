@@ -15,7 +15,8 @@ namespace {
 
 void get_result(const RouteContext& c, const httplib::Request& req, httplib::Response& res) {
   const std::string id = req.matches[1];
-  const auto format = negotiate_image_format(param_value(req, "format"), header_value(req, "Accept"));
+  const auto format =
+      negotiate_image_format(param_value(req, "format"), header_value(req, "Accept"));
   if (const auto* p = std::get_if<Problem>(&format)) return send_problem(res, req, *p);
   const ImageFormat f = std::get<ImageFormat>(format);
   const auto v = c.jobs.view(id);
@@ -35,9 +36,10 @@ void get_result(const RouteContext& c, const httplib::Request& req, httplib::Res
       return;
     }
   }
-  Problem p = make_problem(409, "result-not-ready", "Result not ready",
-                           std::string("job ") + id + " is " + to_string(state) +
-                               (is_finished(state) ? " and has no result" : "; poll the job and retry"));
+  Problem p =
+      make_problem(409, "result-not-ready", "Result not ready",
+                   std::string("job ") + id + " is " + to_string(state) +
+                       (is_finished(state) ? " and has no result" : "; poll the job and retry"));
   p.extensions["state"] = to_string(state);
   p.extensions["job"] = job_path(id);
   if (!is_finished(state)) p.retry_after_seconds = retry_after_seconds(*v);
@@ -47,7 +49,8 @@ void get_result(const RouteContext& c, const httplib::Request& req, httplib::Res
 }  // namespace
 
 void add_result_routes(httplib::Server& s, const RouteContext& c) {
-  s.Get(kResultRoute, [&c](const httplib::Request& req, httplib::Response& res) { get_result(c, req, res); });
+  s.Get(kResultRoute,
+        [&c](const httplib::Request& req, httplib::Response& res) { get_result(c, req, res); });
 }
 
 }  // namespace penumbra::server

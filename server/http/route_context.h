@@ -20,9 +20,12 @@ struct RouteContext {
 };
 
 // One function per route group, each in its own file.
-void add_service_routes(httplib::Server& server, const RouteContext& context);  // health, metrics, OpenAPI
-void add_job_routes(httplib::Server& server, const RouteContext& context);      // /v1/jobs, /v1/jobs/{id}
-void add_result_routes(httplib::Server& server, const RouteContext& context);   // /v1/jobs/{id}/result
-void add_render_routes(httplib::Server& server, const RouteContext& context);   // /v1/render
+void add_service_routes(httplib::Server& server,
+                        const RouteContext& context);  // health, metrics, OpenAPI
+void add_job_routes(httplib::Server& server,
+                    const RouteContext& context);  // /v1/jobs, /v1/jobs/{id}
+void add_result_routes(httplib::Server& server,
+                       const RouteContext& context);  // /v1/jobs/{id}/result
+void add_render_routes(httplib::Server& server, const RouteContext& context);  // /v1/render
 
 }  // namespace penumbra::server

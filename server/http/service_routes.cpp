@@ -25,7 +25,8 @@ void add_service_routes(httplib::Server& s, const RouteContext& c) {
   });
   s.Get("/v1/openapi.json", [](const httplib::Request& req, httplib::Response& res) {
     const std::string* doc = api::embedded_document("openapi.json");
-    if (!doc) return send_problem(res, req, status_problem(404, "no OpenAPI document was built in"));
+    if (!doc)
+      return send_problem(res, req, status_problem(404, "no OpenAPI document was built in"));
     res.set_content(*doc, "application/json");
   });
 }

@@ -12,22 +12,24 @@ std::optional<Problem> submission_problem(const SubmitOutcome& o) {
     case K::kReplayed:
       return std::nullopt;
     case K::kSyntax: {
-      Problem p = make_problem(400, "malformed-json", "Malformed JSON",
-                               o.errors.empty() ? "the body is not JSON" : o.errors.front().message);
+      Problem p =
+          make_problem(400, "malformed-json", "Malformed JSON",
+                       o.errors.empty() ? "the body is not JSON" : o.errors.front().message);
       p.extensions["errors"] = diagnostics_json(o.errors);
       return p;
     }
     case K::kInvalid: {
-      Problem p = make_problem(422, "invalid-scene", "Invalid scene",
-                               std::to_string(o.errors.size()) + " error(s) in the scene; see errors");
+      Problem p =
+          make_problem(422, "invalid-scene", "Invalid scene",
+                       std::to_string(o.errors.size()) + " error(s) in the scene; see errors");
       p.extensions["errors"] = diagnostics_json(o.errors);
       if (!o.warnings.empty()) p.extensions["warnings"] = diagnostics_json(o.warnings);
       return p;
     }
     case K::kKeyReused: {
-      Problem p = make_problem(422, "idempotency-key-reused", "Idempotency-Key reused",
-                               "this Idempotency-Key was used for a different scene (job " +
-                                   o.record.id + ")");
+      Problem p = make_problem(
+          422, "idempotency-key-reused", "Idempotency-Key reused",
+          "this Idempotency-Key was used for a different scene (job " + o.record.id + ")");
       p.extensions["job"] = job_path(o.record.id);
       return p;
     }

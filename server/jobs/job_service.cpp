@@ -2,9 +2,8 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <random>
-
 #include <nlohmann/json.hpp>
+#include <random>
 
 #include "server/jobs/unix_time.h"
 
@@ -52,7 +51,8 @@ void JobService::start() {
   // A crash between a tombstone's commit and the removal of its files leaves the files.
   for (const JobRecord& r : stored.records)
     if (r.state == JobState::kDeleted) results_.remove(r.id);
-  for (const std::string& id : table_.restore(std::move(stored.records))) queue_.push(id, /*force=*/true);
+  for (const std::string& id : table_.restore(std::move(stored.records)))
+    queue_.push(id, /*force=*/true);
   expire_now();
   workers_.start(config_.workers);
   reaper_ = std::thread([this] { reaper_loop(); });
@@ -88,7 +88,8 @@ SubmitOutcome JobService::submit(std::string_view body, const std::string& idemp
       // Read from the store: the table keeps no scenes. A submission may wait on a commit here.
       const auto stored_scene = store_.scene(existing->id);
       out.record = std::move(*existing);
-      out.kind = stored_scene == scene_json ? SubmitOutcome::Kind::kReplayed : SubmitOutcome::Kind::kKeyReused;
+      out.kind = stored_scene == scene_json ? SubmitOutcome::Kind::kReplayed
+                                            : SubmitOutcome::Kind::kKeyReused;
       return out;
     }
   }
@@ -139,7 +140,8 @@ std::optional<JobView> JobService::view(const std::string& id) const {
   return v;
 }
 
-std::vector<JobView> JobService::list(std::optional<JobState> state, int64_t before_seq, int limit) const {
+std::vector<JobView> JobService::list(std::optional<JobState> state, int64_t before_seq,
+                                      int limit) const {
   std::vector<JobView> out;
   for (JobEntry& e : table_.list(state, before_seq, limit)) out.push_back(make_view(std::move(e)));
   return out;
@@ -194,9 +196,10 @@ DeleteOutcome JobService::cancel_or_delete(const std::string& id, std::chrono::m
       break;
   }
   const auto after = table_.wait(
-      id, std::chrono::steady_clock::now() + wait, [](const JobRecord& r) { return r.state != JobState::kRunning; },
-      [] { return false; });
-  return !after || after->state != JobState::kRunning ? DeleteOutcome::kCancelled : DeleteOutcome::kCancelling;
+      id, std::chrono::steady_clock::now() + wait,
+      [](const JobRecord& r) { return r.state != JobState::kRunning; }, [] { return false; });
+  return !after || after->state != JobState::kRunning ? DeleteOutcome::kCancelled
+                                                      : DeleteOutcome::kCancelling;
 }
 
 std::shared_ptr<const Image> JobService::preview(const std::string& id) const {
@@ -204,10 +207,11 @@ std::shared_ptr<const Image> JobService::preview(const std::string& id) const {
   return entry && entry->runtime ? entry->runtime->preview() : nullptr;
 }
 
-std::optional<JobRecord> JobService::wait_finished(const std::string& id,
-                                                   std::chrono::steady_clock::time_point deadline) const {
+std::optional<JobRecord> JobService::wait_finished(
+    const std::string& id, std::chrono::steady_clock::time_point deadline) const {
   return table_.wait(
-      id, deadline, [](const JobRecord& r) { return is_finished(r.state) || r.state == JobState::kDeleted; },
+      id, deadline,
+      [](const JobRecord& r) { return is_finished(r.state) || r.state == JobState::kDeleted; },
       [this] { return stopping_.load(); });
 }
 
@@ -221,7 +225,8 @@ void JobService::expire_now() {
 }
 
 void JobService::reaper_loop() {
-  const auto period = std::chrono::duration<double>(std::clamp(config_.retention_seconds / 4, 0.05, 60.0));
+  const auto period =
+      std::chrono::duration<double>(std::clamp(config_.retention_seconds / 4, 0.05, 60.0));
   std::unique_lock lock(reaper_mutex_);
   while (!stopping_) {
     reaper_cv_.wait_for(lock, period, [&] { return stopping_.load(); });
@@ -243,9 +248,7 @@ void JobService::begin_shutdown() {
   workers_.begin_shutdown();
   queue_.close();
   table_.wake_all();
-  {
-    std::lock_guard rl(reaper_mutex_);
-  }
+  { std::lock_guard rl(reaper_mutex_); }
   reaper_cv_.notify_all();
 }
 

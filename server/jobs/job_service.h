@@ -53,16 +53,16 @@ struct SubmitOutcome {
 
 struct JobView {
   JobRecord record;
-  std::optional<RenderProgress> progress;        // while running
-  std::optional<std::size_t> queue_position;     // while queued
+  std::optional<RenderProgress> progress;     // while running
+  std::optional<std::size_t> queue_position;  // while queued
   bool stop_requested = false;
 };
 
 enum class DeleteOutcome {
-  kNotFound,     // never existed (or expired)
-  kCancelled,    // was queued or running, now cancelled
-  kCancelling,   // running; the render has been told to stop but has not yet
-  kDeleted,      // was finished; record and result removed
+  kNotFound,    // never existed (or expired)
+  kCancelled,   // was queued or running, now cancelled
+  kCancelling,  // running; the render has been told to stop but has not yet
+  kDeleted,     // was finished; record and result removed
 };
 
 class JobService {
@@ -83,7 +83,8 @@ class JobService {
     return results_.open(id, format);
   }
   // Blocks until the job is finished, the deadline passes or shutdown begins.
-  std::optional<JobRecord> wait_finished(const std::string& id, std::chrono::steady_clock::time_point deadline) const;
+  std::optional<JobRecord> wait_finished(const std::string& id,
+                                         std::chrono::steady_clock::time_point deadline) const;
 
   bool accepting() const { return accepting_.load(); }
   // Stops taking jobs; running renders are put back in the queue, except one that will be done

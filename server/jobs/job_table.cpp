@@ -5,7 +5,8 @@
 namespace penumbra::server {
 
 std::vector<std::string> JobTable::restore(std::vector<JobRecord> records) {
-  std::sort(records.begin(), records.end(), [](const JobRecord& a, const JobRecord& b) { return a.seq < b.seq; });
+  std::sort(records.begin(), records.end(),
+            [](const JobRecord& a, const JobRecord& b) { return a.seq < b.seq; });
   std::vector<std::string> queued;
   std::lock_guard lock(mutex_);
   for (JobRecord& r : records) {
@@ -49,7 +50,8 @@ std::optional<JobRecord> JobTable::find_by_key(const std::string& key) const {
   return jobs_.at(k->second).record;
 }
 
-std::vector<JobEntry> JobTable::list(std::optional<JobState> state, int64_t before_seq, int limit) const {
+std::vector<JobEntry> JobTable::list(std::optional<JobState> state, int64_t before_seq,
+                                     int limit) const {
   std::vector<JobEntry> out;
   std::lock_guard lock(mutex_);
   auto it = before_seq > 0 ? by_seq_.lower_bound(before_seq) : by_seq_.end();
@@ -102,7 +104,8 @@ std::vector<std::string> JobTable::take_expired(double finished_before) {
     std::lock_guard lock(mutex_);
     for (auto it = jobs_.begin(); it != jobs_.end();) {
       const JobRecord& r = it->second.record;
-      if ((is_finished(r.state) || r.state == JobState::kDeleted) && r.finished_at < finished_before) {
+      if ((is_finished(r.state) || r.state == JobState::kDeleted) &&
+          r.finished_at < finished_before) {
         ids.push_back(r.id);
         by_seq_.erase(r.seq);
         if (!r.idempotency_key.empty()) by_key_.erase(r.idempotency_key);
@@ -117,7 +120,8 @@ std::vector<std::string> JobTable::take_expired(double finished_before) {
   return ids;
 }
 
-std::optional<JobRecord> JobTable::wait(const std::string& id, std::chrono::steady_clock::time_point deadline,
+std::optional<JobRecord> JobTable::wait(const std::string& id,
+                                        std::chrono::steady_clock::time_point deadline,
                                         const std::function<bool(const JobRecord&)>& done,
                                         const std::function<bool()>& give_up) const {
   std::unique_lock lock(mutex_);
@@ -127,7 +131,8 @@ std::optional<JobRecord> JobTable::wait(const std::string& id, std::chrono::stea
     if (done(it->second.record) || give_up() || std::chrono::steady_clock::now() >= deadline)
       return it->second.record;
     // The timeout bounds a wake-up missed by give_up(), which is not set under this lock.
-    changed_.wait_until(lock, std::min(deadline, std::chrono::steady_clock::now() + std::chrono::milliseconds(500)));
+    changed_.wait_until(lock, std::min(deadline, std::chrono::steady_clock::now() +
+                                                     std::chrono::milliseconds(500)));
   }
 }
 

@@ -47,13 +47,15 @@ class JobTable {
 
   // Calls change(entry) under the lock. When it returns true, the record it left is queued for
   // the store and waiters are woken; the ticket is returned. nullopt: no such job, or no change.
-  std::optional<StoreWriter::Ticket> modify(const std::string& id, const std::function<bool(JobEntry&)>& change);
+  std::optional<StoreWriter::Ticket> modify(const std::string& id,
+                                            const std::function<bool(JobEntry&)>& change);
   // Finished jobs and tombstones finished before the time: removed (and erased from the store).
   std::vector<std::string> take_expired(double finished_before);
 
   // Blocks until done(record) holds, the job is gone, give_up() is true or the deadline passes;
   // returns the record as it was then (nullopt when gone). Woken by every change and wake_all().
-  std::optional<JobRecord> wait(const std::string& id, std::chrono::steady_clock::time_point deadline,
+  std::optional<JobRecord> wait(const std::string& id,
+                                std::chrono::steady_clock::time_point deadline,
                                 const std::function<bool(const JobRecord&)>& done,
                                 const std::function<bool()>& give_up) const;
   void wake_all();

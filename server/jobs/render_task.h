@@ -12,8 +12,8 @@ namespace penumbra::server {
 
 struct RenderJobOptions {
   api::Limits limits;
-  int threads = 0;                 // render threads for this job
-  double max_render_seconds = 0;   // the server's budget per job; 0 = none
+  int threads = 0;                // render threads for this job
+  double max_render_seconds = 0;  // the server's budget per job; 0 = none
 };
 
 struct RenderOutcome {

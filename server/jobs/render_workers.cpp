@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cstdio>
-
 #include <nlohmann/json.hpp>
 
 #include "renderer/io/image_io.h"
@@ -17,7 +16,9 @@ constexpr int kMaxAttempts = 3;
 // At shutdown, a render that will be done within this many seconds is finished, not requeued.
 constexpr double kFinishAtShutdownSeconds = 5.0;
 
-std::string error_json(const std::string& detail) { return nlohmann::ordered_json{{"detail", detail}}.dump(); }
+std::string error_json(const std::string& detail) {
+  return nlohmann::ordered_json{{"detail", detail}}.dump();
+}
 
 std::string stats_json(const RenderOutcome& o, int threads) {
   const RenderStats& s = o.stats;
@@ -35,10 +36,11 @@ std::string stats_json(const RenderOutcome& o, int threads) {
 }
 
 // A running (or, when `from_queued`, a queued) job ends in `state`.
-std::function<bool(JobEntry&)> settle(JobState state, double now, std::string stats, std::string error,
-                                      bool from_queued = false) {
+std::function<bool(JobEntry&)> settle(JobState state, double now, std::string stats,
+                                      std::string error, bool from_queued = false) {
   return [=](JobEntry& e) {
-    const bool live = e.record.state == JobState::kRunning || (from_queued && e.record.state == JobState::kQueued);
+    const bool live = e.record.state == JobState::kRunning ||
+                      (from_queued && e.record.state == JobState::kQueued);
     if (!live) return false;
     e.record.state = state;
     e.record.finished_at = now;
@@ -51,9 +53,15 @@ std::function<bool(JobEntry&)> settle(JobState state, double now, std::string st
 
 }  // namespace
 
-RenderWorkers::RenderWorkers(const ServerConfig& config, JobQueue& queue, JobTable& table, StoreWriter& writer,
-                             JobStore& store, ResultStore& results, Metrics& metrics)
-    : config_(config), queue_(queue), table_(table), writer_(writer), store_(store), results_(results),
+RenderWorkers::RenderWorkers(const ServerConfig& config, JobQueue& queue, JobTable& table,
+                             StoreWriter& writer, JobStore& store, ResultStore& results,
+                             Metrics& metrics)
+    : config_(config),
+      queue_(queue),
+      table_(table),
+      writer_(writer),
+      store_(store),
+      results_(results),
       metrics_(metrics) {}
 
 RenderWorkers::~RenderWorkers() { join(); }
@@ -132,7 +140,8 @@ void RenderWorkers::run_job(const std::string& id) {
   writer_.wait_durable(*ticket);
   const auto scene = store_.scene(id);
   if (!scene) {
-    table_.modify(id, settle(JobState::kFailed, unix_now(), "", error_json("the job's scene is missing from the store")));
+    table_.modify(id, settle(JobState::kFailed, unix_now(), "",
+                             error_json("the job's scene is missing from the store")));
     return;
   }
   RenderJobOptions options;
@@ -140,7 +149,8 @@ void RenderWorkers::run_job(const std::string& id) {
   options.threads = config_.threads_per_job();
   options.max_render_seconds = config_.max_render_seconds;
   const RenderOutcome outcome = run_render_job(*scene, options, *runtime);
-  if (outcome.kind == RenderOutcome::Kind::kStopped && runtime->stop_reason() == JobRuntime::StopReason::kShutdown) {
+  if (outcome.kind == RenderOutcome::Kind::kStopped &&
+      runtime->stop_reason() == JobRuntime::StopReason::kShutdown) {
     table_.modify(id, [](JobEntry& e) {  // runs again after the restart; the attempt does not count
       if (e.record.state != JobState::kRunning) return false;
       e.record.state = JobState::kQueued;

@@ -76,7 +76,8 @@ void StoreWriter::run() {
   }
 }
 
-void StoreWriter::record_failure(const std::vector<JobChange>& batch, Ticket first, const std::string& what) {
+void StoreWriter::record_failure(const std::vector<JobChange>& batch, Ticket first,
+                                 const std::string& what) {
   // The memory state keeps these changes, the disk does not: a restart would show the jobs as
   // they were before. Said loudly, with the jobs concerned, since no client request fails for
   // most of them.
@@ -84,7 +85,8 @@ void StoreWriter::record_failure(const std::vector<JobChange>& batch, Ticket fir
   for (std::size_t i = 0; i < batch.size() && i < kChangesLogged; ++i)
     changes += (i ? ", " : "") + describe(batch[i]);
   if (batch.size() > kChangesLogged) changes += ", ...";
-  std::fprintf(stderr, "penumbra serve: store: commit of %zu change(s) [%s] (tickets %llu..) failed: %s\n",
+  std::fprintf(stderr,
+               "penumbra serve: store: commit of %zu change(s) [%s] (tickets %llu..) failed: %s\n",
                batch.size(), changes.c_str(), static_cast<unsigned long long>(first), what.c_str());
 }
 

@@ -46,7 +46,7 @@ class StoreWriter {
   std::condition_variable done_cv_;  // applied_ moved
   std::vector<JobChange> pending_;
   Ticket last_enqueued_ = 0;
-  Ticket applied_ = 0;  // every ticket <= applied_ has been committed or has failed
+  Ticket applied_ = 0;            // every ticket <= applied_ has been committed or has failed
   std::deque<Failure> failures_;  // the most recent ones; older waiters are long gone
   bool stopping_ = false;
   std::thread thread_;

@@ -1,12 +1,13 @@
 #include "server/storage/file_result_store.h"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <cerrno>
 #include <cstring>
-#include <fcntl.h>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
-#include <unistd.h>
 
 namespace penumbra::server {
 namespace fs = std::filesystem;
@@ -21,17 +22,20 @@ void fsync_dir(const std::string& dir) {
 }
 }  // namespace
 
-FileResultStore::FileResultStore(const std::string& data_dir) : dir_((fs::path(data_dir) / "results").string()) {
+FileResultStore::FileResultStore(const std::string& data_dir)
+    : dir_((fs::path(data_dir) / "results").string()) {
   fs::create_directories(dir_);
   for (const auto& entry : fs::directory_iterator(dir_))
-    if (entry.path().filename().string().find(".tmp") != std::string::npos) fs::remove(entry.path());
+    if (entry.path().filename().string().find(".tmp") != std::string::npos)
+      fs::remove(entry.path());
 }
 
 std::string FileResultStore::path(const std::string& id, const std::string& format) const {
   return (fs::path(dir_) / (id + "." + format)).string();
 }
 
-std::optional<StoredResult> FileResultStore::open(const std::string& id, const std::string& format) const {
+std::optional<StoredResult> FileResultStore::open(const std::string& id,
+                                                  const std::string& format) const {
   const std::string file = path(id, format);
   auto stream = std::make_shared<std::ifstream>(file, std::ios::binary);
   if (!*stream) return std::nullopt;

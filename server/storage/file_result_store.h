@@ -9,8 +9,10 @@ namespace penumbra::server {
 
 class FileResultStore final : public ResultStore {
  public:
-  explicit FileResultStore(const std::string& data_dir);  // creates DIR/results, removes stale temp files
-  void write(const std::string& id, const std::string& format, const std::vector<uint8_t>& bytes) override;
+  explicit FileResultStore(
+      const std::string& data_dir);  // creates DIR/results, removes stale temp files
+  void write(const std::string& id, const std::string& format,
+             const std::vector<uint8_t>& bytes) override;
   std::optional<StoredResult> open(const std::string& id, const std::string& format) const override;
   void remove(const std::string& id) override;
   std::string path(const std::string& id, const std::string& format) const;

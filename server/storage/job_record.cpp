@@ -1,5 +1,8 @@
 #include "server/storage/job_record.h"
 
+#include <array>
+#include <utility>
+
 namespace penumbra::server {
 
 bool is_valid_job_id(std::string_view id) {
@@ -9,22 +12,29 @@ bool is_valid_job_id(std::string_view id) {
   return true;
 }
 
+namespace {
+
+// Stored in the job store, and shown in the API (all but "deleted", a tombstone never shown).
+constexpr std::array<std::pair<JobState, const char*>, 6> kStateNames = {{
+    {JobState::kQueued, "queued"},
+    {JobState::kRunning, "running"},
+    {JobState::kSucceeded, "succeeded"},
+    {JobState::kFailed, "failed"},
+    {JobState::kCancelled, "cancelled"},
+    {JobState::kDeleted, "deleted"},
+}};
+
+}  // namespace
+
 const char* to_string(JobState s) {
-  switch (s) {
-    case JobState::kQueued: return "queued";
-    case JobState::kRunning: return "running";
-    case JobState::kSucceeded: return "succeeded";
-    case JobState::kFailed: return "failed";
-    case JobState::kCancelled: return "cancelled";
-    case JobState::kDeleted: return "deleted";
-  }
+  for (const auto& [state, name] : kStateNames)
+    if (state == s) return name;
   return "unknown";
 }
 
 std::optional<JobState> job_state_from_string(const std::string& s) {
-  for (JobState st : {JobState::kQueued, JobState::kRunning, JobState::kSucceeded,
-                      JobState::kFailed, JobState::kCancelled, JobState::kDeleted})
-    if (s == to_string(st)) return st;
+  for (const auto& [state, name] : kStateNames)
+    if (s == name) return state;
   return std::nullopt;
 }
 

@@ -23,7 +23,7 @@ struct JobRecord {
   std::string id;
   int64_t seq = 0;  // submission order; newest first in listings
   JobState state = JobState::kQueued;
-  std::string idempotency_key;  // "" = none
+  std::string idempotency_key;                             // "" = none
   double created_at = 0, started_at = 0, finished_at = 0;  // Unix seconds, 0 = not yet
   int attempts = 0;  // times a render started (a kill -9 mid-render leaves it counted)
   int width = 0, height = 0, spp = 0;

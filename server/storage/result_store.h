@@ -20,9 +20,11 @@ class ResultStore {
   virtual ~ResultStore() = default;
   // Whole or not at all, and durable when it returns: a reader, or a restart after kill -9,
   // sees the complete image or none. Throws std::runtime_error.
-  virtual void write(const std::string& id, const std::string& format, const std::vector<uint8_t>& bytes) = 0;
+  virtual void write(const std::string& id, const std::string& format,
+                     const std::vector<uint8_t>& bytes) = 0;
   // nullopt when there is no such result.
-  virtual std::optional<StoredResult> open(const std::string& id, const std::string& format) const = 0;
+  virtual std::optional<StoredResult> open(const std::string& id,
+                                           const std::string& format) const = 0;
   // Every format of the job; a missing result is fine.
   virtual void remove(const std::string& id) = 0;
 };

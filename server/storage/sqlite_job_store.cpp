@@ -48,7 +48,8 @@ class Statement {
 };
 
 constexpr const char* kColumns =
-    "id, seq, state, idempotency_key, created_at, started_at, finished_at, attempts, width, height, "
+    "id, seq, state, idempotency_key, created_at, started_at, finished_at, attempts, width, "
+    "height, "
     "spp, samples_total, stats, error, warnings";
 
 JobRecord read_record(const Statement& s) {
@@ -74,7 +75,8 @@ JobRecord read_record(const Statement& s) {
 }  // namespace
 
 SqliteJobStore::SqliteJobStore(const std::string& path) {
-  if (sqlite3_open_v2(path.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_NOMUTEX,
+  if (sqlite3_open_v2(path.c_str(), &db_,
+                      SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_NOMUTEX,
                       nullptr) != SQLITE_OK) {
     const std::string msg = db_ ? sqlite3_errmsg(db_) : "out of memory";
     sqlite3_close(db_);
@@ -93,11 +95,14 @@ SqliteJobStore::SqliteJobStore(const std::string& path) {
       " state TEXT NOT NULL,"
       " scene TEXT NOT NULL,"
       " idempotency_key TEXT UNIQUE,"
-      " created_at REAL NOT NULL, started_at REAL NOT NULL DEFAULT 0, finished_at REAL NOT NULL DEFAULT 0,"
+      " created_at REAL NOT NULL, started_at REAL NOT NULL DEFAULT 0, finished_at REAL NOT NULL "
+      "DEFAULT 0,"
       " attempts INTEGER NOT NULL DEFAULT 0,"
-      " width INTEGER NOT NULL DEFAULT 0, height INTEGER NOT NULL DEFAULT 0, spp INTEGER NOT NULL DEFAULT 0,"
+      " width INTEGER NOT NULL DEFAULT 0, height INTEGER NOT NULL DEFAULT 0, spp INTEGER NOT NULL "
+      "DEFAULT 0,"
       " samples_total INTEGER NOT NULL DEFAULT 0,"
-      " stats TEXT NOT NULL DEFAULT '', error TEXT NOT NULL DEFAULT '', warnings TEXT NOT NULL DEFAULT '')");
+      " stats TEXT NOT NULL DEFAULT '', error TEXT NOT NULL DEFAULT '', warnings TEXT NOT NULL "
+      "DEFAULT '')");
   exec("CREATE INDEX IF NOT EXISTS jobs_by_state ON jobs(state, seq)");
 }
 
@@ -154,8 +159,14 @@ void SqliteJobStore::apply_one(const JobChange& change) {
                 "INSERT INTO jobs (seq, id, state, scene, idempotency_key, created_at, started_at, "
                 "finished_at, attempts, width, height, spp, samples_total, stats, error, warnings) "
                 "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
-    s.bind(1, r.seq).bind(2, r.id).bind(3, std::string(to_string(r.state))).bind(4, insert->scene_json);
-    s.bind_or_null(5, r.idempotency_key).bind(6, r.created_at).bind(7, r.started_at).bind(8, r.finished_at);
+    s.bind(1, r.seq)
+        .bind(2, r.id)
+        .bind(3, std::string(to_string(r.state)))
+        .bind(4, insert->scene_json);
+    s.bind_or_null(5, r.idempotency_key)
+        .bind(6, r.created_at)
+        .bind(7, r.started_at)
+        .bind(8, r.finished_at);
     s.bind(9, int64_t(r.attempts)).bind(10, int64_t(r.width)).bind(11, int64_t(r.height));
     s.bind(12, int64_t(r.spp)).bind(13, int64_t(r.samples_total)).bind(14, r.stats_json);
     s.bind(15, r.error_json).bind(16, r.warnings_json);
@@ -163,11 +174,14 @@ void SqliteJobStore::apply_one(const JobChange& change) {
   } else if (const auto* update = std::get_if<UpdateJob>(&change)) {
     const JobRecord& r = update->record;
     // A tombstone's scene goes: it can be megabytes and nothing reads it again.
-    Statement s(db_,
-                "UPDATE jobs SET state = ?1, idempotency_key = ?2, started_at = ?3, finished_at = ?4, "
-                "attempts = ?5, samples_total = ?6, stats = ?7, error = ?8, warnings = ?9, "
-                "scene = CASE WHEN ?1 = 'deleted' THEN '' ELSE scene END WHERE id = ?10");
-    s.bind(1, std::string(to_string(r.state))).bind_or_null(2, r.idempotency_key).bind(3, r.started_at);
+    Statement s(
+        db_,
+        "UPDATE jobs SET state = ?1, idempotency_key = ?2, started_at = ?3, finished_at = ?4, "
+        "attempts = ?5, samples_total = ?6, stats = ?7, error = ?8, warnings = ?9, "
+        "scene = CASE WHEN ?1 = 'deleted' THEN '' ELSE scene END WHERE id = ?10");
+    s.bind(1, std::string(to_string(r.state)))
+        .bind_or_null(2, r.idempotency_key)
+        .bind(3, r.started_at);
     s.bind(4, r.finished_at).bind(5, int64_t(r.attempts)).bind(6, int64_t(r.samples_total));
     s.bind(7, r.stats_json).bind(8, r.error_json).bind(9, r.warnings_json).bind(10, r.id);
     s.step();

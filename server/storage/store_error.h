@@ -1,5 +1,6 @@
 #pragma once
-// The one exception type of the storage layer (a failed read, write or commit), whatever the backend.
+// The one exception type of the storage layer (a failed read, write or commit), whatever the
+// backend.
 #include <stdexcept>
 
 namespace penumbra::server {

@@ -1,9 +1,9 @@
 // Flags and environment variables of `penumbra serve`, durations and sizes, loopback detection.
+#include "server/server_config.h"
+
 #include <gtest/gtest.h>
 
 #include <map>
-
-#include "server/server_config.h"
 
 namespace penumbra::test {
 namespace {
@@ -31,9 +31,11 @@ TEST(ServerConfig, DefaultsAreDocumented) {
 }
 
 TEST(ServerConfig, FlagsOverrideEnvironmentOverrideDefaults) {
-  const auto p = parse({"--port", "9000", "--max-body=1M"},
-                       {{"PENUMBRA_PORT", "7000"}, {"PENUMBRA_WORKERS", "3"}, {"PENUMBRA_TOKEN", "s3cret"},
-                        {"PENUMBRA_RETENTION", "15m"}, {"PENUMBRA_DATA_DIR", "/data"}});
+  const auto p = parse({"--port", "9000", "--max-body=1M"}, {{"PENUMBRA_PORT", "7000"},
+                                                             {"PENUMBRA_WORKERS", "3"},
+                                                             {"PENUMBRA_TOKEN", "s3cret"},
+                                                             {"PENUMBRA_RETENTION", "15m"},
+                                                             {"PENUMBRA_DATA_DIR", "/data"}});
   ASSERT_TRUE(p.config) << p.error;
   EXPECT_EQ(p.config->port, 9000);
   EXPECT_EQ(p.config->workers, 3);
@@ -49,16 +51,33 @@ TEST(ServerConfig, RejectsBadValuesNamingTheFlag) {
   EXPECT_NE(parse({"--retention", "soon"}).error.find("--retention"), std::string::npos);
   EXPECT_NE(parse({"--bogus"}).error.find("unknown option"), std::string::npos);
   EXPECT_NE(parse({"--port"}).error.find("missing value"), std::string::npos);
-  EXPECT_NE(parse({}, {{"PENUMBRA_MAX_SPP", "x"}}).error.find("PENUMBRA_MAX_SPP"), std::string::npos);
+  EXPECT_NE(parse({}, {{"PENUMBRA_MAX_SPP", "x"}}).error.find("PENUMBRA_MAX_SPP"),
+            std::string::npos);
   EXPECT_TRUE(parse({"--help"}).help);
 }
 
 TEST(ServerConfig, EveryFlagIsInTheUsage) {
   const std::string usage = serve_usage();
-  for (const char* flag : {"--host", "--port", "--data-dir", "--workers", "--render-threads", "--max-queue",
-                           "--max-body", "--max-pixels", "--max-spp", "--max-triangles", "--max-render-time",
-                           "--retention", "--token", "--insecure", "--http-threads", "--read-timeout",
-                           "--write-timeout", "--keep-alive", "--keep-alive-requests", "--drain",
+  for (const char* flag : {"--host",
+                           "--port",
+                           "--data-dir",
+                           "--workers",
+                           "--render-threads",
+                           "--max-queue",
+                           "--max-body",
+                           "--max-pixels",
+                           "--max-spp",
+                           "--max-triangles",
+                           "--max-render-time",
+                           "--retention",
+                           "--token",
+                           "--insecure",
+                           "--http-threads",
+                           "--read-timeout",
+                           "--write-timeout",
+                           "--keep-alive",
+                           "--keep-alive-requests",
+                           "--drain",
                            "--access-log"}) {
     EXPECT_NE(usage.find(flag), std::string::npos) << flag;
   }

@@ -5,11 +5,10 @@
 
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <random>
 #include <sstream>
 #include <string>
-
-#include <nlohmann/json.hpp>
 
 namespace penumbra::test {
 
@@ -44,7 +43,8 @@ inline std::string read_file(const std::string& path) {
 
 // A valid scene (the Cornell box of scenes/) at a tiny size.
 inline Json tiny_scene(int width = 16, int height = 16, int spp = 2) {
-  Json scene = Json::parse(read_file(std::string(PENUMBRA_SOURCE_DIR) + "/scenes/cornell_box.json"));
+  Json scene =
+      Json::parse(read_file(std::string(PENUMBRA_SOURCE_DIR) + "/scenes/cornell_box.json"));
   scene["render"]["width"] = width;
   scene["render"]["height"] = height;
   scene["render"]["spp"] = spp;

@@ -1,8 +1,8 @@
 // Result format negotiation: ?format= wins, then Accept in the client's order with q=0
 // refusals honoured, else PNG; 400 and 406 problems.
-#include <gtest/gtest.h>
-
 #include "server/http/accept_negotiation.h"
+
+#include <gtest/gtest.h>
 
 namespace penumbra::test {
 namespace {
@@ -45,7 +45,8 @@ TEST(AcceptNegotiation, QZeroRefusesARange) {
 }
 
 TEST(AcceptNegotiation, ZeroQvalues) {
-  for (const char* zero : {"0", "0.", "0.0", "0.000"}) EXPECT_TRUE(server::is_zero_qvalue(zero)) << zero;
+  for (const char* zero : {"0", "0.", "0.0", "0.000"})
+    EXPECT_TRUE(server::is_zero_qvalue(zero)) << zero;
   for (const char* not_zero : {"", "1", "0.5", "0.001", "00", "0x", ".0"})
     EXPECT_FALSE(server::is_zero_qvalue(not_zero)) << not_zero;
 }
@@ -53,7 +54,8 @@ TEST(AcceptNegotiation, ZeroQvalues) {
 TEST(AcceptNegotiation, TheFormatParameterWins) {
   EXPECT_EQ(std::get<ImageFormat>(negotiate_image_format("EXR", "image/png")), ImageFormat::kExr);
   EXPECT_EQ(std::get<ImageFormat>(negotiate_image_format("png", "text/html")), ImageFormat::kPng);
-  EXPECT_EQ(std::get<ImageFormat>(negotiate_image_format(std::nullopt, std::nullopt)), ImageFormat::kPng);
+  EXPECT_EQ(std::get<ImageFormat>(negotiate_image_format(std::nullopt, std::nullopt)),
+            ImageFormat::kPng);
   const auto bad = negotiate_image_format("gif", std::nullopt);
   ASSERT_TRUE(std::holds_alternative<Problem>(bad));
   const Problem& p = std::get<Problem>(bad);

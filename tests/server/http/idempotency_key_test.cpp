@@ -1,7 +1,7 @@
 // The Idempotency-Key header at its boundaries: absent, quoted, 255 and 256 characters.
-#include <gtest/gtest.h>
-
 #include "server/http/idempotency_key.h"
+
+#include <gtest/gtest.h>
 
 namespace penumbra::test {
 namespace {
@@ -9,13 +9,16 @@ namespace {
 using server::parse_idempotency_key;
 using server::Problem;
 
-bool refused(const std::string& header) { return std::holds_alternative<Problem>(parse_idempotency_key(header)); }
+bool refused(const std::string& header) {
+  return std::holds_alternative<Problem>(parse_idempotency_key(header));
+}
 
 TEST(IdempotencyKey, ParsedForms) {
   EXPECT_EQ(std::get<std::string>(parse_idempotency_key(std::nullopt)), "") << "no header, no key";
   EXPECT_EQ(std::get<std::string>(parse_idempotency_key("order-42")), "order-42");
   EXPECT_EQ(std::get<std::string>(parse_idempotency_key(" \"order-42\"\t")), "order-42");
-  EXPECT_EQ(std::get<std::string>(parse_idempotency_key(std::string(255, 'k'))), std::string(255, 'k'));
+  EXPECT_EQ(std::get<std::string>(parse_idempotency_key(std::string(255, 'k'))),
+            std::string(255, 'k'));
 }
 
 TEST(IdempotencyKey, RefusedForms) {

@@ -1,10 +1,10 @@
 // The pre-routing guard: framing, encodings, body limit at limit and limit + 1, ranges, token.
-#include <gtest/gtest.h>
+#include "server/http/request_guard.h"
 
+#include <gtest/gtest.h>
 #include <httplib.h>
 
 #include "server/http/auth.h"
-#include "server/http/request_guard.h"
 
 namespace penumbra::test {
 namespace {

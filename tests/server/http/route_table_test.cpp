@@ -1,7 +1,7 @@
 // Route templates (metric labels, 405 answers), found without std::regex.
-#include <gtest/gtest.h>
-
 #include "server/http/route_table.h"
+
+#include <gtest/gtest.h>
 
 namespace penumbra::test {
 namespace {

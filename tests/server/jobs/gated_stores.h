@@ -66,10 +66,12 @@ class GatedJobStore final : public server::JobStore {
 class GatedResultStore final : public server::ResultStore {
  public:
   GatedResultStore(server::ResultStore& inner, Gate& gate) : inner_(inner), gate_(gate) {}
-  void write(const std::string& id, const std::string& format, const std::vector<uint8_t>& bytes) override {
+  void write(const std::string& id, const std::string& format,
+             const std::vector<uint8_t>& bytes) override {
     inner_.write(id, format, bytes);
   }
-  std::optional<server::StoredResult> open(const std::string& id, const std::string& format) const override {
+  std::optional<server::StoredResult> open(const std::string& id,
+                                           const std::string& format) const override {
     return inner_.open(id, format);
   }
   void remove(const std::string& id) override {

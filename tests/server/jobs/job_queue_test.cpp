@@ -1,9 +1,9 @@
 // The FIFO of queued job ids: order, capacity, removal (cancel), positions, close.
+#include "server/jobs/job_queue.h"
+
 #include <gtest/gtest.h>
 
 #include <future>
-
-#include "server/jobs/job_queue.h"
 
 namespace penumbra::test {
 namespace {
@@ -29,7 +29,8 @@ TEST(JobQueue, CapacityAtTheBoundaryAndForcedPushes) {
   EXPECT_EQ(q.push("b"), JobQueue::PushResult::kPushed);
   EXPECT_TRUE(q.full());
   EXPECT_EQ(q.push("c"), JobQueue::PushResult::kFull);
-  EXPECT_EQ(q.push("c", /*force=*/true), JobQueue::PushResult::kPushed) << "recovered jobs were accepted";
+  EXPECT_EQ(q.push("c", /*force=*/true), JobQueue::PushResult::kPushed)
+      << "recovered jobs were accepted";
   EXPECT_EQ(q.size(), 3u);
 }
 

@@ -35,7 +35,8 @@ TEST(JobService, AJobGoesFromQueuedThroughRunningToSucceededOnDisk) {
   EXPECT_EQ(done->record.attempts, 1);
   EXPECT_GT(done->record.started_at, 0);
   EXPECT_GE(done->record.finished_at, done->record.started_at);
-  EXPECT_NE(done->record.stats_json.find("\"camera_samples\":128"), std::string::npos) << done->record.stats_json;
+  EXPECT_NE(done->record.stats_json.find("\"camera_samples\":128"), std::string::npos)
+      << done->record.stats_json;
   const auto png = s->open_result(o.record.id, "png");
   ASSERT_TRUE(png);
   EXPECT_GT(png->size, 0u);
@@ -77,9 +78,9 @@ TEST(JobService, ARestartRunsInterruptedAndQueuedJobsInSubmissionOrder) {
       crashed.push_back(server::InsertJob{r, tiny_scene(8, 8, 1).dump()});
       return r.id;
     };
-    job(1, JobState::kRunning, 1);   // interrupted once: runs again
+    job(1, JobState::kRunning, 1);  // interrupted once: runs again
     job(2, JobState::kQueued, 0);
-    job(3, JobState::kRunning, 3);   // interrupted three times: fails instead of crash-looping
+    job(3, JobState::kRunning, 3);  // interrupted three times: fails instead of crash-looping
     job(4, JobState::kQueued, 0);
     store.apply(crashed);
   }
@@ -161,7 +162,8 @@ TEST(JobService, FinishedJobsExpireFromMemoryTheStoreAndTheDisk) {
   Service s(dir.path(), config);
   const std::string id = submit_ok(*s, tiny_scene(8, 8, 1));
   // It renders, then goes 0.3 s after it finished (polling for "succeeded" could miss it).
-  const auto gone = wait_until(*s, id, [](JobState) { return false; }, 10s);
+  const auto gone = wait_until(
+      *s, id, [](JobState) { return false; }, 10s);
   EXPECT_FALSE(gone) << "expired after the retention";
   s.stop();
   EXPECT_FALSE(stored(s.sqlite(), id)) << "and erased from the store";

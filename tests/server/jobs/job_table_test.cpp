@@ -1,8 +1,9 @@
 // The in-memory job table: listings newest first with paging and filters, the idempotency-key
 // index following tombstones, expiry, and every change reaching the store in order.
+#include "server/jobs/job_table.h"
+
 #include <gtest/gtest.h>
 
-#include "server/jobs/job_table.h"
 #include "server/storage/sqlite_job_store.h"
 #include "tests/server/test_support.h"
 
@@ -35,10 +36,11 @@ TEST(JobTable, ListsNewestFirstPageByPage) {
   server::SqliteJobStore store(dir.path() + "/jobs.db");
   server::StoreWriter writer(store);
   server::JobTable table(writer);
-  table.restore({job(3, JobState::kSucceeded), job(1, JobState::kQueued), job(2, JobState::kDeleted),
-                 job(5, JobState::kQueued), job(4, JobState::kFailed)});
+  table.restore({job(3, JobState::kSucceeded), job(1, JobState::kQueued),
+                 job(2, JobState::kDeleted), job(5, JobState::kQueued), job(4, JobState::kFailed)});
   using V = std::vector<std::string>;
-  EXPECT_EQ(ids(table.list(std::nullopt, 0, 10)), (V{"job5", "job4", "job3", "job1"})) << "no tombstones";
+  EXPECT_EQ(ids(table.list(std::nullopt, 0, 10)), (V{"job5", "job4", "job3", "job1"}))
+      << "no tombstones";
   EXPECT_EQ(ids(table.list(std::nullopt, 0, 2)), (V{"job5", "job4"}));
   EXPECT_EQ(ids(table.list(std::nullopt, 4, 2)), (V{"job3", "job1"})) << "the page after seq 4";
   EXPECT_EQ(ids(table.list(JobState::kQueued, 0, 10)), (V{"job5", "job1"}));
@@ -70,7 +72,8 @@ TEST(JobTable, TheKeyIndexFollowsChangesAndEveryChangeIsStoredInOrder) {
       e.record.attempts = attempt;
       return true;
     });
-  EXPECT_FALSE(table.modify("job1", [](JobEntry&) { return false; })) << "no change, nothing queued";
+  EXPECT_FALSE(table.modify("job1", [](JobEntry&) { return false; }))
+      << "no change, nothing queued";
   EXPECT_FALSE(table.modify("nope", [](JobEntry&) { return true; }));
   const auto ticket = table.modify("job1", [](JobEntry& e) {
     e.record.state = JobState::kDeleted;
@@ -90,8 +93,8 @@ TEST(JobTable, ExpiryTakesFinishedJobsAndTombstonesOnly) {
   server::SqliteJobStore store(dir.path() + "/jobs.db");
   server::StoreWriter writer(store);
   server::JobTable table(writer);
-  table.restore({job(1, JobState::kSucceeded), job(2, JobState::kQueued), job(3, JobState::kCancelled),
-                 job(4, JobState::kFailed)});
+  table.restore({job(1, JobState::kSucceeded), job(2, JobState::kQueued),
+                 job(3, JobState::kCancelled), job(4, JobState::kFailed)});
   // finished_at is 200 + seq: jobs 1 and 3 are older than 203.5.
   auto expired = table.take_expired(203.5);
   std::sort(expired.begin(), expired.end());

@@ -27,7 +27,8 @@ inline server::ServerConfig service_config(const std::string& data_dir) {
 // Owns the stores and the service; a second Service on the same directory is a restart.
 class Service {
  public:
-  explicit Service(const std::string& data_dir, std::optional<server::ServerConfig> config = std::nullopt)
+  explicit Service(const std::string& data_dir,
+                   std::optional<server::ServerConfig> config = std::nullopt)
       : config_(config ? *config : service_config(data_dir)),
         sqlite_(data_dir + "/jobs.db"),
         files_(data_dir),
@@ -59,7 +60,8 @@ class Service {
   std::unique_ptr<server::JobService> service_;
 };
 
-inline std::string submit_ok(server::JobService& s, const Json& scene, const std::string& key = "") {
+inline std::string submit_ok(server::JobService& s, const Json& scene,
+                             const std::string& key = "") {
   const server::SubmitOutcome o = s.submit(scene.dump(), key);
   if (o.kind != server::SubmitOutcome::Kind::kAccepted) throw std::runtime_error("submit refused");
   return o.record.id;
@@ -67,8 +69,9 @@ inline std::string submit_ok(server::JobService& s, const Json& scene, const std
 
 // Polls the job until `done(state)`; returns the last view (nullopt once the job is gone).
 template <class Done>
-std::optional<server::JobView> wait_until(server::JobService& s, const std::string& id, Done done,
-                                          std::chrono::milliseconds timeout = std::chrono::seconds(60)) {
+std::optional<server::JobView> wait_until(
+    server::JobService& s, const std::string& id, Done done,
+    std::chrono::milliseconds timeout = std::chrono::seconds(60)) {
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   for (;;) {
     auto v = s.view(id);

@@ -26,8 +26,9 @@ struct PollTimes {
 // Polls the jobs (and a listing) `rounds` times on another thread. When they have not finished
 // within the timeout (a poll blocked behind the gate), opens the gate so the test fails instead
 // of hanging, and returns nullopt.
-std::optional<PollTimes> poll_on_the_side(server::JobService& s, const std::vector<std::string>& ids,
-                                          int rounds, std::chrono::milliseconds timeout, Gate& gate) {
+std::optional<PollTimes> poll_on_the_side(server::JobService& s,
+                                          const std::vector<std::string>& ids, int rounds,
+                                          std::chrono::milliseconds timeout, Gate& gate) {
   auto polls = std::async(std::launch::async, [&s, ids, rounds] {
     PollTimes t;
     for (int i = 0; i < rounds; ++i) {
@@ -60,11 +61,16 @@ TEST(StatusPath, PollsDoNotWaitForACommitInProgress) {
   // Every commit from now on blocks: a submission, a delete and a cancel all wait for one.
   s.commit_gate.close();
   const int commits_before = s.commit_gate.arrived();
-  auto submitting = std::async(std::launch::async, [&] { return s->submit(tiny_scene(8, 8, 1).dump(), ""); });
-  ASSERT_TRUE(s.commit_gate.wait_arrived(commits_before + 1)) << "the submission reached its commit";
-  auto deleting = std::async(std::launch::async, [&] { return s->cancel_or_delete(finished, 3000ms); });
-  auto cancelling = std::async(std::launch::async, [&] { return s->cancel_or_delete(queued, 3000ms); });
-  std::this_thread::sleep_for(100ms);  // both are now waiting for durability (or, if buggy, for a lock)
+  auto submitting =
+      std::async(std::launch::async, [&] { return s->submit(tiny_scene(8, 8, 1).dump(), ""); });
+  ASSERT_TRUE(s.commit_gate.wait_arrived(commits_before + 1))
+      << "the submission reached its commit";
+  auto deleting =
+      std::async(std::launch::async, [&] { return s->cancel_or_delete(finished, 3000ms); });
+  auto cancelling =
+      std::async(std::launch::async, [&] { return s->cancel_or_delete(queued, 3000ms); });
+  std::this_thread::sleep_for(
+      100ms);  // both are now waiting for durability (or, if buggy, for a lock)
 
   const auto times = poll_on_the_side(*s, {running, queued, finished}, 200, 5s, s.commit_gate);
   const bool still_committing = deleting.wait_for(0ms) == std::future_status::timeout &&
@@ -96,7 +102,8 @@ TEST(StatusPath, PollsDoNotWaitForAResultDeletion) {
   ASSERT_EQ(wait_for_state(*s, other, JobState::kSucceeded)->record.state, JobState::kSucceeded);
 
   s.delete_gate.close();
-  auto deleting = std::async(std::launch::async, [&] { return s->cancel_or_delete(finished, 3000ms); });
+  auto deleting =
+      std::async(std::launch::async, [&] { return s->cancel_or_delete(finished, 3000ms); });
   ASSERT_TRUE(s.delete_gate.wait_arrived(1)) << "the delete reached the file deletion";
 
   const auto times = poll_on_the_side(*s, {other, finished}, 200, 5s, s.delete_gate);

@@ -1,11 +1,12 @@
 // The store writer: a ticket is waited for until its commit is on disk, changes keep their
 // order across commits, a burst shares one commit, and a failed commit reaches its waiter and
 // the log instead of vanishing.
+#include "server/jobs/store_writer.h"
+
 #include <gtest/gtest.h>
 
 #include <future>
 
-#include "server/jobs/store_writer.h"
 #include "server/storage/sqlite_job_store.h"
 #include "tests/server/jobs/gated_stores.h"
 #include "tests/server/test_support.h"

@@ -1,10 +1,11 @@
 // Result files: whole or absent, readable while being removed, stale temporary files cleaned.
+#include "server/storage/file_result_store.h"
+
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
 
-#include "server/storage/file_result_store.h"
 #include "tests/server/test_support.h"
 
 namespace penumbra::test {
@@ -12,7 +13,9 @@ namespace {
 
 const std::string kId = "0123456789abcdef01234567";
 
-std::string read_all(std::istream& in) { return std::string(std::istreambuf_iterator<char>(in), {}); }
+std::string read_all(std::istream& in) {
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
 
 TEST(FileResultStore, WriteOpenRemove) {
   TempDir dir;

@@ -1,8 +1,9 @@
 // The SQLite job store against a temporary file: every field round-trips, updates and
 // tombstones, atomic batches, the sequence high-water mark, and what survives reopening.
+#include "server/storage/sqlite_job_store.h"
+
 #include <gtest/gtest.h>
 
-#include "server/storage/sqlite_job_store.h"
 #include "tests/server/test_support.h"
 
 namespace penumbra::test {
@@ -101,7 +102,8 @@ TEST(SqliteJobStore, TheLastSequenceNumberOutlivesErasedJobs) {
   TempDir dir;
   {
     SqliteJobStore store(dir.path() + "/jobs.db");
-    store.apply({InsertJob{record(1), "{}"}, InsertJob{record(2), "{}"}, InsertJob{record(3), "{}"}});
+    store.apply(
+        {InsertJob{record(1), "{}"}, InsertJob{record(2), "{}"}, InsertJob{record(3), "{}"}});
     store.apply({EraseJob{record(3).id}, EraseJob{record(2).id}});
   }
   SqliteJobStore store(dir.path() + "/jobs.db");
