@@ -9,12 +9,12 @@
 #include <thread>
 #include <unistd.h>
 
-#include "server/http_server.h"
-#include "server/job_service.h"
-#include "server/job_store.h"
+#include "server/http/http_server.h"
+#include "server/jobs/job_service.h"
 #include "server/metrics.h"
-#include "server/result_files.h"
 #include "server/server_config.h"
+#include "server/storage/file_result_store.h"
+#include "server/storage/sqlite_job_store.h"
 
 namespace penumbra::server {
 namespace {
@@ -58,8 +58,8 @@ int run_serve(int argc, char** argv) {
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
 
   std::filesystem::create_directories(config.data_dir);
-  JobStore store((std::filesystem::path(config.data_dir) / "jobs.db").string());
-  ResultFiles files(config.data_dir);
+  SqliteJobStore store((std::filesystem::path(config.data_dir) / "jobs.db").string());
+  FileResultStore files(config.data_dir);
   Metrics metrics;
   JobService jobs(config, store, files, metrics);
   HttpServer http(config, jobs, metrics);

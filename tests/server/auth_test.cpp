@@ -3,7 +3,7 @@
 
 #include "server_process.h"
 
-namespace penumbra::server::testing {
+namespace penumbra::test {
 namespace {
 
 TEST(Auth, OffByDefaultOnLoopback) {
@@ -61,4 +61,4 @@ TEST(Auth, RefusesNonLoopbackWithoutTokenUnlessInsecure) {
 }
 
 }  // namespace
-}  // namespace penumbra::server::testing
+}  // namespace penumbra::test

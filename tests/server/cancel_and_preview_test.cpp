@@ -3,7 +3,7 @@
 
 #include "server_process.h"
 
-namespace penumbra::server::testing {
+namespace penumbra::test {
 namespace {
 
 TEST(Cancel, QueuedJobNeverRuns) {
@@ -74,4 +74,4 @@ TEST(Preview, RunningJobServesItsProgressiveImage) {
 }
 
 }  // namespace
-}  // namespace penumbra::server::testing
+}  // namespace penumbra::test

@@ -6,7 +6,7 @@
 
 #include "server_process.h"
 
-namespace penumbra::server::testing {
+namespace penumbra::test {
 namespace {
 
 TEST(Durability, KillDashNineDuringARenderLosesNothing) {
@@ -85,4 +85,4 @@ TEST(Durability, FinishedJobsExpireAfterTheRetention) {
 }
 
 }  // namespace
-}  // namespace penumbra::server::testing
+}  // namespace penumbra::test

@@ -5,7 +5,7 @@
 
 #include "server_process.h"
 
-namespace penumbra::server::testing {
+namespace penumbra::test {
 namespace {
 
 Json expect_problem(const httplib::Result& res, int status, const std::string& type = "") {
@@ -174,4 +174,4 @@ TEST_F(ErrorResponses, InvalidIdempotencyKeyIs400) {
 }
 
 }  // namespace
-}  // namespace penumbra::server::testing
+}  // namespace penumbra::test

@@ -6,7 +6,7 @@
 
 #include "server_process.h"
 
-namespace penumbra::server::testing {
+namespace penumbra::test {
 namespace {
 
 void shutdown_during_render(int sig) {
@@ -65,4 +65,4 @@ TEST(GracefulShutdown, IdleServerExitsPromptly) {
 }
 
 }  // namespace
-}  // namespace penumbra::server::testing
+}  // namespace penumbra::test

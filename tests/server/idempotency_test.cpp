@@ -4,7 +4,7 @@
 
 #include "server_process.h"
 
-namespace penumbra::server::testing {
+namespace penumbra::test {
 namespace {
 
 TEST(Idempotency, SameKeySameBodyIsTheSameJob) {
@@ -60,4 +60,4 @@ TEST(Idempotency, KeySurvivesRestartAndIsFreedByDelete) {
 }
 
 }  // namespace
-}  // namespace penumbra::server::testing
+}  // namespace penumbra::test

@@ -5,7 +5,7 @@
 
 #include "server_process.h"
 
-namespace penumbra::server::testing {
+namespace penumbra::test {
 namespace {
 
 int status_of(httplib::Client& c, const Json& scene) {
@@ -113,4 +113,4 @@ TEST(Limits, QueueLengthAtTheBoundaryAnswers429WithRetryAfter) {
 }
 
 }  // namespace
-}  // namespace penumbra::server::testing
+}  // namespace penumbra::test

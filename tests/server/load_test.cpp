@@ -10,7 +10,7 @@
 
 #include "server_process.h"
 
-namespace penumbra::server::testing {
+namespace penumbra::test {
 namespace {
 
 constexpr int kClients = 4;
@@ -127,4 +127,4 @@ TEST(Load, HundredsOfSubmitsThousandsOfPollsNothingLost) {
 }
 
 }  // namespace
-}  // namespace penumbra::server::testing
+}  // namespace penumbra::test

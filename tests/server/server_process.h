@@ -23,36 +23,9 @@
 #include <httplib.h>
 #include <nlohmann/json.hpp>
 
-namespace penumbra::server::testing {
+#include "test_support.h"
 
-using Json = nlohmann::json;
-
-// A fresh directory under the system temp dir, removed at destruction.
-class TempDir {
- public:
-  TempDir() {
-    std::random_device rd;
-    path_ = (std::filesystem::temp_directory_path() /
-             ("penumbra-server-test-" + std::to_string(::getpid()) + "-" + std::to_string(rd())))
-                .string();
-    std::filesystem::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    std::filesystem::remove_all(path_, ec);
-  }
-  const std::string& path() const { return path_; }
-
- private:
-  std::string path_;
-};
-
-inline std::string read_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+namespace penumbra::test {
 
 namespace detail {
 // fork + exec of the binary with stdout and stderr into one pipe; returns the read end.
@@ -197,18 +170,6 @@ inline RunResult run_serve_to_exit(std::vector<std::string> args, std::vector<st
   return r;
 }
 
-// A valid scene (the Cornell box of scenes/) at a tiny size.
-inline Json tiny_scene(int width = 16, int height = 16, int spp = 2) {
-  Json scene = Json::parse(read_file(std::string(PENUMBRA_SOURCE_DIR) + "/scenes/cornell_box.json"));
-  scene["render"]["width"] = width;
-  scene["render"]["height"] = height;
-  scene["render"]["spp"] = spp;
-  return scene;
-}
-
-// A render that keeps one worker busy for many seconds (to be cancelled or interrupted).
-inline Json long_scene() { return tiny_scene(64, 64, 1 << 16); }
-
 inline httplib::Result post_json(httplib::Client& client, const std::string& path,
                                  const std::string& body, const httplib::Headers& headers = {}) {
   return client.Post(path.c_str(), headers, body, "application/json");
@@ -244,13 +205,13 @@ inline Json wait_for_state(httplib::Client& client, const std::string& id,
   }
 }
 
-}  // namespace penumbra::server::testing
+}  // namespace penumbra::test
 
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
 
-namespace penumbra::server::testing {
+namespace penumbra::test {
 
 // Sends raw bytes on a fresh connection and returns whatever comes back within the timeout
 // (for framing tests the client library would not produce: chunked bodies, bad lengths).
@@ -287,4 +248,4 @@ inline int raw_status(const std::string& response) {
   return std::stoi(response.substr(9, 3));
 }
 
-}  // namespace penumbra::server::testing
+}  // namespace penumbra::test

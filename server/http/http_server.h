@@ -1,0 +1,43 @@
+#pragma once
+// The HTTP service on cpp-httplib: its settings, the guard before routing, problem documents
+// for the library's own errors, the exception handler, the access log and metrics; the routes
+// themselves are in one file per group (route_context.h). Renders never run on HTTP threads
+// (JobService owns the workers), so polls are answered at once.
+#include <atomic>
+#include <memory>
+
+#include "server/http/auth.h"
+#include "server/http/route_context.h"
+#include "server/jobs/job_service.h"
+#include "server/metrics.h"
+#include "server/server_config.h"
+
+namespace httplib {
+class Server;
+}
+
+namespace penumbra::server {
+
+class HttpServer {
+ public:
+  HttpServer(const ServerConfig& config, JobService& jobs, Metrics& metrics);
+  ~HttpServer();
+  // Binds host:port (port 0 = ephemeral); returns the bound port, or -1.
+  int bind();
+  // Serves until stop(); blocks.
+  bool listen();
+  void stop();
+  // /readyz answers 503 from now on (shutdown has begun); the port stays open.
+  void set_ready(bool ready) { ready_ = ready; }
+
+ private:
+  void install_handlers();
+  const ServerConfig config_;
+  Metrics& metrics_;
+  BearerAuth auth_;
+  std::atomic<bool> ready_{true};
+  RouteContext context_;
+  std::unique_ptr<httplib::Server> server_;
+};
+
+}  // namespace penumbra::server

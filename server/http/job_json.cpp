@@ -1,0 +1,79 @@
+#include "server/http/job_json.h"
+
+#include <algorithm>
+#include <cmath>
+#include <ctime>
+
+namespace penumbra::server {
+
+std::string job_path(const std::string& id) { return "/v1/jobs/" + id; }
+
+double retry_after_seconds(const JobView& v) {
+  if (v.progress && v.progress->fraction > 0) return std::clamp(v.progress->eta_seconds, 1.0, 10.0);
+  return v.record.state == JobState::kQueued ? 2.0 : 1.0;
+}
+
+std::string rfc3339(double t) {
+  const std::time_t seconds = std::time_t(std::floor(t));
+  const int millis = std::min(999, int((t - std::floor(t)) * 1000));
+  std::tm tm{};
+  gmtime_r(&seconds, &tm);
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%04d-%02d-%02dT%02d:%02d:%02d.%03dZ", tm.tm_year + 1900,
+                tm.tm_mon + 1, tm.tm_mday, tm.tm_hour, tm.tm_min, tm.tm_sec, millis);
+  return buf;
+}
+
+nlohmann::ordered_json job_json(const JobView& v) {
+  using json = nlohmann::ordered_json;
+  const JobRecord& r = v.record;
+  auto time_or_null = [](double t) { return t > 0 ? json(rfc3339(t)) : json(nullptr); };
+  json j = {{"id", r.id}, {"state", to_string(r.state)}};
+  double progress = 0;
+  // samples_total is width x height x spp, except while an adaptive render (noise_threshold)
+  // runs: then it is the renderer's current estimate, and once it succeeds, what it took.
+  uint64_t samples_done = 0, samples_total = r.samples_total;
+  json eta = nullptr;
+  if (r.state == JobState::kSucceeded) {
+    progress = 1;
+    samples_done = r.samples_total;
+  }
+  if (v.progress) {
+    progress = v.progress->fraction;
+    samples_done = v.progress->samples_done;
+    if (v.progress->samples_total > 0) samples_total = v.progress->samples_total;
+    if (v.progress->fraction > 0) eta = v.progress->eta_seconds;
+  }
+  json stats = nullptr;
+  if (!r.stats_json.empty()) {
+    stats = json::parse(r.stats_json);
+    if (r.state == JobState::kSucceeded || r.state == JobState::kCancelled)
+      samples_done = stats.value("camera_samples", samples_done);
+    if (r.state == JobState::kSucceeded) samples_total = samples_done;
+    if (r.state == JobState::kCancelled && r.samples_total > 0)
+      progress = std::min(1.0, double(samples_done) / double(r.samples_total));  // how far it got
+  }
+  j["progress"] = progress;
+  j["samples_done"] = samples_done;
+  j["samples_total"] = samples_total;
+  j["eta_seconds"] = eta;
+  j["queue_position"] = v.queue_position ? json(*v.queue_position) : json(nullptr);
+  if (v.stop_requested) j["cancel_requested"] = true;
+  j["created_at"] = time_or_null(r.created_at);
+  j["started_at"] = time_or_null(r.started_at);
+  j["finished_at"] = time_or_null(r.finished_at);
+  j["attempts"] = r.attempts;
+  j["render"] = {{"width", r.width}, {"height", r.height}, {"spp", r.spp}};
+  j["stats"] = stats;
+  if (!r.error_json.empty()) j["error"] = json::parse(r.error_json);
+  j["warnings"] = r.warnings_json.empty() ? json::array() : json::parse(r.warnings_json);
+  const std::string self = job_path(r.id);
+  j["links"] = {{"self", self},
+                {"result", self + "/result"},
+                {"result_png", self + "/result?format=png"},
+                {"result_exr", self + "/result?format=exr"},
+                {"preview", self + "/result?preview=true"}};
+  return j;
+}
+
+}  // namespace penumbra::server

@@ -1,0 +1,90 @@
+#include "server/http/request_guard.h"
+
+#include <httplib.h>
+
+#include <cctype>
+#include <string>
+
+#include "server/http/text_util.h"
+
+namespace penumbra::server {
+namespace {
+
+bool is_digits(const std::string& s) {
+  if (s.empty() || s.size() > 19) return false;
+  for (char c : s)
+    if (!std::isdigit(static_cast<unsigned char>(c))) return false;
+  return true;
+}
+
+}  // namespace
+
+std::optional<Problem> guard_request(const httplib::Request& req, const GuardSettings& settings,
+                                     const BearerAuth& auth) {
+  // Liveness must answer whatever the token: orchestrators probe it without credentials.
+  if (auth.enabled() && req.path != "/healthz" &&
+      !auth.allows(req.get_header_value("Authorization"))) {
+    Problem p = make_problem(401, "unauthorized", "Unauthorized",
+                             "send 'Authorization: Bearer <token>' (the server's --token)");
+    return p;
+  }
+  if (req.has_header("Transfer-Encoding")) {
+    // A chunked body has no length to check against the limit before it is read.
+    return make_problem(411, "length-required", "Length Required",
+                        "Transfer-Encoding is not accepted; send the body with Content-Length");
+  }
+  if (req.get_header_value_count("Content-Length") > 1)
+    return make_problem(400, "bad-framing", "Bad Request", "more than one Content-Length header");
+  if (req.has_header("Content-Encoding")) {
+    const std::string enc =
+        ascii_lower(std::string(trim_ows(req.get_header_value("Content-Encoding"))));
+    if (enc != "identity")
+      return make_problem(
+          415, "unsupported-content-encoding", "Unsupported Media Type",
+          "Content-Encoding '" + enc + "' is not accepted; send the body uncompressed");
+  }
+  const bool has_length = req.has_header("Content-Length");
+  const std::string length_text(trim_ows(req.get_header_value("Content-Length")));
+  if (has_length && !is_digits(length_text))
+    return make_problem(400, "bad-framing", "Bad Request", "Content-Length is not a number");
+  if (req.method == "POST" || req.method == "PUT" || req.method == "PATCH") {
+    if (!has_length)
+      return make_problem(411, "length-required", "Length Required",
+                          "a request body needs a Content-Length header");
+  }
+  if (has_length) {
+    const unsigned long long length = std::stoull(length_text);
+    if (length > settings.max_body_bytes) {
+      Problem p = make_problem(413, "body-too-large", "Content Too Large",
+                               "the body has " + length_text + " bytes; the limit is " +
+                                   std::to_string(settings.max_body_bytes) + " (--max-body)");
+      p.extensions["limit"] = settings.max_body_bytes;
+      return p;
+    }
+  }
+  if (req.has_header("Range") && req.get_header_value("Range").find(',') != std::string::npos) {
+    // One range at most: a many-range request multiplies the response size. The parsed ranges
+    // are dropped too, or the library would cut this very answer into a multipart response.
+    // (The Request object is not const in the library; only the handler's view of it is.)
+    const_cast<httplib::Request&>(req).ranges.clear();
+    return make_problem(416, "multiple-ranges", "Range Not Satisfiable",
+                        "only a single byte range is served");
+  }
+  if (req.method == "POST" && req.has_header("Content-Type")) {
+    // Checked before the body is read: the library would otherwise parse multipart bodies.
+    std::string type = ascii_lower(req.get_header_value("Content-Type"));
+    type = std::string(trim_ows(type.substr(0, type.find(';'))));
+    const bool json_like =
+        type == "application/json" || (type.rfind("application/", 0) == 0 && type.size() > 5 &&
+                                       type.compare(type.size() - 5, 5, "+json") == 0);
+    // curl --data-binary sends application/x-www-form-urlencoded unless told otherwise; it is
+    // read as JSON too so the one-line curl of the README works.
+    if (!json_like && type != "application/x-www-form-urlencoded")
+      return make_problem(
+          415, "unsupported-media-type", "Unsupported Media Type",
+          "the body must be a JSON scene (Content-Type: application/json), not " + type);
+  }
+  return std::nullopt;
+}
+
+}  // namespace penumbra::server

@@ -1,0 +1,19 @@
+#pragma once
+// The API's paths: the patterns handlers are registered with, and the template of a request
+// path (for metric labels and 405 answers), found without std::regex.
+#include <string>
+#include <vector>
+
+namespace penumbra::server {
+
+// cpp-httplib 0.11 has no path parameters: routes with an id are registered as regexes
+// (compiled once, at registration).
+inline const std::string kJobRoute = "/v1/jobs/([0-9a-f]{24})";
+inline const std::string kResultRoute = kJobRoute + "/result";
+
+// The route template of a path ("/v1/jobs/{id}"), or "other": a bounded set of labels.
+std::string route_template(const std::string& path);
+// The methods a route template answers (for Allow on a 405).
+std::vector<std::string> allowed_methods(const std::string& route);
+
+}  // namespace penumbra::server

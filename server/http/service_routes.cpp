@@ -1,0 +1,34 @@
+// GET /healthz, /readyz, /metrics, /v1/openapi.json: the service itself, no job.
+#include <httplib.h>
+
+#include "api/embedded_documents.h"
+#include "server/http/json_response.h"
+#include "server/http/problem.h"
+#include "server/http/route_context.h"
+
+namespace penumbra::server {
+
+void add_service_routes(httplib::Server& s, const RouteContext& c) {
+  s.Get("/healthz", [](const httplib::Request&, httplib::Response& res) {
+    send_json(res, 200, {{"status", "ok"}});
+  });
+  s.Get("/readyz", [&c](const httplib::Request& req, httplib::Response& res) {
+    if (c.ready && c.jobs.accepting()) return send_json(res, 200, {{"status", "ready"}});
+    Problem p = make_problem(503, "shutting-down", "Shutting down", "not accepting new jobs");
+    p.retry_after_seconds = 5;
+    send_problem(res, req, p);
+  });
+  s.Get("/metrics", [&c](const httplib::Request&, httplib::Response& res) {
+    Metrics::Gauges g = c.jobs.gauges();
+    g.ready = g.ready && c.ready;
+    res.set_content(c.metrics.render_text(g), "text/plain; version=0.0.4; charset=utf-8");
+  });
+  s.Get("/v1/openapi.json", [](const httplib::Request& req, httplib::Response& res) {
+    const std::string* doc = api::embedded_document("openapi.json");
+    if (!doc)
+      return send_problem(res, req, status_problem(404, "no OpenAPI document was built in"));
+    res.set_content(*doc, "application/json");
+  });
+}
+
+}  // namespace penumbra::server

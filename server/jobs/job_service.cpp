@@ -1,0 +1,278 @@
+#include "server/jobs/job_service.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+#include <random>
+
+#include "server/jobs/unix_time.h"
+
+namespace penumbra::server {
+namespace {
+
+std::string new_job_id() {
+  static thread_local std::random_device rd;  // /dev/urandom: ids are unguessable
+  static const char* kHex = "0123456789abcdef";
+  std::string id;
+  for (int i = 0; i < 6; ++i) {
+    const uint32_t v = rd();
+    for (int k = 0; k < 4; ++k) id += kHex[(v >> (k * 4)) & 15];
+  }
+  return id;
+}
+
+nlohmann::json diagnostics_json(const std::vector<api::Diagnostic>& ds) {
+  nlohmann::json a = nlohmann::json::array();
+  for (const auto& d : ds) a.push_back({{"pointer", d.pointer}, {"detail", d.message}});
+  return a;
+}
+
+}  // namespace
+
+JobService::JobService(const ServerConfig& config, JobStore& store, ResultStore& results,
+                       Metrics& metrics)
+    : config_(config),
+      store_(store),
+      results_(results),
+      metrics_(metrics),
+      writer_(store),
+      table_(writer_),
+      queue_(std::size_t(config.max_queue)),
+      workers_(config_, queue_, table_, writer_, store, results, metrics) {}
+
+JobService::~JobService() {
+  begin_shutdown();
+  stop(std::chrono::steady_clock::now() + std::chrono::hours(1));
+}
+
+void JobService::start() {
+  StoredJobs stored = store_.load();
+  last_seq_ = stored.last_seq;
+  // A crash between a tombstone's commit and the removal of its files leaves the files.
+  for (const JobRecord& r : stored.records)
+    if (r.state == JobState::kDeleted) results_.remove(r.id);
+  for (const std::string& id : table_.restore(std::move(stored.records)))
+    queue_.push(id, /*force=*/true);
+  expire_now();
+  workers_.start(config_.workers);
+  reaper_ = std::thread([this] { reaper_loop(); });
+}
+
+double JobService::retry_after_for_queue() const {
+  const double average = workers_.average_job_seconds();
+  const double per_job = average > 0 ? average : 5.0;
+  const double wait = per_job * double(queue_.size()) / std::max(1, config_.workers);
+  return std::clamp(wait, 1.0, 3600.0);
+}
+
+SubmitOutcome JobService::submit(std::string_view body, const std::string& idempotency_key) {
+  SubmitOutcome out;
+  auto refuse_shutting_down = [&] {
+    out.kind = SubmitOutcome::Kind::kNotAccepting;
+    out.retry_after_seconds = 5;
+    return out;
+  };
+  if (!accepting_) return refuse_shutting_down();
+  api::LoadResult loaded = api::load_scene(body, config_.scene_limits());
+  out.warnings = loaded.warnings;
+  if (!loaded.ok()) {
+    out.kind = loaded.kind == api::LoadErrorKind::kSyntax ? SubmitOutcome::Kind::kSyntax
+                                                          : SubmitOutcome::Kind::kInvalid;
+    out.errors = std::move(loaded.errors);
+    return out;
+  }
+  const std::string scene_json(body);
+  std::lock_guard submit_lock(submit_mutex_);
+  if (!idempotency_key.empty()) {
+    if (auto existing = table_.find_by_key(idempotency_key)) {
+      // Read from the store: the table keeps no scenes. A submission may wait on a commit here.
+      const auto stored_scene = store_.scene(existing->id);
+      out.record = std::move(*existing);
+      out.kind = stored_scene == scene_json ? SubmitOutcome::Kind::kReplayed
+                                            : SubmitOutcome::Kind::kKeyReused;
+      return out;
+    }
+  }
+  if (!accepting_) return refuse_shutting_down();
+  if (queue_.full()) {
+    out.kind = SubmitOutcome::Kind::kQueueFull;
+    out.retry_after_seconds = retry_after_for_queue();
+    return out;
+  }
+  const RenderSettings& s = loaded.request->settings;
+  JobRecord r;
+  r.id = new_job_id();
+  r.seq = last_seq_ + 1;
+  r.idempotency_key = idempotency_key;
+  r.created_at = unix_now();
+  r.width = s.width;
+  r.height = s.height;
+  r.spp = s.spp;
+  r.samples_total = uint64_t(s.width) * uint64_t(s.height) * uint64_t(s.spp);
+  if (!out.warnings.empty()) r.warnings_json = diagnostics_json(out.warnings).dump();
+  // Committed (fsync'd) before anyone hears 202. Nobody knows the id yet, so no other change
+  // of this job can be queued before its insert.
+  writer_.wait_durable(writer_.enqueue(InsertJob{r, scene_json}));
+  last_seq_ = r.seq;
+  table_.add(r);
+  queue_.push(r.id, /*force=*/true);  // capacity was checked under submit_mutex_
+  metrics_.count_submitted();
+  out.record = std::move(r);
+  out.kind = SubmitOutcome::Kind::kAccepted;
+  return out;
+}
+
+JobView JobService::make_view(JobEntry entry) const {
+  JobView v;
+  v.record = std::move(entry.record);
+  if (v.record.state == JobState::kQueued) v.queue_position = queue_.position(v.record.id);
+  if (v.record.state == JobState::kRunning && entry.runtime) v.progress = entry.runtime->progress();
+  return v;
+}
+
+std::optional<JobView> JobService::view(const std::string& id) const {
+  auto entry = table_.find(id);
+  if (!entry || entry->record.state == JobState::kDeleted) return std::nullopt;
+  const bool stop_requested =
+      entry->runtime && entry->runtime->stop_reason() != JobRuntime::StopReason::kNone;
+  JobView v = make_view(std::move(*entry));
+  v.stop_requested = stop_requested;
+  return v;
+}
+
+std::vector<JobView> JobService::list(std::optional<JobState> state, int64_t before_seq,
+                                      int limit) const {
+  std::vector<JobView> out;
+  for (JobEntry& e : table_.list(state, before_seq, limit)) out.push_back(make_view(std::move(e)));
+  return out;
+}
+
+DeleteOutcome JobService::cancel_or_delete(const std::string& id, std::chrono::milliseconds wait) {
+  enum class Found { kNothing, kTombstone, kFinished, kQueued, kRunning } found = Found::kNothing;
+  const double now = unix_now();
+  const auto ticket = table_.modify(id, [&](JobEntry& e) {
+    JobRecord& r = e.record;
+    if (r.state == JobState::kDeleted) {
+      found = Found::kTombstone;  // deleted before: DELETE is idempotent
+      return false;
+    }
+    if (is_finished(r.state)) {
+      // The record stays as a tombstone so a repeated DELETE still answers 204; the key is freed.
+      found = Found::kFinished;
+      r.state = JobState::kDeleted;
+      r.finished_at = now;
+      r.idempotency_key.clear();
+      r.stats_json.clear();
+      r.error_json.clear();
+      r.warnings_json.clear();
+      return true;
+    }
+    if (r.state == JobState::kQueued) {
+      // A worker that popped it meanwhile sees the state and skips it.
+      found = Found::kQueued;
+      r.state = JobState::kCancelled;
+      r.finished_at = now;
+      return true;
+    }
+    found = Found::kRunning;
+    e.runtime->request_stop(JobRuntime::StopReason::kUserCancel);
+    return false;
+  });
+  switch (found) {
+    case Found::kNothing:
+      return DeleteOutcome::kNotFound;
+    case Found::kTombstone:
+      return DeleteOutcome::kDeleted;
+    case Found::kFinished:
+      results_.remove(id);  // no lock held: polls of other jobs go on meanwhile
+      writer_.wait_durable(*ticket);
+      return DeleteOutcome::kDeleted;
+    case Found::kQueued:
+      queue_.remove(id);
+      metrics_.observe_render("cancelled", 0, 0);
+      writer_.wait_durable(*ticket);
+      return DeleteOutcome::kCancelled;
+    case Found::kRunning:
+      break;
+  }
+  const auto after = table_.wait(
+      id, std::chrono::steady_clock::now() + wait,
+      [](const JobRecord& r) { return r.state != JobState::kRunning; }, [] { return false; });
+  return !after || after->state != JobState::kRunning ? DeleteOutcome::kCancelled
+                                                      : DeleteOutcome::kCancelling;
+}
+
+std::shared_ptr<const Image> JobService::preview(const std::string& id) const {
+  const auto entry = table_.find(id);
+  return entry && entry->runtime ? entry->runtime->preview() : nullptr;
+}
+
+std::optional<JobRecord> JobService::wait_finished(
+    const std::string& id, std::chrono::steady_clock::time_point deadline) const {
+  return table_.wait(
+      id, deadline,
+      [](const JobRecord& r) { return is_finished(r.state) || r.state == JobState::kDeleted; },
+      [this] { return stopping_.load(); });
+}
+
+void JobService::expire_now() {
+  const std::vector<std::string> ids = table_.take_expired(unix_now() - config_.retention_seconds);
+  if (ids.empty()) return;
+  // Records first, then files (as before the table existed): a crash in between leaves files
+  // nobody serves, never a record whose image is gone.
+  writer_.flush();
+  for (const std::string& id : ids) results_.remove(id);
+}
+
+void JobService::reaper_loop() {
+  const auto period =
+      std::chrono::duration<double>(std::clamp(config_.retention_seconds / 4, 0.05, 60.0));
+  std::unique_lock lock(reaper_mutex_);
+  while (!stopping_) {
+    reaper_cv_.wait_for(lock, period, [&] { return stopping_.load(); });
+    if (stopping_) break;
+    try {
+      expire_now();
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "penumbra serve: expiry failed: %s\n", e.what());
+    }
+  }
+}
+
+void JobService::begin_shutdown() {
+  if (!accepting_.exchange(false) && stopping_) return;
+  {
+    std::lock_guard submit_lock(submit_mutex_);  // no submission is half-way through
+  }
+  stopping_ = true;
+  workers_.begin_shutdown();
+  queue_.close();
+  table_.wake_all();
+  { std::lock_guard rl(reaper_mutex_); }
+  reaper_cv_.notify_all();
+}
+
+bool JobService::stop(std::chrono::steady_clock::time_point deadline) {
+  if (!workers_.wait_stopped(deadline)) {
+    writer_.flush();  // what has been decided is written; the stuck render's job runs again
+    return false;     // a thread still runs (e.g. a scene build): the caller exits hard
+  }
+  workers_.join();
+  if (reaper_.joinable()) reaper_.join();
+  writer_.flush();
+  return true;
+}
+
+Metrics::Gauges JobService::gauges() const {
+  Metrics::Gauges g;
+  for (const auto& [state, n] : table_.count_by_state()) {
+    if (state != JobState::kDeleted) g.jobs_by_state[to_string(state)] = n;
+    if (state == JobState::kRunning) g.running = n;
+  }
+  g.queue_depth = int64_t(queue_.size());
+  g.queue_capacity = int64_t(queue_.capacity());
+  g.ready = accepting_;
+  return g;
+}
+
+}  // namespace penumbra::server

@@ -1,0 +1,125 @@
+#pragma once
+// The jobs: submission (validate, idempotency, capacity, durable commit), the FIFO queue, the
+// render workers on their own threads, cancellation, deletion, expiry and graceful shutdown.
+// HTTP handlers call this and only translate its answers.
+//
+// Locking (why a status poll never waits on a disk): the state of every job is in memory
+// (JobTable, one short mutex). Changes go to the store from one writer thread (StoreWriter);
+// only the callers that must not answer before a change is durable wait for it (submit,
+// cancel, delete, and a worker before it starts a render), and they wait with no lock held.
+// Result files are written and removed with no lock held. view() and list() take the table's
+// mutex, the queue's and a running job's progress mutex, each for a copy, never anything else.
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <thread>
+#include <vector>
+
+#include "api/scene_loader.h"
+#include "server/jobs/job_queue.h"
+#include "server/jobs/job_table.h"
+#include "server/jobs/render_task.h"
+#include "server/jobs/render_workers.h"
+#include "server/jobs/store_writer.h"
+#include "server/metrics.h"
+#include "server/server_config.h"
+#include "server/storage/job_record.h"
+#include "server/storage/job_store.h"
+#include "server/storage/result_store.h"
+
+namespace penumbra::server {
+
+struct SubmitOutcome {
+  enum class Kind {
+    kAccepted,      // new job, committed
+    kReplayed,      // same idempotency key and scene: the existing job
+    kSyntax,        // not JSON (400)
+    kInvalid,       // not a valid scene (422)
+    kKeyReused,     // idempotency key used for another scene (422)
+    kQueueFull,     // 429
+    kNotAccepting,  // shutting down (503)
+  };
+  Kind kind = Kind::kAccepted;
+  JobRecord record;
+  std::vector<api::Diagnostic> errors;
+  std::vector<api::Diagnostic> warnings;
+  double retry_after_seconds = 0;
+};
+
+struct JobView {
+  JobRecord record;
+  std::optional<RenderProgress> progress;     // while running
+  std::optional<std::size_t> queue_position;  // while queued
+  bool stop_requested = false;
+};
+
+enum class DeleteOutcome {
+  kNotFound,    // never existed (or expired)
+  kCancelled,   // was queued or running, now cancelled
+  kCancelling,  // running; the render has been told to stop but has not yet
+  kDeleted,     // was finished; record and result removed
+};
+
+class JobService {
+ public:
+  JobService(const ServerConfig& config, JobStore& store, ResultStore& results, Metrics& metrics);
+  ~JobService();
+
+  // Loads the jobs from the store (interrupted ones run again) and starts the threads.
+  void start();
+  SubmitOutcome submit(std::string_view body, const std::string& idempotency_key);
+  std::optional<JobView> view(const std::string& id) const;
+  std::vector<JobView> list(std::optional<JobState> state, int64_t before_seq, int limit) const;
+  // Cancels a queued/running job, deletes a finished one. Waits up to `wait` for a running
+  // render to stop.
+  DeleteOutcome cancel_or_delete(const std::string& id, std::chrono::milliseconds wait);
+  std::shared_ptr<const Image> preview(const std::string& id) const;
+  std::optional<StoredResult> open_result(const std::string& id, const std::string& format) const {
+    return results_.open(id, format);
+  }
+  // Blocks until the job is finished, the deadline passes or shutdown begins.
+  std::optional<JobRecord> wait_finished(const std::string& id,
+                                         std::chrono::steady_clock::time_point deadline) const;
+
+  bool accepting() const { return accepting_.load(); }
+  // Stops taking jobs; running renders are put back in the queue, except one that will be done
+  // within a few seconds, which is finished.
+  void begin_shutdown();
+  // Joins the threads and writes every pending change; true if the threads all ended before
+  // the deadline.
+  bool stop(std::chrono::steady_clock::time_point deadline);
+  // Removes finished jobs older than the retention now (the reaper thread does it periodically).
+  void expire_now();
+
+  Metrics::Gauges gauges() const;
+  double retry_after_for_queue() const;
+
+ private:
+  void reaper_loop();
+  JobView make_view(JobEntry entry) const;
+
+  const ServerConfig config_;
+  JobStore& store_;  // read here (scenes); written only through writer_
+  ResultStore& results_;
+  Metrics& metrics_;
+  StoreWriter writer_;
+  JobTable table_;
+  JobQueue queue_;
+  RenderWorkers workers_;
+
+  std::mutex submit_mutex_;  // idempotency check + capacity check + commit + enqueue as one step
+  int64_t last_seq_ = 0;     // under submit_mutex_
+
+  std::atomic<bool> accepting_{true};
+  std::atomic<bool> stopping_{false};
+  std::thread reaper_;
+  std::mutex reaper_mutex_;
+  std::condition_variable reaper_cv_;
+};
+
+}  // namespace penumbra::server

@@ -1,0 +1,57 @@
+#include "server/jobs/render_task.h"
+
+#include <algorithm>
+#include <chrono>
+
+namespace penumbra::server {
+
+RenderOutcome run_render_job(const std::string& scene_json, const RenderJobOptions& options,
+                             JobRuntime& runtime) {
+  RenderOutcome out;
+  // Validated at submission; validated again because the server may have restarted with
+  // tighter limits since.
+  api::LoadResult loaded = api::load_scene(scene_json, options.limits);
+  if (!loaded.ok()) {
+    out.error = "the scene is no longer valid under this server's limits: " +
+                loaded.errors.front().to_string();
+    return out;
+  }
+  RenderSettings settings = loaded.request->settings;
+  settings.threads = options.threads;
+  if (options.max_render_seconds > 0)
+    settings.time_limit = settings.time_limit > 0
+                              ? std::min(settings.time_limit, options.max_render_seconds)
+                              : options.max_render_seconds;
+  out.settings = settings;
+
+  const auto build_start = std::chrono::steady_clock::now();
+  std::unique_ptr<Scene> scene;
+  try {
+    scene = Scene::build(loaded.request->scene);
+  } catch (const SceneBuildError& e) {
+    out.error = std::string("scene build failed: ") + e.what();
+    return out;
+  }
+  out.build_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - build_start).count();
+  if (runtime.cancel_flag()->load()) {
+    out.kind = RenderOutcome::Kind::kStopped;
+    return out;
+  }
+
+  RenderControl control;
+  control.cancel = runtime.cancel_flag();
+  control.on_progress = [&runtime](const RenderProgress& p) { runtime.set_progress(p); };
+  control.on_pass = [&runtime](const Image& image, const RenderProgress& p) {
+    runtime.set_preview(image);
+    runtime.set_progress(p);
+  };
+  RenderResult result = render(*scene, settings, control);
+  out.stats = result.stats;
+  out.image = std::move(result.image);
+  out.kind =
+      result.stats.cancelled ? RenderOutcome::Kind::kStopped : RenderOutcome::Kind::kSucceeded;
+  return out;
+}
+
+}  // namespace penumbra::server

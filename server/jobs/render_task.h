@@ -1,0 +1,32 @@
+#pragma once
+// Renders one job: scene JSON -> validated request -> Embree scene -> progressive render.
+// Called on the service's own worker threads, never on HTTP threads.
+#include <string>
+
+#include "api/scene_loader.h"
+#include "renderer/core/image.h"
+#include "renderer/render/render.h"
+#include "server/jobs/job_runtime.h"
+
+namespace penumbra::server {
+
+struct RenderJobOptions {
+  api::Limits limits;
+  int threads = 0;                // render threads for this job
+  double max_render_seconds = 0;  // the server's budget per job; 0 = none
+};
+
+struct RenderOutcome {
+  enum class Kind { kSucceeded, kFailed, kStopped };
+  Kind kind = Kind::kFailed;
+  Image image;
+  RenderStats stats;
+  RenderSettings settings;
+  double build_seconds = 0;
+  std::string error;  // when failed
+};
+
+RenderOutcome run_render_job(const std::string& scene_json, const RenderJobOptions& options,
+                             JobRuntime& runtime);
+
+}  // namespace penumbra::server

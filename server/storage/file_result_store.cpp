@@ -1,0 +1,85 @@
+#include "server/storage/file_result_store.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+
+namespace penumbra::server {
+namespace fs = std::filesystem;
+
+namespace {
+void fsync_dir(const std::string& dir) {
+  const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY);
+  if (fd >= 0) {
+    ::fsync(fd);
+    ::close(fd);
+  }
+}
+}  // namespace
+
+FileResultStore::FileResultStore(const std::string& data_dir)
+    : dir_((fs::path(data_dir) / "results").string()) {
+  fs::create_directories(dir_);
+  for (const auto& entry : fs::directory_iterator(dir_))
+    if (entry.path().filename().string().find(".tmp") != std::string::npos)
+      fs::remove(entry.path());
+}
+
+std::string FileResultStore::path(const std::string& id, const std::string& format) const {
+  return (fs::path(dir_) / (id + "." + format)).string();
+}
+
+std::optional<StoredResult> FileResultStore::open(const std::string& id,
+                                                  const std::string& format) const {
+  const std::string file = path(id, format);
+  auto stream = std::make_shared<std::ifstream>(file, std::ios::binary);
+  if (!*stream) return std::nullopt;
+  std::error_code ec;
+  const auto size = fs::file_size(file, ec);
+  if (ec) return std::nullopt;
+  return StoredResult{std::move(stream), size};
+}
+
+void FileResultStore::write(const std::string& id, const std::string& format,
+                            const std::vector<uint8_t>& bytes) {
+  const std::string final_path = path(id, format);
+  const std::string tmp = final_path + ".tmp";
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) throw std::runtime_error("cannot create " + tmp + ": " + std::strerror(errno));
+  std::size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      const std::string err = std::strerror(errno);
+      ::close(fd);
+      ::unlink(tmp.c_str());
+      throw std::runtime_error("cannot write " + tmp + ": " + err);
+    }
+    done += std::size_t(n);
+  }
+  // The data must be on disk before the rename makes it visible, or a crash could leave a
+  // complete-looking but empty file.
+  if (::fsync(fd) != 0 || ::close(fd) != 0) {
+    ::unlink(tmp.c_str());
+    throw std::runtime_error("cannot flush " + tmp);
+  }
+  if (::rename(tmp.c_str(), final_path.c_str()) != 0) {
+    ::unlink(tmp.c_str());
+    throw std::runtime_error("cannot rename " + tmp + ": " + std::strerror(errno));
+  }
+  fsync_dir(dir_);
+}
+
+void FileResultStore::remove(const std::string& id) {
+  std::error_code ec;
+  fs::remove(path(id, "png"), ec);
+  fs::remove(path(id, "exr"), ec);
+}
+
+}  // namespace penumbra::server

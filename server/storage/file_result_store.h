@@ -1,0 +1,24 @@
+#pragma once
+// Result images as files: DIR/results/<id>.png and .exr, each written to a temporary file,
+// flushed to disk and renamed, so a reader (or a restart after kill -9) sees a whole file or none.
+#include <string>
+
+#include "server/storage/result_store.h"
+
+namespace penumbra::server {
+
+class FileResultStore final : public ResultStore {
+ public:
+  explicit FileResultStore(
+      const std::string& data_dir);  // creates DIR/results, removes stale temp files
+  void write(const std::string& id, const std::string& format,
+             const std::vector<uint8_t>& bytes) override;
+  std::optional<StoredResult> open(const std::string& id, const std::string& format) const override;
+  void remove(const std::string& id) override;
+  std::string path(const std::string& id, const std::string& format) const;
+
+ private:
+  std::string dir_;
+};
+
+}  // namespace penumbra::server

@@ -1,0 +1,195 @@
+#include "server/storage/sqlite_job_store.h"
+
+#include <sqlite3.h>
+
+namespace penumbra::server {
+namespace {
+
+// One prepared statement, finalised on every path out.
+class Statement {
+ public:
+  Statement(sqlite3* db, const std::string& sql) : db_(db) {
+    if (sqlite3_prepare_v2(db, sql.c_str(), -1, &stmt_, nullptr) != SQLITE_OK)
+      throw StoreError(std::string("sqlite prepare: ") + sqlite3_errmsg(db));
+  }
+  ~Statement() { sqlite3_finalize(stmt_); }
+  Statement(const Statement&) = delete;
+  Statement& operator=(const Statement&) = delete;
+
+  Statement& bind(int i, const std::string& v) {
+    return check(sqlite3_bind_text(stmt_, i, v.data(), int(v.size()), SQLITE_TRANSIENT));
+  }
+  Statement& bind(int i, int64_t v) { return check(sqlite3_bind_int64(stmt_, i, v)); }
+  Statement& bind(int i, double v) { return check(sqlite3_bind_double(stmt_, i, v)); }
+  // "" is stored as NULL: the UNIQUE idempotency_key column admits many NULLs, not many "".
+  Statement& bind_or_null(int i, const std::string& v) {
+    return v.empty() ? check(sqlite3_bind_null(stmt_, i)) : bind(i, v);
+  }
+  bool step() {  // true while there is a row
+    const int rc = sqlite3_step(stmt_);
+    if (rc == SQLITE_ROW) return true;
+    if (rc == SQLITE_DONE) return false;
+    throw StoreError(std::string("sqlite step: ") + sqlite3_errmsg(db_));
+  }
+  std::string text(int col) const {
+    const auto* p = sqlite3_column_text(stmt_, col);
+    return p ? std::string(reinterpret_cast<const char*>(p), sqlite3_column_bytes(stmt_, col)) : "";
+  }
+  int64_t integer(int col) const { return sqlite3_column_int64(stmt_, col); }
+  double real(int col) const { return sqlite3_column_double(stmt_, col); }
+
+ private:
+  Statement& check(int rc) {
+    if (rc != SQLITE_OK) throw StoreError(std::string("sqlite bind: ") + sqlite3_errmsg(db_));
+    return *this;
+  }
+  sqlite3* db_;
+  sqlite3_stmt* stmt_ = nullptr;
+};
+
+constexpr const char* kColumns =
+    "id, seq, state, idempotency_key, created_at, started_at, finished_at, attempts, width, "
+    "height, "
+    "spp, samples_total, stats, error, warnings";
+
+JobRecord read_record(const Statement& s) {
+  JobRecord r;
+  r.id = s.text(0);
+  r.seq = s.integer(1);
+  r.state = job_state_from_string(s.text(2)).value_or(JobState::kFailed);
+  r.idempotency_key = s.text(3);
+  r.created_at = s.real(4);
+  r.started_at = s.real(5);
+  r.finished_at = s.real(6);
+  r.attempts = int(s.integer(7));
+  r.width = int(s.integer(8));
+  r.height = int(s.integer(9));
+  r.spp = int(s.integer(10));
+  r.samples_total = uint64_t(s.integer(11));
+  r.stats_json = s.text(12);
+  r.error_json = s.text(13);
+  r.warnings_json = s.text(14);
+  return r;
+}
+
+}  // namespace
+
+SqliteJobStore::SqliteJobStore(const std::string& path) {
+  if (sqlite3_open_v2(path.c_str(), &db_,
+                      SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_NOMUTEX,
+                      nullptr) != SQLITE_OK) {
+    const std::string msg = db_ ? sqlite3_errmsg(db_) : "out of memory";
+    sqlite3_close(db_);
+    throw StoreError("cannot open " + path + ": " + msg);
+  }
+  sqlite3_busy_timeout(db_, 5000);
+  // WAL: readers never wait for the writer. synchronous=FULL: a commit is on disk when it
+  // returns (https://www.sqlite.org/pragma.html#pragma_synchronous), so even a power cut
+  // cannot lose an accepted job.
+  exec("PRAGMA journal_mode=WAL");
+  exec("PRAGMA synchronous=FULL");
+  exec(
+      "CREATE TABLE IF NOT EXISTS jobs ("
+      " seq INTEGER PRIMARY KEY AUTOINCREMENT,"
+      " id TEXT NOT NULL UNIQUE,"
+      " state TEXT NOT NULL,"
+      " scene TEXT NOT NULL,"
+      " idempotency_key TEXT UNIQUE,"
+      " created_at REAL NOT NULL, started_at REAL NOT NULL DEFAULT 0, finished_at REAL NOT NULL "
+      "DEFAULT 0,"
+      " attempts INTEGER NOT NULL DEFAULT 0,"
+      " width INTEGER NOT NULL DEFAULT 0, height INTEGER NOT NULL DEFAULT 0, spp INTEGER NOT NULL "
+      "DEFAULT 0,"
+      " samples_total INTEGER NOT NULL DEFAULT 0,"
+      " stats TEXT NOT NULL DEFAULT '', error TEXT NOT NULL DEFAULT '', warnings TEXT NOT NULL "
+      "DEFAULT '')");
+  exec("CREATE INDEX IF NOT EXISTS jobs_by_state ON jobs(state, seq)");
+}
+
+SqliteJobStore::~SqliteJobStore() { sqlite3_close(db_); }
+
+void SqliteJobStore::exec(const char* sql) {
+  char* err = nullptr;
+  if (sqlite3_exec(db_, sql, nullptr, nullptr, &err) != SQLITE_OK) {
+    const std::string msg = err ? err : "unknown error";
+    sqlite3_free(err);
+    throw StoreError(std::string("sqlite: ") + msg);
+  }
+}
+
+StoredJobs SqliteJobStore::load() {
+  std::lock_guard lock(mutex_);
+  StoredJobs out;
+  Statement q(db_, std::string("SELECT ") + kColumns + " FROM jobs");
+  while (q.step()) out.records.push_back(read_record(q));
+  // AUTOINCREMENT remembers the highest seq in sqlite_sequence, also after that row is deleted.
+  Statement last(db_,
+                 "SELECT MAX(n) FROM (SELECT seq AS n FROM sqlite_sequence WHERE name = 'jobs' "
+                 "UNION ALL SELECT MAX(seq) FROM jobs)");
+  if (last.step()) out.last_seq = last.integer(0);
+  return out;
+}
+
+std::optional<std::string> SqliteJobStore::scene(const std::string& id) {
+  std::lock_guard lock(mutex_);
+  Statement q(db_, "SELECT scene FROM jobs WHERE id = ? AND state != 'deleted'");
+  q.bind(1, id);
+  if (!q.step()) return std::nullopt;
+  return q.text(0);
+}
+
+void SqliteJobStore::apply(const std::vector<JobChange>& changes) {
+  if (changes.empty()) return;
+  std::lock_guard lock(mutex_);
+  // One transaction, so one fsync for the whole batch (group commit).
+  exec("BEGIN IMMEDIATE");
+  try {
+    for (const JobChange& c : changes) apply_one(c);
+    exec("COMMIT");
+  } catch (...) {
+    sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);  // the error being thrown says why
+    throw;
+  }
+}
+
+void SqliteJobStore::apply_one(const JobChange& change) {
+  if (const auto* insert = std::get_if<InsertJob>(&change)) {
+    const JobRecord& r = insert->record;
+    Statement s(db_,
+                "INSERT INTO jobs (seq, id, state, scene, idempotency_key, created_at, started_at, "
+                "finished_at, attempts, width, height, spp, samples_total, stats, error, warnings) "
+                "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+    s.bind(1, r.seq)
+        .bind(2, r.id)
+        .bind(3, std::string(to_string(r.state)))
+        .bind(4, insert->scene_json);
+    s.bind_or_null(5, r.idempotency_key)
+        .bind(6, r.created_at)
+        .bind(7, r.started_at)
+        .bind(8, r.finished_at);
+    s.bind(9, int64_t(r.attempts)).bind(10, int64_t(r.width)).bind(11, int64_t(r.height));
+    s.bind(12, int64_t(r.spp)).bind(13, int64_t(r.samples_total)).bind(14, r.stats_json);
+    s.bind(15, r.error_json).bind(16, r.warnings_json);
+    s.step();
+  } else if (const auto* update = std::get_if<UpdateJob>(&change)) {
+    const JobRecord& r = update->record;
+    // A tombstone's scene goes: it can be megabytes and nothing reads it again.
+    Statement s(
+        db_,
+        "UPDATE jobs SET state = ?1, idempotency_key = ?2, started_at = ?3, finished_at = ?4, "
+        "attempts = ?5, samples_total = ?6, stats = ?7, error = ?8, warnings = ?9, "
+        "scene = CASE WHEN ?1 = 'deleted' THEN '' ELSE scene END WHERE id = ?10");
+    s.bind(1, std::string(to_string(r.state)))
+        .bind_or_null(2, r.idempotency_key)
+        .bind(3, r.started_at);
+    s.bind(4, r.finished_at).bind(5, int64_t(r.attempts)).bind(6, int64_t(r.samples_total));
+    s.bind(7, r.stats_json).bind(8, r.error_json).bind(9, r.warnings_json).bind(10, r.id);
+    s.step();
+  } else {
+    Statement s(db_, "DELETE FROM jobs WHERE id = ?");
+    s.bind(1, std::get<EraseJob>(change).id);
+    s.step();
+  }
+}
+
+}  // namespace penumbra::server
