@@ -60,20 +60,17 @@ std::vector<Setting> settings() {
                      return "";
                    }};
   };
+  auto text_setting = [](const char* flag, const char* env, auto member) {
+    return Setting{flag, env, true, [=](ServerConfig& c, const std::string& v) -> std::string {
+                     if (v.empty()) return std::string("empty ") + flag;
+                     c.*member = v;
+                     return "";
+                   }};
+  };
   return {
-      {"--host", "PENUMBRA_HOST", true,
-       [](ServerConfig& c, const std::string& v) -> std::string {
-         if (v.empty()) return "empty --host";
-         c.host = v;
-         return "";
-       }},
+      text_setting("--host", "PENUMBRA_HOST", &ServerConfig::host),
       int_setting("--port", "PENUMBRA_PORT", 0, 65535, &ServerConfig::port),
-      {"--data-dir", "PENUMBRA_DATA_DIR", true,
-       [](ServerConfig& c, const std::string& v) -> std::string {
-         if (v.empty()) return "empty --data-dir";
-         c.data_dir = v;
-         return "";
-       }},
+      text_setting("--data-dir", "PENUMBRA_DATA_DIR", &ServerConfig::data_dir),
       int_setting("--workers", "PENUMBRA_WORKERS", 1, 256, &ServerConfig::workers),
       int_setting("--render-threads", "PENUMBRA_RENDER_THREADS", 0, 4096,
                   &ServerConfig::render_threads),
