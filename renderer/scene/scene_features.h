@@ -11,6 +11,7 @@ struct SceneFeatures {
   bool absorption = false;    // any material that absorbs inside (Beer-Lambert)
   bool lights = false;        // any light to sample (area, point, directional or environment)
   bool environment = false;   // rays that escape see radiance
+  bool textures = false;      // some material reads textures: hits need their uv
 };
 
 }  // namespace penumbra

@@ -45,6 +45,7 @@ struct ShapeContext {
   vec3 offset{0.f};             // added to every position (motion baked in without a shutter)
   vec3 camera_position{0.f};    // picks how finely a moving mesh is tessellated in time
   bool emissive = false;        // an area light will sample it: prepare sampling by area
+  bool need_uv = false;         // something reads SurfaceHit::uv (textures); else it may stay 0
 };
 
 class Shape {
@@ -73,6 +74,11 @@ class Shape {
 
 // Solid-angle density of picking point p (normal n) uniformly by area on a surface of `area`:
 // the area density 1/area times dist^2 / |cos| (pbrt-v4 section 6.1.3).
-float area_to_solid_angle(const vec3& ref, const vec3& p, const vec3& n, float area);
+inline float area_to_solid_angle(const vec3& ref, const vec3& p, const vec3& n, float area) {
+  const vec3 w = p - ref;
+  const float dist2 = glm::dot(w, w);
+  const float cos_l = std::abs(glm::dot(n, w)) / std::sqrt(dist2);
+  return cos_l > 0.f && area > 0.f ? dist2 / (cos_l * area) : 0.f;
+}
 
 }  // namespace penumbra

@@ -64,7 +64,8 @@ Sphere::Sphere(const SphereDesc& desc, const ShapeContext& ctx)
     : center_(desc.center + ctx.offset),
       radius_(desc.radius),
       area_(4.f * kPi * desc.radius * desc.radius),
-      motion_(ctx.motion) {}
+      motion_(ctx.motion),
+      need_uv_(ctx.need_uv) {}
 
 EmbreeGeometry Sphere::make_geometry(RTCDevice device) const {
   // User geometry: the exact quadratic motion path needs our own test.
@@ -95,6 +96,8 @@ Bounds3 Sphere::embree_bounds() const {
 
 void Sphere::hit_geometry(const Ray& ray, float t, uint32_t, const vec2&, SurfaceHit* hit) const {
   sphere_hit_geometry(center_at(ray.time), radius_, ray.origin + ray.direction * t, hit);
+  // Two inverse trigonometric functions per hit: only when textures read the uv.
+  if (!need_uv_) return;
   // Mitsuba 3's sphere: u = phi / 2 pi with phi = atan2(y, x) in [0, 2 pi), v = theta / pi from
   // +z, in the sphere's frame (ours is unrotated).
   const vec3 n = hit->ng;

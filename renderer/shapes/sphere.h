@@ -34,6 +34,7 @@ class Sphere final : public Shape {
   float radius_;
   float area_;
   ShapeMotion motion_;
+  bool need_uv_;
 };
 
 // Nearest t in (0, t_max) where origin + t*dir (dir unit) meets the sphere, or a negative value.

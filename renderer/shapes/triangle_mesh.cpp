@@ -55,8 +55,9 @@ int motion_time_steps(const Motion& motion, float span, float camera_distance) {
 
 // The point b0 p0 + b1 p1 + b2 p2 and its error bound: pbrt-v4 section 6.8.4 bounds the error of
 // the barycentric sum by gamma(7).
-void barycentric_point(const vec3& p0, const vec3& p1, const vec3& p2, float b0, float b1, float b2,
-                       vec3* p, vec3* error) {
+[[gnu::always_inline]] inline void barycentric_point(const vec3& p0, const vec3& p1,
+                                                     const vec3& p2, float b0, float b1, float b2,
+                                                     vec3* p, vec3* error) {
   const vec3 t0 = b0 * p0, t1 = b1 * p1, t2 = b2 * p2;
   *p = t0 + t1 + t2;
   *error = gamma_bound(7) * (glm::abs(t0) + glm::abs(t1) + glm::abs(t2));
