@@ -55,13 +55,19 @@ void print_memory(const MemoryEstimate& m, bool with_film) {
       with_film ? (", film " + byte_size(m.film)).c_str() : "");
 }
 
-// "3 quads, 1 sphere" from counts by kind, in a fixed order.
-std::string list_counts(const std::vector<std::pair<const char*, int64_t>>& counts) {
+struct Count {
+  const char* one;
+  const char* many;
+  int64_t n;
+};
+
+// "3 quads, 1 sphere", leaving out the kinds with none.
+std::string list_counts(const std::vector<Count>& counts) {
   std::string out;
-  for (const auto& [kind, n] : counts) {
-    if (n == 0) continue;
+  for (const Count& c : counts) {
+    if (c.n == 0) continue;
     if (!out.empty()) out += ", ";
-    out += std::to_string(n) + " " + kind + (n == 1 ? "" : "s");
+    out += std::to_string(c.n) + " " + (c.n == 1 ? c.one : c.many);
   }
   return out.empty() ? "none" : out;
 }
@@ -94,13 +100,18 @@ int print_scene(const std::string& file) {
 
   std::printf("%s: scene, %d x %d pixels, %d spp\n", file.c_str(), settings.width, settings.height,
               settings.spp);
-  std::printf("  objects     %zu: %s; %lld emitting\n", scene.objects.size(),
-              list_counts({{"sphere", spheres}, {"quad", quads}, {"mesh", meshes}}).c_str(),
-              static_cast<long long>(emitting));
+  std::printf(
+      "  objects     %zu: %s; %lld emitting\n", scene.objects.size(),
+      list_counts(
+          {{"sphere", "spheres", spheres}, {"quad", "quads", quads}, {"mesh", "meshes", meshes}})
+          .c_str(),
+      static_cast<long long>(emitting));
   std::printf("  triangles   %lld\n", static_cast<long long>(triangles));
   std::printf("  vertices    %lld\n", static_cast<long long>(vertices));
   std::printf("  lights      %s; environment %s\n",
-              list_counts({{"point light", points}, {"directional light", directionals}}).c_str(),
+              list_counts({{"point light", "point lights", points},
+                           {"directional light", "directional lights", directionals}})
+                  .c_str(),
               is_black(scene.environment) ? "black" : "constant");
   std::printf("  materials   %zu\n", scene.materials.size());
   std::printf("  files       %zu\n", request.assets.size());
