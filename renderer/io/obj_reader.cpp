@@ -214,7 +214,8 @@ MeshFile parse_obj(std::string bytes, const std::string& name, const MeshFileLim
   std::string().swap(bytes);  // not needed any more: lower the peak
 
   // Which attributes every corner has; attributes on some corners only are dropped.
-  bool all_normals = !attrib.normals.empty(), all_uvs = !attrib.texcoords.empty();
+  // A corner naming a normal or uv the file lacks is reported by VertexMerger, not ignored.
+  bool all_normals = true, all_uvs = true;
   bool some_normals = false, some_uvs = false;
   size_t corners = 0;
   for (const tinyobj::shape_t& shape : shapes)

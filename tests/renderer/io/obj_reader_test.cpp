@@ -121,6 +121,8 @@ TEST(ObjReader, BadIndicesAndFaces) {
   EXPECT_CONTAINS(obj_error(three + "f 1 2 -4\n"), "face 1: a vertex index is out of range");
   EXPECT_CONTAINS(obj_error(three + "vn 0 0 1\nf 1//1 2//1 3//2\n"),
                   "face 1: a normal index is out of range");
+  EXPECT_CONTAINS(obj_error(three + "f 1//1 2//1 3//1\n"),
+                  "face 1: a normal index is out of range (the file has 0)");
   EXPECT_CONTAINS(obj_error(three + "f 1 2 0\n"), "cannot parse the file");
   EXPECT_CONTAINS(obj_error(three + "f 1 2\n"), "line 4: a face needs at least 3 vertices");
   EXPECT_CONTAINS(obj_error(three + "f\tx\n"), "line 4: a face needs at least 3 vertices");
