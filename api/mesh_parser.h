@@ -1,19 +1,35 @@
 #pragma once
-// The "mesh" object: flat positions / indices / optional normals -> a world-space MeshDesc.
-// Degenerate (zero-area) triangles are dropped with a warning rather than rejected, so meshes
-// exported by modelling tools load; zero-length normals are repaired per vertex (see .cpp).
+// The "mesh" object -> a world-space MeshDesc: inline arrays (positions / indices / optional
+// normals and uvs) or a mesh file ("file": PLY or OBJ in the scene's asset folder, read by
+// renderer/io/). Both go through the same placement: transform, range checks, degenerate
+// (zero-area) triangles dropped with a warning rather than rejected, so meshes exported by
+// modelling tools load; zero-length normals repaired per vertex (see .cpp).
 #include <cstdint>
 #include <optional>
+#include <string>
 
+#include "api/asset_path.h"
 #include "api/json_reader.h"
+#include "api/scene_loader.h"
 #include "api/transform.h"
 #include "renderer/scene/scene_input.h"
 
 namespace penumbra::api {
 
-// `triangle_budget` = how many triangles the scene may still add (Limits::max_triangles minus
-// those of earlier meshes).
-std::optional<MeshDesc> parse_mesh(ObjectReader& reader, const AffineTransform& transform,
-                                    int64_t triangle_budget, int64_t max_triangles);
+// What the scene may still add: Limits::max_triangles and max_vertices minus what earlier meshes
+// took.
+struct MeshBudget {
+  int64_t triangles = 0;
+  int64_t vertices = 0;
+};
+
+struct ParsedMesh {
+  MeshDesc mesh;
+  std::optional<AssetUse> file;  // set for a mesh read from a file
+};
+
+std::optional<ParsedMesh> parse_mesh(ObjectReader& reader, const AffineTransform& transform,
+                                     const MeshBudget& budget, const Limits& limits,
+                                     const AssetFolder& assets);
 
 }  // namespace penumbra::api

@@ -148,12 +148,15 @@ ParsedObjects parse_objects(const Json* objects, const std::string& pointer,
         if (auto quad = parse_quad(reader, transform)) object.shape = *quad;
       }
     } else if (*type == "mesh") {
-      reader.allow({"positions", "indices", "normals"});
-      const int64_t budget = limits.max_triangles - parsed.triangles;
+      reader.allow({"positions", "indices", "normals", "uvs", "file"});
+      const MeshBudget budget{limits.max_triangles - parsed.triangles,
+                              limits.max_vertices - parsed.vertices};
       if (transform_ok) {
-        if (auto mesh = parse_mesh(reader, transform, budget, limits.max_triangles)) {
-          parsed.triangles += int64_t(mesh->indices.size() / 3);
-          object.shape = std::move(*mesh);
+        if (auto mesh = parse_mesh(reader, transform, budget, limits, assets)) {
+          parsed.triangles += int64_t(mesh->mesh.indices.size() / 3);
+          parsed.vertices += int64_t(mesh->mesh.positions.size());
+          if (mesh->file) parsed.assets.push_back(std::move(*mesh->file));
+          object.shape = std::move(mesh->mesh);
         }
       }
     } else {

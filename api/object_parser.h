@@ -21,6 +21,8 @@ inline constexpr double kMaxCoordinate = 1e18;
 struct ParsedObjects {
   std::vector<ObjectDesc> objects;
   int64_t triangles = 0;             // mesh triangles kept, after dropping degenerate ones
+  int64_t vertices = 0;              // mesh vertices
+  std::vector<AssetUse> assets;      // mesh files read
   std::vector<bool> material_used;   // per material handle
   bool any_emission = false;
 };

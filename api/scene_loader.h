@@ -32,6 +32,8 @@ struct Limits {
   int max_spp = 1 << 20;
   int max_depth = 1024;
   int64_t max_triangles = 4'000'000;
+  int64_t max_vertices = 12'000'000;              // mesh vertices, whole scene
+  int64_t max_mesh_file_bytes = int64_t(1) << 30;  // any one mesh file
   int max_objects = 100'000;
   int max_materials = 10'000;
   int max_lights = 10'000;
@@ -45,6 +47,13 @@ enum class LoadErrorKind {
   kInvalid,  // JSON, but not a valid scene: HTTP 422
 };
 
+// A file the scene reads, for reports such as `penumbra info`.
+struct AssetUse {
+  std::string pointer;  // the field naming it, "/objects/3/file"
+  std::string path;     // as the scene writes it
+  std::string summary;  // what was read from it: "12000 triangles (6000 faces), normals, uvs"
+};
+
 struct SceneRequest {
   SceneInput scene;
   RenderSettings settings;
@@ -52,6 +61,7 @@ struct SceneRequest {
   // position): single-precision rendering keeps its accuracy however far from the JSON origin
   // the scene lies. Add it back to recover JSON coordinates.
   glm::dvec3 world_origin{0.0};
+  std::vector<AssetUse> assets;  // in the order the scene names them
 };
 
 struct LoadResult {

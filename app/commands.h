@@ -4,5 +4,6 @@
 namespace penumbra::app {
 int run_render(int argc, char** argv);
 int run_validate(int argc, char** argv);
+int run_info(int argc, char** argv);
 int run_bench(int argc, char** argv);
 }  // namespace penumbra::app

@@ -1,4 +1,4 @@
-// penumbra: render, validate, serve, bench.
+// penumbra: render, validate, info, serve, bench.
 #include <cstdio>
 #include <cstring>
 #include <exception>
@@ -18,6 +18,7 @@ void print_usage(std::FILE* out) {
                "commands:\n"
                "  render SCENE.json -o OUT.{png,exr}   render a scene to an image\n"
                "  validate SCENE.json...               check scenes, print every error with its JSON pointer\n"
+               "  info FILE...                         what a scene or mesh file contains, and its memory\n"
 #ifdef PENUMBRA_HAVE_SERVER
                "  serve                                run the HTTP render service\n"
 #endif
@@ -37,6 +38,7 @@ int main(int argc, char** argv) {
   try {
     if (command == "render") return penumbra::app::run_render(argc - 1, argv + 1);
     if (command == "validate") return penumbra::app::run_validate(argc - 1, argv + 1);
+    if (command == "info") return penumbra::app::run_info(argc - 1, argv + 1);
     if (command == "bench") return penumbra::app::run_bench(argc - 1, argv + 1);
 #ifdef PENUMBRA_HAVE_SERVER
     if (command == "serve") return penumbra::server::run_serve(argc - 1, argv + 1);

@@ -3,6 +3,7 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 
 #include "api/render_overrides.h"
 
@@ -63,6 +64,38 @@ bool parse_render_override(OptionParser& p, std::vector<api::RenderOverride>& ov
   std::string value;
   if (p.value(&value)) overrides.push_back({p.arg(), std::move(value)});
   return true;
+}
+
+std::optional<std::vector<std::string>> file_arguments(int argc, char** argv, const char* command,
+                                                       void (*print_help)(std::FILE*),
+                                                       int* exit_code) {
+  std::vector<std::string> files;
+  bool options_done = false;
+  for (int i = 1; i < argc; ++i) {
+    const char* arg = argv[i];
+    if (!options_done && (!std::strcmp(arg, "--help") || !std::strcmp(arg, "-h"))) {
+      print_help(stdout);
+      *exit_code = 0;
+      return std::nullopt;
+    }
+    if (!options_done && !std::strcmp(arg, "--")) {
+      options_done = true;
+      continue;
+    }
+    if (!options_done && arg[0] == '-' && arg[1] != '\0') {
+      std::fprintf(stderr, "penumbra %s: unknown option '%s'\n", command, arg);
+      print_help(stderr);
+      *exit_code = 2;
+      return std::nullopt;
+    }
+    files.emplace_back(arg);
+  }
+  if (files.empty()) {
+    print_help(stderr);
+    *exit_code = 2;
+    return std::nullopt;
+  }
+  return files;
 }
 
 }  // namespace penumbra::app

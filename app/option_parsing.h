@@ -1,5 +1,6 @@
 #pragma once
 // Small command-line parsing helpers shared by the subcommands.
+#include <cstdio>
 #include <optional>
 #include <string>
 #include <vector>
@@ -36,5 +37,12 @@ class OptionParser {
 // it as typed and returns true (check p.failed() for a missing value). Its value is checked by
 // api/ with the scene, by the same code and limits as the JSON field.
 bool parse_render_override(OptionParser& p, std::vector<api::RenderOverride>& overrides);
+
+// The arguments of a command that takes only files and --help (validate, info): the files in
+// order ("--" ends the options). nullopt when the command is done, with *exit_code set: 0 after
+// --help, 2 after printing a usage error (an unknown option, no file).
+std::optional<std::vector<std::string>> file_arguments(int argc, char** argv, const char* command,
+                                                       void (*print_help)(std::FILE*),
+                                                       int* exit_code);
 
 }  // namespace penumbra::app

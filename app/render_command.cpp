@@ -10,6 +10,7 @@
 #include "api/scene_loader.h"
 #include "api/version.h"
 #include "app/commands.h"
+#include "app/load_report.h"
 #include "app/option_parsing.h"
 #include "renderer/io/image_io.h"
 #include "renderer/render/render.h"
@@ -78,13 +79,7 @@ int run_render(int argc, char** argv) {
   }
 
   api::LoadResult loaded = api::load_scene_file(scene_path, {}, overrides);
-  for (const auto& w : loaded.warnings)
-    std::fprintf(stderr, "%s: warning: %s\n", scene_path.c_str(), w.to_string().c_str());
-  if (!loaded.ok()) {
-    for (const auto& e : loaded.errors)
-      std::fprintf(stderr, "%s: %s\n", scene_path.c_str(), e.to_string().c_str());
-    return 1;
-  }
+  if (!report_load_problems(scene_path, loaded)) return 1;
   const RenderSettings& settings = loaded.request->settings;
 
   const auto build_start = std::chrono::steady_clock::now();

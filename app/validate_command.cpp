@@ -2,13 +2,14 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstdio>
-#include <cstring>
 #include <string>
 #include <variant>
 #include <vector>
 
 #include "api/scene_loader.h"
 #include "app/commands.h"
+#include "app/load_report.h"
+#include "app/option_parsing.h"
 
 namespace penumbra::app {
 
@@ -36,38 +37,14 @@ int64_t count_triangles(const SceneInput& scene) {
 }  // namespace
 
 int run_validate(int argc, char** argv) {
-  std::vector<std::string> files;
-  bool options_done = false;
-  for (int i = 1; i < argc; ++i) {
-    const char* arg = argv[i];
-    if (!options_done && (!std::strcmp(arg, "--help") || !std::strcmp(arg, "-h"))) {
-      print_help(stdout);
-      return 0;
-    }
-    if (!options_done && !std::strcmp(arg, "--")) {
-      options_done = true;
-      continue;
-    }
-    if (!options_done && arg[0] == '-' && arg[1] != '\0') {
-      std::fprintf(stderr, "penumbra validate: unknown option '%s'\n", arg);
-      print_help(stderr);
-      return 2;
-    }
-    files.emplace_back(arg);
-  }
-  if (files.empty()) {
-    print_help(stderr);
-    return 2;
-  }
+  int exit_code = 0;
+  const auto files = file_arguments(argc, argv, "validate", print_help, &exit_code);
+  if (!files) return exit_code;
 
   bool all_valid = true;
-  for (const std::string& file : files) {
+  for (const std::string& file : *files) {
     const api::LoadResult result = api::load_scene_file(file);
-    for (const api::Diagnostic& warning : result.warnings)
-      std::fprintf(stderr, "%s: warning: %s\n", file.c_str(), warning.to_string().c_str());
-    for (const api::Diagnostic& error : result.errors)
-      std::fprintf(stderr, "%s: %s\n", file.c_str(), error.to_string().c_str());
-    if (!result.ok()) {
+    if (!report_load_problems(file, result)) {
       all_valid = false;
       continue;
     }

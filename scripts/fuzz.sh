@@ -1,12 +1,19 @@
 #!/usr/bin/env bash
-# Fuzz the scene loader (api::load_scene, plus Scene::build and a 4x4 render of valid scenes)
-# with libFuzzer under AddressSanitizer + UndefinedBehaviorSanitizer for a bounded time.
-#   scripts/fuzz.sh [SECONDS]     (default 60)
+# Fuzz every libFuzzer target under AddressSanitizer + UndefinedBehaviorSanitizer for a bounded
+# total time, shared equally between the targets:
+#   scene_loader  api::load_scene (plus Scene::build and a 4x4 render of valid scenes)
+#   ply_reader    renderer/io/ply_reader (our own PLY parser)
+#   obj_reader    renderer/io/obj_reader (screening + tinyobjloader)
+#   scripts/fuzz.sh [SECONDS] [TARGET...]     (default 60 seconds, all targets)
 # Builds with clang in build-fuzz/. Fails (non-zero) on any crash, sanitizer report, leak,
 # timeout (an input taking more than 10 s) or out-of-memory (2 GB). Crash reproducers are left
-# in build-fuzz/artifacts/; new corpus entries go to build-fuzz/corpus/ (fuzz/corpus/ is the seed).
+# in build-fuzz/artifacts/<target>/; new corpus entries go to build-fuzz/corpus/<target>/
+# (fuzz/corpus/<target>/ is the seed, fuzz/dict/<target>.dict the dictionary where there is one).
 set -euo pipefail
 seconds="${1:-60}"
+shift || true
+targets=("$@")
+if [ ${#targets[@]} -eq 0 ]; then targets=(scene_loader ply_reader obj_reader); fi
 root="$(cd "$(dirname "$0")/.." && pwd)"
 build="$root/build-fuzz"
 jobs="${JOBS:-2}"
@@ -14,12 +21,19 @@ jobs="${JOBS:-2}"
 CC=clang CXX=clang++ cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DPENUMBRA_FUZZ=ON -DPENUMBRA_SANITIZE=ON -DPENUMBRA_BUILD_TESTS=OFF -DPENUMBRA_BUILD_BENCH=OFF \
   -DPENUMBRA_BUILD_SERVER=OFF >/dev/null
-ninja -C "$build" -j "$jobs" scene_loader_fuzzer
+ninja -C "$build" -j "$jobs" "${targets[@]/%/_fuzzer}"
 
-mkdir -p "$build/corpus" "$build/artifacts"
 export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1:${ASAN_OPTIONS:-}"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:${UBSAN_OPTIONS:-}"
-# -max_len covers the seed scenes; -timeout is per input; -rss_limit_mb bounds memory.
-"$build/fuzz/scene_loader_fuzzer" "$build/corpus" "$root/fuzz/corpus" \
-  -max_total_time="$seconds" -max_len=8192 -timeout=10 -rss_limit_mb=2048 \
-  -artifact_prefix="$build/artifacts/" -print_final_stats=1
+share=$(( seconds / ${#targets[@]} ))
+if [ "$share" -lt 1 ]; then share=1; fi
+for target in "${targets[@]}"; do
+  echo "== fuzz $target for ${share} s" >&2
+  mkdir -p "$build/corpus/$target" "$build/artifacts/$target"
+  dict=()
+  if [ -f "$root/fuzz/dict/$target.dict" ]; then dict=(-dict="$root/fuzz/dict/$target.dict"); fi
+  # -max_len covers the seeds; -timeout is per input; -rss_limit_mb bounds memory.
+  "$build/fuzz/${target}_fuzzer" "$build/corpus/$target" "$root/fuzz/corpus/$target" "${dict[@]}" \
+    -max_total_time="$share" -max_len=8192 -timeout=10 -rss_limit_mb=2048 \
+    -artifact_prefix="$build/artifacts/$target/" -print_final_stats=1
+done

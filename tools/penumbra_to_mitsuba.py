@@ -317,10 +317,64 @@ def convert_object(mi, index: int, obj: dict, materials: dict, time: float):
         positions = np.array([origin, origin + u, origin + u + v, origin + v])
         faces = np.array([[0, 1, 2], [0, 2, 3]], dtype=np.uint32)
         return build_mesh(mi, f"quad{index}", positions, faces, None, instantiate(mi, children))
+    if kind == "mesh" and "file" in obj:
+        return mesh_file_shape(mi, obj, matrix, offset, children)
     if kind == "mesh":
         positions, faces, normals = mesh_arrays(obj, matrix, offset)
         return build_mesh(mi, f"mesh{index}", positions, faces, normals, instantiate(mi, children))
     raise ValueError(f"object {index}: unknown type {kind!r}")
+
+
+# --------------------------------------------------------------------------------------------
+# Mesh files ("file" on a mesh object)
+# --------------------------------------------------------------------------------------------
+
+def mesh_file_shape(mi, obj: dict, matrix: np.ndarray, offset: np.ndarray, children: dict) -> dict:
+    """A mesh object with ``"file"`` -> Mitsuba's own ``ply`` or ``obj`` plugin on the same file,
+    so that the reference also checks penumbra's readers.
+
+    The object transform (and the motion offset at this instant) becomes ``to_world``. Mitsuba
+    computes smooth vertex normals for a file without any, where penumbra shades such a mesh
+    with its face normals (flat, as an inline mesh without normals): ``face_normals`` says which.
+    Both flip OBJ's v on load. The path must already be resolved (:func:`load_json` does it).
+    """
+    path = obj["file"]
+    kind = os.path.splitext(path)[1].lower().lstrip(".")
+    if kind not in ("ply", "obj"):
+        raise ValueError(f"unknown mesh file type {path!r}")
+    to_world = matrix.copy()
+    to_world[:3, 3] += offset
+    return {"type": kind, "filename": path, "to_world": mi.ScalarTransform4f(to_world),
+            "face_normals": not mesh_file_has_normals(path), **children}
+
+
+def mesh_file_has_normals(path: str) -> bool:
+    """Whether penumbra shades the file with its vertex normals: a PLY whose vertex element has
+    nx, ny, nz; an OBJ whose every face corner names a normal (``v//vn`` or ``v/vt/vn``)."""
+    with open(path, "rb") as f:
+        data = f.read()
+    if path.lower().endswith(".ply"):
+        header = data[:data.index(b"end_header")].decode("ascii", "replace").split("\n")
+        element, names = None, set()
+        for line in header:
+            words = line.split()
+            if words[:1] == ["element"]:
+                element = words[1]
+            elif words[:1] == ["property"] and element == "vertex":
+                names.add(words[-1])
+        return {"nx", "ny", "nz"} <= names
+    corners = [c for line in data.decode("utf-8", "replace").splitlines() if line.split()[:1] == ["f"]
+               for c in line.split()[1:]]
+    return bool(corners) and all(c.count("/") == 2 and not c.endswith("/") for c in corners)
+
+
+def resolve_mesh_files(scene: dict, folder: str) -> dict:
+    """Mesh ``"file"`` paths made absolute, relative to the scene file's folder as penumbra's
+    CLI reads them."""
+    for obj in scene.get("objects", []):
+        if obj.get("type") == "mesh" and "file" in obj:
+            obj["file"] = os.path.join(folder, obj["file"])
+    return scene
 
 
 def instantiate(mi, children: dict) -> dict:
@@ -403,9 +457,10 @@ def to_mitsuba(mi, scene: dict, time: float = 0.0, spp: int | None = None,
 
 
 def load_json(path: str) -> dict:
-    """Read a penumbra scene file."""
+    """Read a penumbra scene file; the files it names are resolved against its folder."""
     with open(path, encoding="utf-8") as f:
-        return json.load(f)
+        scene = json.load(f)
+    return resolve_mesh_files(scene, os.path.dirname(os.path.abspath(path)))
 
 
 def render_average(mi, scene: dict, spp: int, instants: int = 64, seed: int = 0,

@@ -108,7 +108,7 @@ TEST(Limits, TrianglesAcrossTheScene) {
 
 TEST(Limits, HugeMeshIsRejectedBeforeReadingElements) {
   Limits limits;
-  limits.max_triangles = 10;
+  limits.max_vertices = 30;
   Json scene = base_scene();
   Json m = {{"type", "mesh"}, {"material", "white"}};
   m["positions"] = Json::array();
@@ -116,7 +116,7 @@ TEST(Limits, HugeMeshIsRejectedBeforeReadingElements) {
   m["indices"] = {0, 1, 2};
   scene["objects"].push_back(m);
   const LoadResult r = load(scene, limits);
-  EXPECT_ERROR(r, "/objects/1/positions", "31 vertices exceed the limit of 30");
+  EXPECT_ERROR(r, "/objects/1/positions", "the scene's mesh vertices exceed the limit of 30 (max_vertices)");
   EXPECT_EQ(r.errors.size(), 1u) << describe(r.errors);
 }
 

@@ -58,7 +58,8 @@ TEST(Schema, DocumentsEveryField) {
                     "camera");
   expect_documented(defs["object"]["properties"],
                     {"type", "material", "emission", "velocity", "acceleration", "transform",
-                     "center", "radius", "origin", "u", "v", "positions", "indices", "normals"},
+                     "center", "radius", "origin", "u", "v", "positions", "indices", "normals",
+                     "uvs", "file"},
                     "object");
   const Json& materials = defs["material"]["oneOf"];
   expect_documented(materials[0]["properties"], {"type", "color"}, "diffuse");

@@ -19,6 +19,8 @@ dof            thin-lens depth of field, 96 x 64 (non-square: checks the vertica
 motion_blur    velocity and acceleration on spheres, an emitter and a transformed mesh
 all_lights     point + directional + quad + sphere + mesh emitters + environment together
 mesh_100k      a 102,400-triangle torus knot with vertex normals, rough conductor
+mesh_files     mesh files: a binary PLY blob with vertex normals and uvs (smooth), an OBJ prism
+               of quads and hexagons without normals (flat), both placed by transforms
 kitchen_sink   depth of field + motion blur + absorbing rough glass + every light kind
 =============  ==============================================================================
 """
@@ -310,6 +312,91 @@ def mesh_100k() -> dict:
         width=96, height=96, max_depth=6, cam_pos=(0, 1.6, 3.6), look=(0, 0.6, 0), fov=35)
 
 
+def icosphere(subdivisions: int) -> tuple[np.ndarray, np.ndarray]:
+    """Unit sphere from a subdivided icosahedron: (positions, triangles), counter-clockwise seen
+    from outside."""
+    t = (1 + math.sqrt(5)) / 2
+    p = [(-1, t, 0), (1, t, 0), (-1, -t, 0), (1, -t, 0), (0, -1, t), (0, 1, t), (0, -1, -t), (0, 1, -t),
+         (t, 0, -1), (t, 0, 1), (-t, 0, -1), (-t, 0, 1)]
+    positions = [np.array(v, dtype=np.float64) / np.linalg.norm(v) for v in p]
+    tris = [(0, 11, 5), (0, 5, 1), (0, 1, 7), (0, 7, 10), (0, 10, 11), (1, 5, 9), (5, 11, 4), (11, 10, 2),
+            (10, 7, 6), (7, 1, 8), (3, 9, 4), (3, 4, 2), (3, 2, 6), (3, 6, 8), (3, 8, 9), (4, 9, 5),
+            (2, 4, 11), (6, 2, 10), (8, 6, 7), (9, 8, 1)]
+    for _ in range(subdivisions):
+        midpoint: dict[tuple[int, int], int] = {}
+
+        def mid(a: int, b: int) -> int:
+            key = (min(a, b), max(a, b))
+            if key not in midpoint:
+                m = positions[a] + positions[b]
+                positions.append(m / np.linalg.norm(m))
+                midpoint[key] = len(positions) - 1
+            return midpoint[key]
+
+        tris = [t2 for a, b, c in tris
+                for t2 in ((a, mid(a, b), mid(c, a)), (b, mid(b, c), mid(a, b)), (c, mid(c, a), mid(b, c)),
+                           (mid(a, b), mid(b, c), mid(c, a)))]
+    return np.array(positions), orient_outward(np.array(positions), np.array(tris))
+
+
+def write_ply_binary(path: str, positions, normals, uvs, tris) -> None:
+    """A binary little-endian PLY: float x, y, z, nx, ny, nz, u, v per vertex; triangles."""
+    vertex = np.zeros(len(positions), dtype=[(n, "<f4") for n in ("x", "y", "z", "nx", "ny", "nz", "u", "v")])
+    for k, n in enumerate(("x", "y", "z")):
+        vertex[n] = positions[:, k]
+        vertex["n" + n] = normals[:, k]
+    vertex["u"], vertex["v"] = uvs[:, 0], uvs[:, 1]
+    face = np.zeros(len(tris), dtype=[("n", "u1"), ("i", "<i4", (3,))])
+    face["n"], face["i"] = 3, tris
+    header = (f"ply\nformat binary_little_endian 1.0\ncomment tests/accuracy/scenes/make_scenes.py\n"
+              f"element vertex {len(positions)}\n" +
+              "".join(f"property float {n}\n" for n in ("x", "y", "z", "nx", "ny", "nz", "u", "v")) +
+              f"element face {len(tris)}\nproperty list uchar int vertex_indices\nend_header\n")
+    with open(path, "wb") as f:
+        f.write(header.encode())
+        f.write(vertex.tobytes())
+        f.write(face.tobytes())
+
+
+def blob_mesh():
+    """A smooth lumpy sphere, 5120 triangles, with area-weighted vertex normals and spherical uvs."""
+    unit, tris = icosphere(4)
+    x, y, z = unit[:, 0], unit[:, 1], unit[:, 2]
+    radius = 1 + 0.12 * np.sin(3 * x + 1) * np.cos(2 * y) + 0.08 * np.sin(4 * z)
+    positions = unit * radius[:, None]
+    uvs = np.stack([np.arctan2(z, x) / (2 * math.pi) + 0.5, np.arccos(np.clip(y, -1, 1)) / math.pi], axis=1)
+    return positions, tris, vertex_normals(positions, tris), uvs
+
+
+def prism_obj() -> str:
+    """A hexagonal prism as OBJ text: two hexagons and six quads, counter-clockwise seen from
+    outside, no normals (shaded flat)."""
+    ring = [(math.cos(k * math.pi / 3), math.sin(k * math.pi / 3)) for k in range(6)]
+    lines = ["# tests/accuracy/scenes/make_scenes.py: hexagonal prism, polygons, no normals"]
+    lines += [f"v {c:.6f} {-0.5:.6f} {s_:.6f}" for c, s_ in ring] + [f"v {c:.6f} {0.5:.6f} {s_:.6f}" for c, s_ in ring]
+    lines.append("f " + " ".join(str(k + 1) for k in range(6)))            # bottom, seen from below
+    lines.append("f " + " ".join(str(12 - k) for k in range(6)))           # top, seen from above
+    for k in range(6):
+        a, b = k + 1, (k + 1) % 6 + 1
+        lines.append(f"f {a} {a + 6} {b + 6} {b}")
+    return "\n".join(lines) + "\n"
+
+
+def mesh_files() -> dict:
+    positions, tris, normals, uvs = blob_mesh()
+    write_ply_binary(os.path.join(HERE, "mesh_files_blob.ply"), positions, normals, uvs, tris)
+    with open(os.path.join(HERE, "mesh_files_prism.obj"), "w", encoding="utf-8") as f:
+        f.write(prism_obj())
+    return floor_scene(
+        [{"type": "mesh", "file": "mesh_files_blob.ply", "material": "coat",
+          "transform": transform([0.45, 0.45, 0.45], [0, 1, 0], 25, [-0.55, 0.56, 0])},
+         {"type": "mesh", "file": "mesh_files_prism.obj", "material": "metal",
+          "transform": transform([0.32, 0.5, 0.32], [1, 0, 1], 20, [0.6, 0.4, 0.15])}],
+        {"coat": {"type": "plastic", "color": [0.7, 0.25, 0.1], "ior": 1.5, "roughness": 0.3},
+         "metal": {"type": "conductor", "color": [0.9, 0.8, 0.55], "roughness": 0.25}},
+        width=96, height=72, max_depth=6, cam_pos=(0, 1.2, 3.6), look=(0, 0.45, 0), fov=35)
+
+
 def kitchen_sink() -> dict:
     cube_p, cube_i = cube_mesh()
     scene = floor_scene(
@@ -331,7 +418,7 @@ def kitchen_sink() -> dict:
 
 
 SCENES = {f.__name__: f for f in (cornell, glass_smooth, glass_rough, furnace, conductors, plastics,
-                                  dof, motion_blur, all_lights, mesh_100k, kitchen_sink)}
+                                  dof, motion_blur, all_lights, mesh_100k, mesh_files, kitchen_sink)}
 
 
 def write(name: str, scene: dict) -> str:

@@ -1,0 +1,59 @@
+// The memory estimate counts each mesh's arrays where they live (input, renderer copy, Embree
+// buffers), Embree's BVH per triangle, light-sampling tables of emitters, and the film.
+#include "renderer/scene/memory_estimate.h"
+
+#include <gtest/gtest.h>
+
+namespace penumbra::test {
+namespace {
+
+MeshDesc grid_mesh(int quads, bool normals, bool uvs) {
+  MeshDesc m;
+  for (int i = 0; i <= quads; ++i)
+    for (int j = 0; j < 2; ++j) {
+      m.positions.emplace_back(float(i), float(j), 0.f);
+      if (normals) m.normals.emplace_back(0.f, 0.f, 1.f);
+      if (uvs) m.uvs.emplace_back(float(i), float(j));
+    }
+  for (uint32_t i = 0; i < uint32_t(quads); ++i)
+    m.indices.insert(m.indices.end(), {2 * i, 2 * i + 2, 2 * i + 3, 2 * i, 2 * i + 3, 2 * i + 1});
+  return m;
+}
+
+TEST(MemoryEstimate, MeshArraysAndEmbree) {
+  const MeshDesc plain = grid_mesh(500, false, false);  // 1002 vertices, 1000 triangles
+  const MemoryEstimate e = estimate_mesh_memory(plain);
+  EXPECT_EQ(e.scene_input, 1002 * 12 + 1000 * 12);
+  EXPECT_EQ(e.shapes, e.scene_input);
+  // Vertex and index buffers, and at least the measured 61 bytes of BVH per triangle.
+  EXPECT_GE(e.embree, 1002 * 12 + 1000 * 12 + 1000 * 61);
+  EXPECT_LE(e.embree, 1002 * 12 + 1000 * 12 + 1000 * 80);
+  EXPECT_GT(e.embree_build_peak, 0);
+  EXPECT_EQ(e.film, 0);
+  const MemoryEstimate full = estimate_mesh_memory(grid_mesh(500, true, true));
+  EXPECT_EQ(full.scene_input - e.scene_input, 1002 * (12 + 8));
+}
+
+TEST(MemoryEstimate, SceneAddsEmittersMotionAndFilm) {
+  SceneInput scene;
+  ObjectDesc mesh;
+  mesh.shape = grid_mesh(100, false, false);
+  scene.objects.push_back(mesh);
+  scene.objects.push_back(ObjectDesc{SphereDesc{}});
+  RenderSettings settings;
+  settings.width = 100;
+  settings.height = 50;
+  const MemoryEstimate base = estimate_memory(scene, settings);
+  EXPECT_EQ(base.film, 100 * 50 * 80);
+  EXPECT_EQ(base.total(),
+            base.scene_input + base.shapes + base.embree + base.embree_build_peak + base.film);
+
+  scene.objects[0].emission = Spectrum(1.f);  // a triangle-area table for light sampling
+  EXPECT_EQ(estimate_memory(scene, settings).shapes - base.shapes, 200 * 4);
+  scene.objects[0].emission = Spectrum(0.f);
+  scene.objects[0].velocity = vec3(1.f, 0.f, 0.f);  // a second vertex buffer
+  EXPECT_EQ(estimate_memory(scene, settings).embree - base.embree, 202 * 12);
+}
+
+}  // namespace
+}  // namespace penumbra::test
