@@ -30,7 +30,8 @@ vec3 EnvironmentMap::uv_to_direction(const vec2& uv) {
 }
 
 EnvironmentMap::EnvironmentMap(const EnvironmentMapDesc& desc)
-    : scale_(clean(desc.scale)), uniform_sampling_(desc.uniform_sampling) {
+    : uniform_sampling_(desc.uniform_sampling) {
+  const float scale = clean(desc.scale);
   const bool has_pixels = desc.width > 0 && desc.height > 0 &&
                           desc.rgb.size() >= size_t(desc.width) * size_t(desc.height) * 3;
   width_ = has_pixels ? desc.width : 1;
@@ -38,12 +39,15 @@ EnvironmentMap::EnvironmentMap(const EnvironmentMapDesc& desc)
   // One row is a map that does not vary with v: its row stands at both poles.
   height_ = std::max(rows, 2);
   texels_.resize(size_t(width_) * size_t(height_), Spectrum(0.f));
-  for (int y = 0; y < height_; ++y)
-    for (int x = 0; x < width_; ++x) {
-      if (!has_pixels) continue;
-      const float* p = &desc.rgb[(size_t(std::min(y, rows - 1)) * size_t(width_) + size_t(x)) * 3];
-      texels_[size_t(y) * size_t(width_) + size_t(x)] = Spectrum(clean(p[0]), clean(p[1]), clean(p[2]));
-    }
+  if (has_pixels)
+    for (int y = 0; y < height_; ++y)
+      for (int x = 0; x < width_; ++x) {
+        const size_t src = (size_t(std::min(y, rows - 1)) * size_t(width_) + size_t(x)) * 3;
+        // Scaled here, so luminances and weights stay within the range the loader checked
+        // (brightest texel x scale <= 1e30) even for texels near the float maximum.
+        Spectrum& t = texels_[size_t(y) * size_t(width_) + size_t(x)];
+        for (int c = 0; c < 3; ++c) t[c] = clean(clean(desc.rgb[src + size_t(c)]) * scale);
+      }
   to_world_ = desc.to_world;
   to_local_ = glm::transpose(desc.to_world);  // orthogonal: the inverse is the transpose
   half_texel_ = 0.5f / float(width_);
@@ -54,8 +58,8 @@ EnvironmentMap::EnvironmentMap(const EnvironmentMapDesc& desc)
   // cell) times the band's cos(theta0) - cos(theta1), the integral of sin(theta) dtheta. The
   // sin(theta) factor keeps the poles, which the map stretches across a whole row, from drawing
   // samples out of proportion to their solid angle (pbrt-v3 §14.2.4; Mitsuba's envmap weights its
-  // grid by sin(theta) too). A cell is zero only if all
-  // four texels are, i.e. only where the radiance is zero.
+  // grid by sin(theta) too). A cell is zero only if all four texels are, i.e. only where the
+  // radiance is zero.
   const int nu = width_, nv = height_ - 1;
   std::vector<float> weights(size_t(nu) * size_t(nv));
   double sum = 0.0;
@@ -71,7 +75,7 @@ EnvironmentMap::EnvironmentMap(const EnvironmentMapDesc& desc)
   }
   distribution_ = Distribution2D(weights, nu, nv);
   // Each cell spans 2 pi / width in azimuth.
-  integral_ = double(scale_) * sum * (2.0 * M_PI / nu);
+  integral_ = sum * (2.0 * M_PI / nu);
 }
 
 Spectrum EnvironmentMap::lookup(const vec2& uv) const {
@@ -92,7 +96,7 @@ Spectrum EnvironmentMap::lookup(const vec2& uv) const {
 }
 
 Spectrum EnvironmentMap::radiance(const vec3& dir) const {
-  return lookup(direction_to_uv(to_local_ * dir)) * scale_;
+  return lookup(direction_to_uv(to_local_ * dir));
 }
 
 bool EnvironmentMap::sample(const vec3&, float, const vec2& u, LightSample* out) const {
@@ -110,7 +114,7 @@ bool EnvironmentMap::sample(const vec3&, float, const vec2& u, LightSample* out)
     if (!(pdf_cell > 0.f) || !(sin_theta > kMinSinTheta)) return false;
     out->wi = to_world_ * uv_to_direction(uv);
     out->pdf = pdf_cell * kInv2PiSquared / sin_theta;
-    out->value = lookup(uv) * scale_;
+    out->value = lookup(uv);
   }
   if (!(out->pdf > 0.f) || !std::isfinite(out->pdf)) return false;
   out->distance = kInfinity;

@@ -40,13 +40,12 @@ class EnvironmentMap final : public EnvironmentLight {
   static vec3 uv_to_direction(const vec2& uv);
 
  private:
-  // Unscaled bilinear lookup at (u, v), as Mitsuba's EnvironmentMapEmitter::eval_spectrum.
+  // Bilinear lookup at (u, v), as Mitsuba's EnvironmentMapEmitter::eval_spectrum.
   Spectrum lookup(const vec2& uv) const;
   const Spectrum& texel(int x, int y) const { return texels_[size_t(y) * size_t(width_) + size_t(x)]; }
 
   int width_ = 1, height_ = 2;      // height >= 2: rows are samples from pole to pole
-  std::vector<Spectrum> texels_;
-  float scale_ = 1.f;
+  std::vector<Spectrum> texels_;  // times scale
   glm::mat3 to_world_{1.f}, to_local_{1.f};
   // Cell (x, y) of the distribution spans texels x, x + 1 and rows y, y + 1; in u it starts at
   // texel x's centre, half a texel right of the cell's own coordinate.

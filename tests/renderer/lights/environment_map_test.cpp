@@ -202,6 +202,28 @@ TEST(EnvironmentMap, BlackMapEmitsNothingAndDividesByNothing) {
   EXPECT_TRUE(EnvironmentMap(empty).is_black());
 }
 
+// Scale applies to the radiance, the samples and the power, also for a texel near the float
+// maximum under a small scale (what the loader allows: brightest texel x scale <= 1e30).
+TEST(EnvironmentMap, ScaleAppliesToRadianceSamplesAndPower) {
+  constexpr float kTexel = 3e38f, kScale = 1e-10f;
+  auto desc = make_map(16, 8, [](int x, int y) { return x == 3 && y == 4 ? kTexel : 0.f; });
+  desc.scale = kScale;
+  const EnvironmentMap map(desc);
+  ASSERT_FALSE(map.is_black());
+  // The texel's centre: u = 3.5 / 16, v = 4 / 7.
+  const vec3 centre = EnvironmentMap::uv_to_direction(vec2(3.5f / 16.f, 4.f / 7.f));
+  EXPECT_NEAR(map.radiance(centre).x, kTexel * kScale, 1e-3f * kTexel * kScale);
+  // Four cells (columns 2, 3; rows 3, 4) hold a quarter of the texel each, 2 pi / 16 wide.
+  auto band = [](int y) { return std::cos(M_PI * y / 7) - std::cos(M_PI * (y + 1) / 7); };
+  const double integral = 0.25 * double(kTexel) * kScale * 2 * (band(3) + band(4)) * 2 * M_PI / 16;
+  EXPECT_NEAR(map.luminance_integral(), integral, 1e-5 * integral);
+  LightSample ls;
+  ASSERT_TRUE(map.sample(vec3(0.f), 0.f, vec2(0.5f, 0.5f), &ls));
+  EXPECT_TRUE(is_finite(ls.value / ls.pdf));
+  EXPECT_GT(ls.value.x, 0.f);
+  EXPECT_LE(ls.value.x, kTexel * kScale * 1.0001f);
+}
+
 TEST(EnvironmentMap, OneTexelMapIsConstant) {
   const EnvironmentMap map(make_map(1, 1, [](int, int) { return 2.f; }));
   EXPECT_FALSE(map.is_black());
