@@ -110,8 +110,9 @@ bool parse_environment(const Json* value, const AssetFolder& assets, SceneInput&
   r.report_unknown_keys();
   if (scale) map.scale = float(*scale);
   if (to_world) map.to_world = *to_world;
-  if (!file || diag.error_count() != errors_before) return false;
-  if (!read_map(*file, assets, map, diag)) return false;
+  // The file is checked even when other fields are wrong: validation reports every problem.
+  if (!file || !read_map(*file, assets, map, diag) || diag.error_count() != errors_before)
+    return false;
 
   const float brightest = map.rgb.empty() ? 0.f : *std::max_element(map.rgb.begin(), map.rgb.end());
   // Scaled radiance must stay finite through the renderer's single-precision arithmetic, as

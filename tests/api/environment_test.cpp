@@ -122,6 +122,10 @@ TEST_F(EnvironmentField, ScaleRange) {
 
 TEST_F(EnvironmentField, PathsStayInTheSceneFolder) {
   EXPECT_ERROR(load_with({{"map", "maps/none.exr"}}), "/environment/map", "no such file");
+  // Reported alongside the other fields' errors.
+  const LoadResult both = load_with(Json::parse(R"({"map": "maps/none.exr", "scale": -1})"));
+  EXPECT_ERROR(both, "/environment/map", "no such file");
+  EXPECT_ERROR(both, "/environment/scale", "must be >= 0");
   EXPECT_ERROR(load_with({{"map", "../sky.exr"}}), "/environment/map", "'..'");
   EXPECT_ERROR(load_with({{"map", (folder_.root / "maps" / "sky.exr").string()}}), "/environment/map",
                "not absolute");
