@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "api/environment_parser.h"
 #include "api/material_parser.h"
 #include "api/object_parser.h"
 
@@ -200,15 +201,8 @@ std::optional<SceneRequest> parse_scene(const Json& document, const Limits& limi
   glm::dvec3 origin(0.0);
   parse_camera(root.get("camera"), request.scene.camera, origin, diag);
 
-  bool environment_lit = false;
-  if (const Json* environment = root.get("environment")) {
-    ObjectReader r(*environment, "/environment", diag);
-    if (auto radiance = r.vec3("radiance", Range::at_least(0), Presence::kRequired)) {
-      request.scene.environment = to_float(*radiance);
-      environment_lit = !is_black(request.scene.environment);
-    }
-    r.report_unknown_keys();
-  }
+  const bool environment_lit =
+      parse_environment(root.get("environment"), assets, request.scene, diag);
 
   ParsedMaterials materials =
       parse_materials(root.get("materials"), "/materials", limits, assets, diag);

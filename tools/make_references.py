@@ -109,6 +109,7 @@ def main(argv: list[str]) -> int:
         if only and name not in only:
             continue
         scene = p2m.load_json(path)
+        p2m.use_scene_folder(mi, path)
         instants = len(p2m.shutter_instants(scene, args.instants))
         start = time.time()
         mean, stderr = render_reference(mi, scene, args.spp, args.batches, args.instants)

@@ -14,6 +14,10 @@ The conversion keeps every semantic of the format (issue 2, docs/accuracy.md has
 * emission is an ``area`` emitter on the shape (one-sided: quad front = u x v, sphere outside,
   mesh counter-clockwise); point lights, directional lights and the constant environment map
   onto ``point``, ``directional`` and ``constant``.
+* an environment ``map`` becomes an ``envmap`` with the same ``scale`` and, as ``to_world``, the
+  same rotation: both renderers look a world direction d up at to_world^-1 d with the same
+  lat-long convention (:func:`convert_environment`). Mitsuba finds the file through its file
+  resolver, to which :func:`use_scene_folder` adds the scene's folder.
 
 Mitsuba 3.9 has no moving shapes. :func:`to_mitsuba` therefore builds the scene at one instant
 ``time``; a motion-blurred reference is the average of renders at many instants spread over the
@@ -393,6 +397,36 @@ def convert_light(light: dict) -> dict:
     raise ValueError(f"unknown light type {light['type']!r}")
 
 
+def convert_environment(mi, env: dict | None) -> dict | None:
+    """A penumbra ``environment`` -> a Mitsuba emitter dictionary, or None when it is black.
+
+    ``radiance`` -> ``constant``. ``map`` -> ``envmap``: penumbra follows Mitsuba 3's envmap
+    (lat-long, +y the top row, +z the centre column, bilinear lookup), so the file, ``scale`` and
+    the map-to-world rotation carry over unchanged; ``matrix`` is row-major as Mitsuba's
+    ScalarTransform4f takes it. The relative file name is resolved by Mitsuba's file resolver
+    (see :func:`use_scene_folder`).
+    """
+    if env is None:
+        return None
+    if "map" not in env:
+        if np.any(vec(env.get("radiance", [0, 0, 0])) > 0):
+            return {"type": "constant", "radiance": rgb(env["radiance"])}
+        return None
+    to_world = np.eye(4)
+    if "matrix" in env:
+        to_world = np.asarray(env["matrix"], dtype=np.float64).reshape(4, 4)
+    elif "rotate" in env:
+        to_world[:3, :3] = rotation_matrix(env["rotate"]["axis"], env["rotate"]["degrees"])
+    return {"type": "envmap", "filename": env["map"], "scale": float(env.get("scale", 1.0)),
+            "to_world": mi.ScalarTransform4f(to_world)}
+
+
+def use_scene_folder(mi, scene_path: str) -> None:
+    """Let Mitsuba find the files a scene names (environment maps) relative to its folder, as
+    penumbra does."""
+    mi.file_resolver().prepend(os.path.dirname(os.path.abspath(scene_path)))
+
+
 def convert_sensor(mi, scene: dict, spp: int, width: int | None = None, height: int | None = None) -> dict:
     """Camera, film (box filter, linear float RGB) and sampler."""
     cam = scene["camera"]
@@ -450,9 +484,9 @@ def to_mitsuba(mi, scene: dict, time: float = 0.0, spp: int | None = None,
         out[f"object{i}"] = convert_object(mi, i, obj, materials, time)
     for i, light in enumerate(scene.get("lights", [])):
         out[f"light{i}"] = convert_light(light)
-    env = scene.get("environment")
-    if env is not None and np.any(vec(env.get("radiance", [0, 0, 0])) > 0):
-        out["environment"] = {"type": "constant", "radiance": rgb(env["radiance"])}
+    environment = convert_environment(mi, scene.get("environment"))
+    if environment is not None:
+        out["environment"] = environment
     return out
 
 
@@ -491,6 +525,7 @@ def main(argv: list[str]) -> int:
     ap.add_argument("--variant", default="llvm_ad_rgb")
     args = ap.parse_args(argv)
     mi = import_mitsuba(args.variant)
+    use_scene_folder(mi, args.scene)
     img = render_average(mi, load_json(args.scene), args.spp, args.instants, args.seed)
     mi.Bitmap(img.astype(np.float32), mi.Bitmap.PixelFormat.RGB).write(args.output)
     return 0

@@ -5,6 +5,7 @@
 #include "renderer/embree/device.h"
 #include "renderer/embree/handles.h"
 #include "renderer/lights/area_light.h"
+#include "renderer/lights/environment_map.h"
 #include "renderer/lights/make_light.h"
 #include "renderer/materials/coating_tables.h"
 #include "renderer/scene/scene.h"
@@ -76,12 +77,12 @@ class SceneBuilder {
     }
     for (const LightDesc& desc : in_.lights)
       if (auto light = make_light(desc)) s_.lights_.push_back(std::move(light));
-    if (!is_black(in_.environment)) {
-      auto env = std::make_unique<ConstantEnvironment>(in_.environment);
-      s_.environment_ = env.get();
-      s_.environment_light_ = int(s_.lights_.size());
-      s_.lights_.push_back(std::move(env));
-      s_.features_.environment = true;
+    if (in_.environment_map) {
+      // A map that emits nothing is left out, as a black constant environment is.
+      auto map = std::make_unique<EnvironmentMap>(*in_.environment_map);
+      if (!map->is_black()) add_environment(std::move(map));
+    } else if (!is_black(in_.environment)) {
+      add_environment(std::make_unique<ConstantEnvironment>(in_.environment));
     }
     s_.features_.lights = !s_.lights_.empty();
     const float radius = std::max(0.5f * glm::length(s_.bounds_.hi - s_.bounds_.lo), 1e-6f);
@@ -89,6 +90,13 @@ class SceneBuilder {
     powers.reserve(s_.lights_.size());
     for (const auto& light : s_.lights_) powers.push_back(light->power(radius));
     s_.light_sampler_ = LightSampler(powers);
+  }
+
+  void add_environment(std::unique_ptr<EnvironmentLight> env) {
+    s_.environment_ = env.get();
+    s_.environment_light_ = int(s_.lights_.size());
+    s_.lights_.push_back(std::move(env));
+    s_.features_.environment = true;
   }
 
   void embree_scene() {

@@ -3,6 +3,7 @@
 // api/ produces it from JSON (applying object transforms) and places the origin at the camera
 // position, computed in double precision, so single-precision rendering keeps its accuracy for
 // scenes far from the JSON origin; tests may build it directly.
+#include <optional>
 #include <string>
 #include <variant>
 #include <vector>
@@ -62,9 +63,24 @@ struct DirectionalLightDesc {
 };
 using LightDesc = std::variant<PointLightDesc, DirectionalLightDesc>;
 
+// An environment from an equirectangular (latitude-longitude) image, with Mitsuba 3's `envmap`
+// conventions: in map space, direction (x, y, z) looks up u = atan2(x, -z) / 2 pi (mod 1),
+// v = acos(y) / pi, so +y is the top row, +z the centre column, -z the left and right edges.
+struct EnvironmentMapDesc {
+  int width = 0;                // texels per row (>= 1)
+  int height = 0;               // rows (>= 1)
+  std::vector<float> rgb;       // width * height * 3 linear radiance values, row 0 = top (+y)
+  float scale = 1.f;            // multiplies every texel
+  glm::mat3 to_world{1.f};      // orthogonal: map space -> world (a rotation, maybe a mirror)
+  // For bench/environment_sampling_benchmark.cpp only: sample directions uniformly instead of
+  // in proportion to the map (the api never sets it).
+  bool uniform_sampling = false;
+};
+
 struct SceneInput {
   CameraDesc camera;
   Spectrum environment{0.f};  // constant radiance arriving from every direction at infinity
+  std::optional<EnvironmentMapDesc> environment_map;  // if set, used instead of `environment`
   std::vector<MaterialParams> materials;
   std::vector<ObjectDesc> objects;
   std::vector<LightDesc> lights;

@@ -1,0 +1,134 @@
+#include "api/environment_parser.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "api/transform.h"
+#include "renderer/io/image_reader.h"
+
+namespace penumbra::api {
+
+namespace {
+
+constexpr const char* kPointer = "/environment";
+
+// The nearest orthogonal matrix (the orthogonal factor of the polar decomposition), by Newton's
+// iteration Q <- (Q + Q^-T) / 2 (Higham 1986): a rotation typed with 7 decimals comes out
+// orthogonal to double precision, so the renderer may invert it by transposing. A mirror stays
+// a mirror (the determinant's sign is kept).
+glm::dmat3 nearest_orthogonal(glm::dmat3 q) {
+  for (int i = 0; i < 8; ++i) q = 0.5 * (q + glm::transpose(glm::inverse(q)));
+  return q;
+}
+
+// The map's orientation from "rotate" or "matrix" (the object transform's forms and error
+// messages), which must leave directions' lengths alone: an environment is infinitely far away,
+// so translating it means nothing and scaling or shearing it would distort it.
+std::optional<glm::mat3> parse_orientation(ObjectReader& reader, Diagnostics& diag) {
+  Json forms = Json::object();
+  for (const char* key : {"rotate", "matrix"})
+    if (const Json* v = reader.get(key)) forms[key] = *v;
+  if (forms.empty()) return glm::mat3(1.f);
+  const auto transform = parse_transform(forms, kPointer, diag);
+  if (!transform) return std::nullopt;
+  const auto scale = transform->similarity_scale();
+  const bool translates = transform->translation != glm::dvec3(0.0);
+  if (translates || !scale || std::abs(*scale - 1.0) > 1e-6) {
+    reader.error("matrix",
+                 "must be a rotation (an orthogonal upper-left 3x3 block and no translation): an "
+                 "environment is infinitely far away, so it can only be turned");
+    return std::nullopt;
+  }
+  return glm::mat3(nearest_orthogonal(transform->linear));
+}
+
+// Reads the image named by "map" into `map` (linear RGB); false after reporting an error.
+bool read_map(const std::string& relative, const AssetFolder& assets, EnvironmentMapDesc& map,
+              Diagnostics& diag) {
+  const std::string pointer = child_pointer(kPointer, "map");
+  const auto path = resolve_asset_path(assets, relative, pointer, diag);
+  if (!path) return false;
+  AssetImage image;
+  try {
+    image = read_asset_image(path->string());
+  } catch (const ImageIoError& e) {
+    // The reader (and OpenImageIO inside it) names the resolved path; the user typed the
+    // relative one, and where the service keeps its folders is nobody's business.
+    std::string reason = e.what();
+    const std::string full = path->string();
+    const std::string prefix = full + ": ";
+    if (reason.rfind(prefix, 0) == 0) reason = reason.substr(prefix.size());
+    for (size_t at = reason.find(full); at != std::string::npos;
+         at = reason.find(full, at + relative.size()))
+      reason.replace(at, full.size(), relative);
+    diag.error(pointer, "'" + relative + "': " + reason);
+    return false;
+  }
+  // Integer formats (PNG, JPEG) store sRGB-encoded values, as Mitsuba's Bitmap assumes too.
+  if (!image.is_float) srgb_to_linear_in_place(image);
+  map.width = image.width;
+  map.height = image.height;
+  const size_t texels = size_t(image.width) * size_t(image.height);
+  map.rgb.resize(texels * 3);
+  const int c = image.channels;
+  for (size_t i = 0; i < texels; ++i) {
+    const float* p = &image.pixels[i * size_t(c)];
+    // One or two channels: grey (and alpha, which an environment has no use for).
+    for (int k = 0; k < 3; ++k) map.rgb[i * 3 + size_t(k)] = c >= 3 ? p[k] : p[0];
+  }
+  return true;
+}
+
+}  // namespace
+
+bool parse_environment(const Json* value, const AssetFolder& assets, SceneInput& scene,
+                       Diagnostics& diag) {
+  if (!value) return false;
+  ObjectReader r(*value, kPointer, diag);
+  if (!r.valid()) return false;
+  const std::size_t errors_before = diag.error_count();
+
+  if (!r.has("map")) {
+    if (auto radiance = r.vec3("radiance", Range::at_least(0), Presence::kRequired))
+      scene.environment = vec3(float(radiance->x), float(radiance->y), float(radiance->z));
+    for (const char* key : {"scale", "rotate", "matrix"})
+      if (r.has(key)) r.error(key, "applies only to an image environment (\"map\")");
+    r.allow({"map", "scale", "rotate", "matrix"});
+    r.report_unknown_keys();
+    return !is_black(scene.environment);
+  }
+
+  if (r.has("radiance"))
+    r.error("radiance",
+            "cannot be combined with \"map\": an environment is either a constant radiance or an "
+            "image (use \"scale\" to brighten the image)");
+  r.allow({"radiance"});
+  EnvironmentMapDesc map;
+  const auto file = r.string("map", Presence::kRequired);
+  const auto scale = r.number("scale", Range::at_least(0));
+  const auto to_world = parse_orientation(r, diag);
+  r.report_unknown_keys();
+  if (scale) map.scale = float(*scale);
+  if (to_world) map.to_world = *to_world;
+  // The file is checked even when other fields are wrong: validation reports every problem.
+  if (!file || !read_map(*file, assets, map, diag) || diag.error_count() != errors_before)
+    return false;
+
+  const float brightest = map.rgb.empty() ? 0.f : *std::max_element(map.rgb.begin(), map.rgb.end());
+  // Scaled radiance must stay finite through the renderer's single-precision arithmetic, as
+  // every other radiance in a scene (kMaxMagnitude).
+  if (double(brightest) * map.scale > kMaxMagnitude) {
+    r.error("scale", "makes the map's brightest texel " +
+                         format_number(double(brightest) * map.scale) + "; at most " +
+                         format_number(kMaxMagnitude));
+    return false;
+  }
+  const bool lit = brightest > 0.f && map.scale > 0.f;
+  if (!lit)
+    r.warning("map", "the environment map is black (every texel is 0, or scale is 0): it emits "
+                     "nothing");
+  scene.environment_map = std::move(map);
+  return lit;
+}
+
+}  // namespace penumbra::api

@@ -1,0 +1,81 @@
+#include "renderer/sampling/distribution_2d.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace penumbra {
+namespace {
+
+float clean(float w) { return std::isfinite(w) && w > 0.f ? w : 0.f; }
+
+// The cell of x in [0, 1] among n equal cells (x == 1 belongs to the last).
+int cell_of(float x, size_t n) {
+  const float scaled = x * float(n);
+  if (!(scaled > 0.f)) return 0;  // also NaN
+  return int(std::min(size_t(scaled), n - 1));
+}
+
+}  // namespace
+
+Distribution1D::Distribution1D(std::span<const float> weights) {
+  const size_t n = std::max<size_t>(weights.size(), 1);
+  func_.assign(n, 0.f);
+  for (size_t i = 0; i < weights.size(); ++i) func_[i] = clean(weights[i]);
+  // Sums in double: a 16k-cell row of float sums would lose the small cells' share.
+  std::vector<double> acc(n + 1, 0.0);
+  for (size_t i = 0; i < n; ++i) acc[i + 1] = acc[i] + double(func_[i]);
+  const double total = acc[n];
+  integral_ = total / double(n);
+  cdf_.resize(n + 1);
+  for (size_t i = 0; i <= n; ++i)
+    cdf_[i] = total > 0.0 ? float(acc[i] / total) : float(double(i) / double(n));
+  cdf_[n] = 1.f;
+}
+
+float Distribution1D::sample(float u, float* pdf, int* cell) const {
+  const size_t n = func_.size();
+  // The last cell i with cdf_[i] <= u: cells of zero width (zero weight) are never chosen.
+  const auto it = std::upper_bound(cdf_.begin(), cdf_.end(), u);
+  const int i = int(std::clamp<std::ptrdiff_t>(it - cdf_.begin() - 1, 0, std::ptrdiff_t(n) - 1));
+  const float width = cdf_[size_t(i) + 1] - cdf_[size_t(i)];
+  float du = width > 0.f ? (u - cdf_[size_t(i)]) / width : 0.f;
+  du = std::clamp(du, 0.f, kOneMinusEpsilon);
+  float x = std::min((float(i) + du) / float(n), kOneMinusEpsilon);
+  // Rounding may carry x onto the next cell's edge; pdf(x) must find the cell sampled here.
+  while (x > 0.f && cell_of(x, n) > i) x = std::nextafter(x, 0.f);
+  if (pdf) *pdf = cell_pdf(i);
+  if (cell) *cell = i;
+  return x;
+}
+
+float Distribution1D::pdf(float x) const { return cell_pdf(cell_of(x, func_.size())); }
+
+Distribution2D::Distribution2D(std::span<const float> weights, int nu, int nv)
+    : nu_(std::max(nu, 1)), nv_(std::max(nv, 1)) {
+  conditional_.reserve(size_t(nv_));
+  std::vector<float> row_integrals(static_cast<size_t>(nv_));
+  for (int j = 0; j < nv_; ++j) {
+    const size_t begin = size_t(j) * size_t(nu_);
+    const std::span<const float> row =
+        begin + size_t(nu_) <= weights.size() ? weights.subspan(begin, size_t(nu_)) : std::span<const float>();
+    conditional_.emplace_back(row);
+    row_integrals[size_t(j)] = float(conditional_.back().integral());
+  }
+  marginal_ = Distribution1D(row_integrals);
+}
+
+vec2 Distribution2D::sample(const vec2& u, float* pdf) const {
+  float pdf_v = 0.f, pdf_u = 0.f;
+  int row = 0;
+  const float v = marginal_.sample(u.y, &pdf_v, &row);
+  const float x = conditional_[size_t(row)].sample(u.x, &pdf_u);
+  if (pdf) *pdf = pdf_v * pdf_u;
+  return vec2(x, v);
+}
+
+float Distribution2D::pdf(const vec2& p) const {
+  const int row = cell_of(p.y, size_t(nv_));
+  return marginal_.cell_pdf(row) * conditional_[size_t(row)].pdf(p.x);
+}
+
+}  // namespace penumbra

@@ -1,0 +1,272 @@
+// The environment map: Mitsuba 3's lat-long orientation and bilinear lookup, importance sampling
+// (chi-square against pdf(), pdf integrating to 1 over the sphere, sample/pdf agreement, a density
+// proportional to radiance), its power, and degenerate maps (black, one texel, one hot texel).
+#include <gtest/gtest.h>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "renderer/lights/environment_light.h"
+#include "renderer/lights/environment_map.h"
+#include "tests/renderer/sampling/chi2_util.h"
+
+namespace penumbra::test {
+namespace {
+
+// A width x height map whose texel (x, y) holds f(x, y) in every channel.
+template <typename F>
+EnvironmentMapDesc make_map(int width, int height, F f) {
+  EnvironmentMapDesc d;
+  d.width = width;
+  d.height = height;
+  d.rgb.resize(size_t(width) * height * 3);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x)
+      for (int c = 0; c < 3; ++c) d.rgb[(size_t(y) * width + x) * 3 + c] = f(x, y);
+  return d;
+}
+
+// A smooth sky with a sun: enough structure for the sampling tests, with a seam-crossing sun.
+EnvironmentMapDesc sky_with_sun(int width, int height) {
+  return make_map(width, height, [&](int x, int y) {
+    const float sun = (x == width - 1 || x == 0) && y == height / 3 ? 500.f : 0.f;
+    return 0.2f + float(y) / height + 0.1f * float(x % 3) + sun;
+  });
+}
+
+glm::mat3 rotation(float degrees, const vec3& axis) {
+  return glm::mat3(glm::rotate(glm::mat4(1.f), glm::radians(degrees), axis));
+}
+
+float value(const EnvironmentMapDesc& d, int x, int y) { return d.rgb[(size_t(y) * d.width + x) * 3]; }
+
+TEST(EnvironmentMap, OrientationMatchesMitsubaEnvmap) {
+  // Odd width: +z lands on a texel centre. Rows: 0 at +y, 2 at the horizon, 4 at -y.
+  const auto desc = make_map(9, 5, [](int x, int y) {
+    if (y == 0) return 100.f;
+    if (y == 4) return 200.f;
+    return float(1 + x + 10 * y);
+  });
+  const EnvironmentMap map(desc);
+  EXPECT_FLOAT_EQ(map.radiance({0, 1, 0}).x, 100.f);   // +y: the top row
+  EXPECT_FLOAT_EQ(map.radiance({0, -1, 0}).x, 200.f);  // -y: the bottom row
+  EXPECT_FLOAT_EQ(map.radiance({0, 0, 1}).x, value(desc, 4, 2));  // +z: the centre column
+  // -z: the left and right edges, which the lookup blends across the seam.
+  EXPECT_FLOAT_EQ(map.radiance({0, 0, -1}).x, 0.5f * (value(desc, 0, 2) + value(desc, 8, 2)));
+  // +x at u = 1/4 (x = 1.75 texels), -x at u = 3/4 (x = 6.25): right-handed, as Mitsuba.
+  EXPECT_FLOAT_EQ(map.radiance({1, 0, 0}).x, 0.25f * value(desc, 1, 2) + 0.75f * value(desc, 2, 2));
+  EXPECT_FLOAT_EQ(map.radiance({-1, 0, 0}).x, 0.75f * value(desc, 6, 2) + 0.25f * value(desc, 7, 2));
+  // Between rows: theta = 67.5 degrees is halfway from row 1 (45) to row 2 (90).
+  const float t = glm::radians(67.5f);
+  EXPECT_NEAR(map.radiance({0, std::cos(t), std::sin(t)}).x,
+              0.5f * (value(desc, 4, 1) + value(desc, 4, 2)), 1e-4f);
+}
+
+TEST(EnvironmentMap, ToWorldTurnsTheMap) {
+  auto desc = make_map(9, 5, [](int x, int y) { return float(1 + x + 10 * y); });
+  const EnvironmentMap plain(desc);
+  desc.to_world = rotation(90.f, {0, 1, 0});  // right-handed about +y: +z -> +x
+  const EnvironmentMap turned(desc);
+  // The map's centre column (+z in map space) now faces +x.
+  EXPECT_FLOAT_EQ(turned.radiance({1, 0, 0}).x, value(desc, 4, 2));
+  Rng rng(3);
+  for (int i = 0; i < 100; ++i) {
+    const vec3 d = uniform_sphere(rng);
+    EXPECT_NEAR(turned.radiance(desc.to_world * d).x, plain.radiance(d).x, 1e-3f);
+    EXPECT_NEAR(turned.pdf(desc.to_world * d), plain.pdf(d), 1e-3f * plain.pdf(d) + 1e-6f);
+  }
+}
+
+TEST(EnvironmentMap, UvAndDirectionAreInverse) {
+  Rng rng(9);
+  for (int i = 0; i < 1000; ++i) {
+    const vec2 uv(rng.next(), 0.01f + 0.98f * rng.next());
+    const vec2 back = EnvironmentMap::direction_to_uv(EnvironmentMap::uv_to_direction(uv));
+    EXPECT_NEAR(back.x, uv.x, 1e-4f);
+    EXPECT_NEAR(back.y, uv.y, 1e-4f);
+  }
+}
+
+// Integral of pdf() over the sphere in world (cos theta, phi) coordinates, independent of the
+// map's own parameterisation.
+double pdf_integral(const EnvironmentLight& env) {
+  AdaptiveCubature cubature([&](double c, double phi) {
+    const double s = std::sqrt(std::max(0.0, 1.0 - c * c));
+    return double(env.pdf(vec3(float(s * std::cos(phi)), float(s * std::sin(phi)), float(c))));
+  }, 12);
+  double total = 0.0;
+  constexpr int n = 32;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+      total += cubature.integrate(-1.0 + 2.0 * i / n, -1.0 + 2.0 * (i + 1) / n, 2 * M_PI * j / n,
+                                  2 * M_PI * (j + 1) / n, 1e-7);
+  return total;
+}
+
+TEST(EnvironmentMap, PdfIntegratesToOneOverTheSphere) {
+  auto desc = sky_with_sun(16, 9);
+  desc.to_world = rotation(30.f, glm::normalize(vec3(1, 2, 0.5f)));
+  EXPECT_NEAR(pdf_integral(EnvironmentMap(desc)), 1.0, 2e-3);
+  desc.uniform_sampling = true;
+  EXPECT_NEAR(pdf_integral(EnvironmentMap(desc)), 1.0, 1e-4);
+}
+
+TEST(EnvironmentMap, SamplingFollowsPdfChiSquare) {
+  auto desc = sky_with_sun(12, 7);
+  desc.to_world = rotation(-50.f, glm::normalize(vec3(0.3f, 1, -1)));
+  const EnvironmentMap map(desc);
+  // Bins in world (cos theta, phi); expected counts by cubature of pdf().
+  constexpr int nt = 16, np = 32, samples = 300000;
+  std::vector<double> observed(nt * np, 0.0), expected(nt * np, 0.0);
+  Rng rng(21);
+  for (int i = 0; i < samples; ++i) {
+    LightSample ls;
+    if (!map.sample(vec3(0.f), 0.f, rng.next2(), &ls)) continue;
+    float phi = std::atan2(ls.wi.y, ls.wi.x);
+    if (phi < 0.f) phi += 2.f * kPi;
+    const int ti = std::clamp(int((ls.wi.z + 1.f) * 0.5f * nt), 0, nt - 1);
+    const int pi = std::clamp(int(phi / (2.f * kPi) * np), 0, np - 1);
+    observed[size_t(ti * np + pi)] += 1.0;
+  }
+  AdaptiveCubature cubature([&](double c, double phi) {
+    const double s = std::sqrt(std::max(0.0, 1.0 - c * c));
+    return double(map.pdf(vec3(float(s * std::cos(phi)), float(s * std::sin(phi)), float(c))));
+  }, 12);
+  for (int ti = 0; ti < nt; ++ti)
+    for (int pi = 0; pi < np; ++pi)
+      expected[size_t(ti * np + pi)] =
+          samples * cubature.integrate(-1.0 + 2.0 * ti / nt, -1.0 + 2.0 * (ti + 1) / nt,
+                                       2 * M_PI * pi / np, 2 * M_PI * (pi + 1) / np, 1e-8);
+  const auto fit = chi2_goodness_of_fit(observed, expected);
+  EXPECT_TRUE(fit.pass) << fit.message;
+}
+
+TEST(EnvironmentMap, SampleAgreesWithPdfAndRadiance) {
+  auto desc = sky_with_sun(32, 17);
+  desc.to_world = rotation(120.f, glm::normalize(vec3(-1, 0.2f, 0.4f)));
+  desc.scale = 2.5f;
+  const EnvironmentMap map(desc);
+  Rng rng(4);
+  int accepted = 0;
+  for (int i = 0; i < 20000; ++i) {
+    LightSample ls;
+    if (!map.sample(vec3(1, 2, 3), 0.f, rng.next2(), &ls)) continue;
+    ++accepted;
+    ASSERT_NEAR(glm::length(ls.wi), 1.f, 1e-5f);
+    EXPECT_FALSE(ls.is_delta);
+    EXPECT_EQ(ls.distance, kInfinity);
+    ASSERT_NEAR(ls.pdf, map.pdf(ls.wi), 2e-3f * ls.pdf);
+    const Spectrum l = map.radiance(ls.wi);
+    ASSERT_NEAR(ls.value.x, l.x, 2e-3f * l.x + 1e-5f);
+  }
+  EXPECT_GT(accepted, 19990);
+}
+
+// For a constant map the ideal density is uniform over the sphere, 1 / (4 pi). Without the
+// sin(theta) weight the cells near the poles, stretched over whole rows, would take as many
+// samples as the cells at the horizon (density 1 / (2 pi^2 sin(theta)) instead).
+TEST(EnvironmentMap, DensityOfAConstantMapIsUniform) {
+  constexpr int width = 64, height = 33;
+  const EnvironmentMap map(make_map(width, height, [](int, int) { return 3.f; }));
+  for (int row = 0; row < height - 1; ++row) {
+    const float theta = kPi * (row + 0.5f) / (height - 1);  // the middle of a band of cells
+    for (float phi : {0.1f, 1.f, 2.5f, 4.f}) {
+      const vec3 d(std::sin(phi) * std::sin(theta), std::cos(theta), -std::cos(phi) * std::sin(theta));
+      EXPECT_NEAR(map.pdf(d) * 4.f * kPi, 1.f, 2e-3f) << "theta " << theta << " phi " << phi;
+    }
+  }
+  EXPECT_NEAR(map.luminance_integral(), 4.0 * M_PI * 3.0, 1e-4);
+}
+
+TEST(EnvironmentMap, PowerIsConstantEnvironmentsForAConstantMap) {
+  const EnvironmentMap map(make_map(8, 4, [](int, int) { return 0.7f; }));
+  const ConstantEnvironment constant(Spectrum(0.7f));
+  EXPECT_NEAR(map.power(3.f), constant.power(3.f), 1e-5f * constant.power(3.f));
+}
+
+TEST(EnvironmentMap, BlackMapEmitsNothingAndDividesByNothing) {
+  const EnvironmentMap black(make_map(16, 8, [](int, int) { return 0.f; }));
+  EXPECT_TRUE(black.is_black());
+  LightSample ls;
+  EXPECT_FALSE(black.sample(vec3(0.f), 0.f, vec2(0.3f, 0.6f), &ls));
+  EXPECT_EQ(black.pdf(vec3(0, 0, 1)), 0.f);
+  EXPECT_EQ(black.power(10.f), 0.f);
+  auto scaled = make_map(4, 4, [](int, int) { return 1.f; });
+  scaled.scale = 0.f;
+  EXPECT_TRUE(EnvironmentMap(scaled).is_black());
+  // Negative and non-finite texels count as black.
+  EXPECT_TRUE(EnvironmentMap(make_map(4, 2, [](int x, int) { return x == 0 ? -5.f : NAN; })).is_black());
+  // Missing pixels (an inconsistent description) are a black 1x1 map, not a crash.
+  EnvironmentMapDesc empty;
+  empty.width = 5;
+  empty.height = 5;
+  EXPECT_TRUE(EnvironmentMap(empty).is_black());
+}
+
+// Scale applies to the radiance, the samples and the power, also for a texel near the float
+// maximum under a small scale (what the loader allows: brightest texel x scale <= 1e30).
+TEST(EnvironmentMap, ScaleAppliesToRadianceSamplesAndPower) {
+  constexpr float kTexel = 3e38f, kScale = 1e-10f;
+  auto desc = make_map(16, 8, [](int x, int y) { return x == 3 && y == 4 ? kTexel : 0.f; });
+  desc.scale = kScale;
+  const EnvironmentMap map(desc);
+  ASSERT_FALSE(map.is_black());
+  // The texel's centre: u = 3.5 / 16, v = 4 / 7.
+  const vec3 centre = EnvironmentMap::uv_to_direction(vec2(3.5f / 16.f, 4.f / 7.f));
+  EXPECT_NEAR(map.radiance(centre).x, kTexel * kScale, 1e-3f * kTexel * kScale);
+  // Four cells (columns 2, 3; rows 3, 4) hold a quarter of the texel each, 2 pi / 16 wide.
+  auto band = [](int y) { return std::cos(M_PI * y / 7) - std::cos(M_PI * (y + 1) / 7); };
+  const double integral = 0.25 * double(kTexel) * kScale * 2 * (band(3) + band(4)) * 2 * M_PI / 16;
+  EXPECT_NEAR(map.luminance_integral(), integral, 1e-5 * integral);
+  LightSample ls;
+  ASSERT_TRUE(map.sample(vec3(0.f), 0.f, vec2(0.5f, 0.5f), &ls));
+  EXPECT_TRUE(is_finite(ls.value / ls.pdf));
+  EXPECT_GT(ls.value.x, 0.f);
+  EXPECT_LE(ls.value.x, kTexel * kScale * 1.0001f);
+}
+
+TEST(EnvironmentMap, OneTexelMapIsConstant) {
+  const EnvironmentMap map(make_map(1, 1, [](int, int) { return 2.f; }));
+  EXPECT_FALSE(map.is_black());
+  for (const vec3& d : {vec3(0, 1, 0), vec3(0, -1, 0), vec3(0, 0, -1), glm::normalize(vec3(1, 1, 1))})
+    EXPECT_FLOAT_EQ(map.radiance(d).y, 2.f);
+  EXPECT_NEAR(pdf_integral(map), 1.0, 2e-3);
+  Rng rng(8);
+  for (int i = 0; i < 2000; ++i) {
+    LightSample ls;
+    if (!map.sample(vec3(0.f), 0.f, rng.next2(), &ls)) continue;
+    ASSERT_TRUE(std::isfinite(ls.pdf) && ls.pdf > 0.f);
+    ASSERT_TRUE(is_finite(ls.value / ls.pdf));
+  }
+}
+
+// One hot texel (a sun of one pixel) on a black map, on the seam and on a pole row: every sample
+// lands next to it with a finite weight, and the density still integrates to 1.
+TEST(EnvironmentMap, OneHotTexelIsSampledWithFiniteWeights) {
+  for (const auto [hx, hy] : {std::pair{10, 7}, std::pair{63, 12}, std::pair{5, 0}}) {
+    const auto desc = make_map(64, 32, [&](int x, int y) { return x == hx && y == hy ? 1e6f : 0.f; });
+    const EnvironmentMap map(desc);
+    Rng rng(17);
+    int accepted = 0;
+    for (int i = 0; i < 5000; ++i) {
+      LightSample ls;
+      if (!map.sample(vec3(0.f), 0.f, rng.next2(), &ls)) continue;
+      ++accepted;
+      ASSERT_TRUE(std::isfinite(ls.pdf) && ls.pdf > 0.f);
+      const Spectrum w = ls.value / ls.pdf;
+      ASSERT_TRUE(is_finite(w));
+      // Bounded: the bilinear value is at most 4 times the mean of the cell's corners, and sin(theta)
+      // within a cell at most twice its mean over the band (the pole cells).
+      ASSERT_LE(w.x, 8.f * float(map.luminance_integral()));
+      // Within one texel of the hot one (the bilinear tent's support).
+      const vec2 uv = EnvironmentMap::direction_to_uv(ls.wi);
+      const float dx = std::abs(uv.x * 64.f - 0.5f - float(hx));
+      EXPECT_LE(std::min(dx, 64.f - dx), 1.001f);
+      EXPECT_LE(std::abs(uv.y * 31.f - float(hy)), 1.001f);
+    }
+    EXPECT_GT(accepted, 4900) << hx << "," << hy;
+    EXPECT_NEAR(pdf_integral(map), 1.0, 1e-2) << hx << "," << hy;
+  }
+}
+
+}  // namespace
+}  // namespace penumbra::test

@@ -1,0 +1,157 @@
+// Piecewise-constant distributions: sample() follows pdf() (chi-square), pdf() integrates to 1,
+// sample() reports the density pdf() gives at the point, and degenerate weights (all zero,
+// negative, NaN, one hot cell) produce no NaN, no Inf and no division by zero.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "renderer/sampling/distribution_2d.h"
+#include "tests/renderer/sampling/chi2_util.h"
+
+namespace penumbra::test {
+namespace {
+
+constexpr int kSamples = 200000;
+
+TEST(Distribution1D, SamplesFollowTheWeights) {
+  const std::vector<float> w = {1.f, 0.f, 3.f, 0.5f, 2.f, 0.f, 0.f, 7.f};
+  const Distribution1D d(w);
+  EXPECT_NEAR(d.integral(), 13.5 / 8.0, 1e-6);
+  // Four bins per cell: the density must also be flat inside each cell.
+  constexpr int kSub = 4;
+  const int bins = int(w.size()) * kSub;
+  std::vector<double> observed(size_t(bins), 0.0), expected(size_t(bins), 0.0);
+  for (int b = 0; b < bins; ++b) expected[size_t(b)] = kSamples * w[size_t(b / kSub)] / 13.5 / kSub;
+  Rng rng(7);
+  for (int i = 0; i < kSamples; ++i) {
+    float pdf = -1.f;
+    int cell = -1;
+    const float x = d.sample(rng.next(), &pdf, &cell);
+    ASSERT_GE(x, 0.f);
+    ASSERT_LT(x, 1.f);
+    ASSERT_EQ(pdf, d.pdf(x));
+    ASSERT_EQ(cell, std::min(int(x * w.size()), int(w.size()) - 1));
+    observed[size_t(std::min(int(x * bins), bins - 1))] += 1.0;
+  }
+  const auto fit = chi2_goodness_of_fit(observed, expected);
+  EXPECT_TRUE(fit.pass) << fit.message;
+}
+
+TEST(Distribution1D, PdfIntegratesToOne) {
+  const std::vector<float> w = {0.2f, 5.f, 0.f, 1e-6f, 3.f};
+  const Distribution1D d(w);
+  double integral = 0.0;
+  for (size_t i = 0; i < w.size(); ++i) integral += d.pdf((i + 0.5f) / w.size()) / double(w.size());
+  EXPECT_NEAR(integral, 1.0, 1e-6);
+  EXPECT_EQ(d.pdf(1.f), d.pdf(0.99f));  // x == 1 belongs to the last cell
+}
+
+TEST(Distribution1D, ExtremeRandomNumbersStayInTheSampledCell) {
+  const std::vector<float> w = {1.f, 0.f, 0.f, 1.f, 1e-30f, 4.f};
+  const Distribution1D d(w);
+  for (float u : {0.f, 1e-9f, 0.2f, 0.25f, 0.5f, 0.75f, 0.9999f, kOneMinusEpsilon}) {
+    float pdf = 0.f;
+    int cell = -1;
+    const float x = d.sample(u, &pdf, &cell);
+    EXPECT_GE(x, 0.f);
+    EXPECT_LT(x, 1.f);
+    EXPECT_GT(pdf, 0.f) << "u = " << u;  // zero-weight cells are never chosen
+    EXPECT_EQ(pdf, d.pdf(x));
+    EXPECT_NE(cell, 1);
+    EXPECT_NE(cell, 2);
+  }
+}
+
+TEST(Distribution1D, ZeroNegativeAndNonFiniteWeightsAreHarmless) {
+  const std::vector<float> zeros(5, 0.f);
+  const Distribution1D z(zeros);
+  EXPECT_EQ(z.integral(), 0.0);
+  float pdf = -1.f;
+  const float x = z.sample(0.3f, &pdf);
+  EXPECT_TRUE(x >= 0.f && x < 1.f);
+  EXPECT_EQ(pdf, 0.f);  // callers reject pdf 0; nothing divided by zero
+  EXPECT_EQ(z.pdf(0.5f), 0.f);
+
+  const std::vector<float> bad = {-1.f, NAN, INFINITY, 2.f};
+  const Distribution1D b(bad);
+  EXPECT_EQ(b.integral(), 0.5);
+  EXPECT_EQ(b.pdf(0.1f), 0.f);
+  EXPECT_EQ(b.pdf(0.9f), 4.f);
+  EXPECT_EQ(b.pdf(NAN), 0.f);  // a NaN coordinate reads cell 0, not out of bounds
+
+  const Distribution1D empty(std::span<const float>{});
+  EXPECT_EQ(empty.size(), 1u);
+  EXPECT_EQ(empty.pdf(0.5f), 0.f);
+}
+
+TEST(Distribution2D, SamplesFollowTheWeights) {
+  // 7 x 5 cells with a zero row, zero cells and a hot cell.
+  constexpr int nu = 7, nv = 5;
+  std::vector<float> w(nu * nv);
+  Rng weights_rng(3);
+  for (float& x : w) x = weights_rng.next();
+  for (int i = 0; i < nu; ++i) w[2 * nu + i] = 0.f;
+  w[4] = w[3 * nu + 6] = 0.f;
+  w[1 * nu + 5] = 40.f;
+  const Distribution2D d(w, nu, nv);
+  double total = 0.0;
+  for (float x : w) total += x;
+  EXPECT_NEAR(d.integral(), total / (nu * nv), 1e-6);
+
+  constexpr int kSub = 2;  // bins per cell and axis
+  const int bu = nu * kSub, bv = nv * kSub;
+  std::vector<double> observed(size_t(bu * bv), 0.0), expected(size_t(bu * bv), 0.0);
+  for (int j = 0; j < bv; ++j)
+    for (int i = 0; i < bu; ++i)
+      expected[size_t(j * bu + i)] = kSamples * w[size_t((j / kSub) * nu + i / kSub)] / total / (kSub * kSub);
+  Rng rng(11);
+  for (int s = 0; s < kSamples; ++s) {
+    float pdf = -1.f;
+    const vec2 p = d.sample(rng.next2(), &pdf);
+    ASSERT_TRUE(p.x >= 0.f && p.x < 1.f && p.y >= 0.f && p.y < 1.f);
+    ASSERT_EQ(pdf, d.pdf(p));
+    ASSERT_GT(pdf, 0.f);
+    observed[size_t(std::min(int(p.y * bv), bv - 1) * bu + std::min(int(p.x * bu), bu - 1))] += 1.0;
+  }
+  const auto fit = chi2_goodness_of_fit(observed, expected);
+  EXPECT_TRUE(fit.pass) << fit.message;
+}
+
+TEST(Distribution2D, PdfIntegratesToOne) {
+  constexpr int nu = 9, nv = 4;
+  std::vector<float> w(nu * nv);
+  for (int k = 0; k < nu * nv; ++k) w[size_t(k)] = float((k * 37) % 11);
+  const Distribution2D d(w, nu, nv);
+  double integral = 0.0;
+  for (int j = 0; j < nv; ++j)
+    for (int i = 0; i < nu; ++i) integral += d.pdf(vec2((i + 0.5f) / nu, (j + 0.5f) / nv)) / (nu * nv);
+  EXPECT_NEAR(integral, 1.0, 1e-5);
+}
+
+TEST(Distribution2D, OneHotCellAndAllZeroAreHarmless) {
+  constexpr int nu = 64, nv = 32;
+  std::vector<float> w(nu * nv, 0.f);
+  w[size_t(17 * nu + 40)] = 1e30f;
+  const Distribution2D hot(w, nu, nv);
+  Rng rng(5);
+  for (int s = 0; s < 1000; ++s) {
+    float pdf = 0.f;
+    const vec2 p = hot.sample(rng.next2(), &pdf);
+    ASSERT_EQ(int(p.x * nu), 40);
+    ASSERT_EQ(int(p.y * nv), 17);
+    ASSERT_NEAR(pdf, float(nu * nv), 1e-3f * nu * nv);
+  }
+  const Distribution2D zero(std::vector<float>(nu * nv, 0.f), nu, nv);
+  float pdf = -1.f;
+  const vec2 p = zero.sample(vec2(0.5f, 0.5f), &pdf);
+  EXPECT_TRUE(std::isfinite(p.x) && std::isfinite(p.y));
+  EXPECT_EQ(pdf, 0.f);
+  EXPECT_EQ(zero.pdf(vec2(0.3f, 0.7f)), 0.f);
+  // A single cell is the uniform distribution.
+  const Distribution2D one(std::vector<float>{2.f}, 1, 1);
+  EXPECT_EQ(one.pdf(vec2(0.1f, 0.9f)), 1.f);
+}
+
+}  // namespace
+}  // namespace penumbra::test
