@@ -13,7 +13,6 @@ class LightSampler {
   explicit LightSampler(const std::vector<float>& powers);
 
   bool empty() const { return pmf_.empty(); }
-  size_t size() const { return pmf_.size(); }
   // The light that u in [0, 1) selects.
   int choose(float u) const;
   // Probability that choose() returns `light`.

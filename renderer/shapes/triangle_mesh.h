@@ -31,7 +31,6 @@ class TriangleMesh : public Shape {
   // True if the ray (origin o, direction d) meets the plane of triangle `prim` at t > 0,
   // decided in double precision (see triangle_mesh.cpp).
   bool ahead_of_ray(uint32_t prim, const vec3& o, const vec3& d, float time) const;
-  int time_steps() const { return time_steps_; }
 
  protected:
   // For shapes made of triangles that keep their own area and sampling (quads).
