@@ -18,6 +18,7 @@ struct ShapeSample {
   vec3 p;           // point on the surface
   vec3 p_error;     // its absolute error bound
   vec3 n;           // unit geometric normal (front side)
+  vec2 uv{0.f};     // surface coordinates of p, as a hit there would have (textured emitters)
   float pdf = 0.f;  // solid-angle density seen from the reference point (0 = failed)
 };
 
@@ -63,6 +64,10 @@ class Shape {
   // error grows with t (pbrt-v4 section 6.8.4).
   virtual void hit_geometry(const Ray& ray, float t, uint32_t prim, const vec2& uv,
                             SurfaceHit* hit) const = 0;
+  // Fills dpdu and dpdv of a hit hit_geometry filled (at normalised time `time`): the partial
+  // derivatives of the surface point with respect to its uv (pbrt-v4 section 6.2.2). Asked only
+  // for materials that need a tangent frame, so other hits do not pay for it.
+  virtual void surface_derivatives(float time, SurfaceHit* hit) const = 0;
   // Samples a point of the surface as seen from `ref` at normalised time `time`; false if none.
   virtual bool sample(const vec3& ref, float time, const vec2& u, ShapeSample* out) const = 0;
   // Solid-angle density with which sample() yields point p (normal n) from ref.
