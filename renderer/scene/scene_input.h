@@ -3,12 +3,14 @@
 // api/ produces it from JSON (applying object transforms) and places the origin at the camera
 // position, computed in double precision, so single-precision rendering keeps its accuracy for
 // scenes far from the JSON origin; tests may build it directly.
+#include <optional>
 #include <string>
 #include <variant>
 #include <vector>
 
 #include "renderer/materials/material_params.h"
 #include "renderer/core/math.h"
+#include "renderer/textures/texture_desc.h"
 
 namespace penumbra {
 
@@ -47,6 +49,8 @@ struct ObjectDesc {
   ShapeDesc shape;
   uint32_t material = 0;         // index into SceneInput::materials
   Spectrum emission{0.f};        // radiance leaving the front side; 0 = not a light
+  // If set, the radiance at a point is `emission` times this texture there (at the hit's uv).
+  std::optional<ImageTextureDesc> emission_texture{};
   // Rigid motion: position(t) = position(0) + velocity*t + 0.5*acceleration*t^2.
   vec3 velocity{0.f};
   vec3 acceleration{0.f};
@@ -68,6 +72,7 @@ struct SceneInput {
   std::vector<MaterialParams> materials;
   std::vector<ObjectDesc> objects;
   std::vector<LightDesc> lights;
+  TextureLimits texture_limits;  // applied again as the build decodes the textures' images
 };
 
 enum class IntegratorKind { kPath, kDistributed };
