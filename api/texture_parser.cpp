@@ -149,7 +149,7 @@ bool TextureSet::reserve(const std::string& file, TextureColorspace colorspace,
                          const AssetImageInfo& info, const std::string& pointer, Diagnostics& diag) {
   const auto key = std::make_pair(file, colorspace);
   if (reserved_.count(key)) return true;
-  const int64_t bytes = decoded_texture_bytes(info.width, info.height, info.channels);
+  const int64_t bytes = decoded_texture_bytes(info.width, info.height, info.channels, info.is_8bit);
   if (bytes_ + bytes > limits_.max_texture_bytes) {
     diag.error(pointer, "this image takes " + bytes_text(bytes) + " decoded, which brings the scene's "
                         "textures to " + bytes_text(bytes_ + bytes) + ", more than the limit of " +

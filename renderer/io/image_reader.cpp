@@ -11,9 +11,6 @@ namespace {
   throw ImageIoError(path + ": " + reason);
 }
 
-float srgb_to_linear(float v) {
-  return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
-}
 
 // The header of an open image, checked against the limits.
 AssetImageInfo check_header(const std::string& path, const OIIO::ImageSpec& spec,
@@ -33,6 +30,7 @@ AssetImageInfo check_header(const std::string& path, const OIIO::ImageSpec& spec
   info.height = spec.height;
   info.channels = std::min(spec.nchannels, limits.max_channels);
   info.is_float = spec.format.is_floating_point();
+  info.is_8bit = spec.format == OIIO::TypeDesc::UINT8;
   return info;
 }
 
@@ -63,6 +61,25 @@ AssetImage read_asset_image(const std::string& path, const ImageReadLimits& limi
   for (float& v : img.pixels)
     if (!std::isfinite(v)) v = 0.f;
   return img;
+}
+
+AssetImage8 read_asset_image_8bit(const std::string& path, const ImageReadLimits& limits) {
+  auto in = open_image(path);
+  const AssetImageInfo info = check_header(path, in->spec(), limits);
+  if (!info.is_8bit) fail(path, "the image does not store 8-bit values");
+  AssetImage8 img;
+  img.width = info.width;
+  img.height = info.height;
+  img.channels = info.channels;
+  img.pixels.resize(size_t(img.width) * size_t(img.height) * size_t(img.channels));
+  if (!in->read_image(0, 0, 0, img.channels, OIIO::TypeDesc::UINT8, img.pixels.data()))
+    fail(path, "cannot decode the image: " + in->geterror());
+  in->close();
+  return img;
+}
+
+float srgb_to_linear(float v) {
+  return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
 }
 
 void srgb_to_linear_in_place(AssetImage& image) {

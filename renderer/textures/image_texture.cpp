@@ -16,6 +16,7 @@ inline float finite_position(float p) {
 }
 
 inline int wrap_index(int i, int size, TextureWrap wrap) {
+  if (unsigned(i) < unsigned(size)) return i;  // inside: most lookups, and no division
   if (wrap == TextureWrap::kClamp) return std::clamp(i, 0, size - 1);
   const int m = i % size;
   return m < 0 ? m + size : m;
@@ -28,8 +29,7 @@ void ImageLookup::eval(const vec2& uv, int first, int count, float* out) const {
   if (filter_ == TextureFilter::kNearest) {
     const int x = wrap_index(int(std::floor(finite_position(uv.x * float(w)))), w, wrap_);
     const int y = wrap_index(int(std::floor(finite_position(uv.y * float(h)))), h, wrap_);
-    const float* t = image_->texel(x, y) + first;
-    for (int c = 0; c < count; ++c) out[c] = t[c];
+    image_->fetch(x, y, first, count, out);
     return;
   }
   // Texel centres sit at half-integers: shift by half a texel so that floor() finds the centre
@@ -41,10 +41,11 @@ void ImageLookup::eval(const vec2& uv, int first, int count, float* out) const {
   const int ix = int(fx), iy = int(fy);
   const int x0 = wrap_index(ix, w, wrap_), x1 = wrap_index(ix + 1, w, wrap_);
   const int y0 = wrap_index(iy, h, wrap_), y1 = wrap_index(iy + 1, h, wrap_);
-  const float* t00 = image_->texel(x0, y0) + first;
-  const float* t10 = image_->texel(x1, y0) + first;
-  const float* t01 = image_->texel(x0, y1) + first;
-  const float* t11 = image_->texel(x1, y1) + first;
+  float t00[4], t10[4], t01[4], t11[4];
+  image_->fetch(x0, y0, first, count, t00);
+  image_->fetch(x1, y0, first, count, t10);
+  image_->fetch(x0, y1, first, count, t01);
+  image_->fetch(x1, y1, first, count, t11);
   for (int c = 0; c < count; ++c) {
     const float top = (1.f - ax) * t00[c] + ax * t10[c];
     const float bottom = (1.f - ax) * t01[c] + ax * t11[c];

@@ -24,16 +24,16 @@ struct ImageTextureDesc {
 };
 
 // Caps on decoded textures, applied by api/ to the files' headers and again by the scene build
-// as it decodes (a file replaced in between cannot exceed them). Texels are stored as 4-byte
-// floats, up to 4 channels.
+// as it decodes (a file replaced in between cannot exceed them). Texels of 8-bit images are
+// stored as bytes, others as 4-byte floats; at most 4 channels.
 struct TextureLimits {
   int64_t max_pixels = int64_t(8192) * 8192;  // width x height of any one image
   int64_t max_bytes = int64_t(1) << 30;       // all distinct decoded images of one scene
 };
 
 // Bytes an image of this size takes once decoded (what TextureLimits::max_bytes counts).
-inline int64_t decoded_texture_bytes(int64_t width, int64_t height, int channels) {
-  return width * height * int64_t(channels < 4 ? channels : 4) * int64_t(sizeof(float));
+inline int64_t decoded_texture_bytes(int64_t width, int64_t height, int channels, bool is_8bit) {
+  return width * height * int64_t(channels < 4 ? channels : 4) * (is_8bit ? 1 : int64_t(sizeof(float)));
 }
 
 }  // namespace penumbra

@@ -198,7 +198,8 @@ TEST_F(Textures, PixelLimitAtTheLimitAndOneBelow) {
 }
 
 TEST_F(Textures, MemoryLimitCountsEachDecodedImageOnceAtTheLimitAndOneBelow) {
-  // wood.png: 4 x 4 x 3 floats = 192 bytes per colorspace; grey.png 4 x 4 x 1 = 64.
+  // wood.png: 4 x 4 x 3 bytes = 48 per colorspace; grey.png 4 x 4 x 1 = 16; hdr.exr 2 x 2 x 3
+  // floats = 48.
   Json scene = base_scene();
   scene["materials"]["white"] = {{"type", "diffuse"}, {"color", {{"texture", "wood.png"}}}};
   scene["materials"]["again"] = {{"type", "plastic"}, {"color", {{"texture", "wood.png"}}}};  // shared
@@ -208,14 +209,21 @@ TEST_F(Textures, MemoryLimitCountsEachDecodedImageOnceAtTheLimitAndOneBelow) {
   for (const char* name : {"again", "raw", "rough"})
     scene["objects"].push_back({{"type", "sphere"}, {"center", {3, 0, 0}}, {"radius", 1}, {"material", name}});
   Limits limits;
-  limits.max_texture_bytes = 192 + 192 + 64;
+  limits.max_texture_bytes = 48 + 48 + 16;
   const LoadResult ok = load_with_assets(scene, limits);
   EXPECT_LOADS(ok);
-  EXPECT_EQ(ok.request->scene.texture_limits.max_bytes, 448);
-  limits.max_texture_bytes = 447;
+  EXPECT_EQ(ok.request->scene.texture_limits.max_bytes, 112);
+  limits.max_texture_bytes = 111;
   // Materials are read in name order: again, raw, rough, white; the last image to fit is grey.
   EXPECT_ERROR(load_with_assets(scene, limits), "/materials/rough/roughness/texture",
-               "more than the limit of 447 bytes (max_texture_bytes)");
+               "more than the limit of 111 bytes (max_texture_bytes)");
+  // Float images count 4 bytes per channel.
+  Json hdr = base_scene();
+  hdr["materials"]["white"] = {{"type", "diffuse"}, {"color", {{"texture", "hdr.exr"}}}};
+  limits.max_texture_bytes = 48;
+  EXPECT_LOADS(load_with_assets(hdr, limits));
+  limits.max_texture_bytes = 47;
+  EXPECT_ERROR(load_with_assets(hdr, limits), "/materials/white/color/texture", "48 bytes");
 }
 
 TEST_F(Textures, ATexturedSceneBuildsAndRenders) {

@@ -25,10 +25,24 @@ TEST(TextureImage, EightBitSrgbIsDecodedAtLoadLinearIsNot) {
   const TextureImage linear = load_texture_image(png, TextureColorspace::kLinear);
   const int codes[] = {0, 10, 128, 255};
   for (int x = 0; x < 4; ++x) {
-    EXPECT_NEAR(srgb.texel(x, 0)[0], srgb_decode(codes[x] / 255.0), 1e-6) << "code " << codes[x];
-    EXPECT_NEAR(linear.texel(x, 0)[1], codes[x] / 255.0, 1e-7) << "code " << codes[x];
+    EXPECT_NEAR(srgb.value(x, 0, 0), srgb_decode(codes[x] / 255.0), 1e-6) << "code " << codes[x];
+    EXPECT_NEAR(linear.value(x, 0, 1), codes[x] / 255.0, 1e-7) << "code " << codes[x];
   }
-  EXPECT_NEAR(srgb.texel(2, 0)[2], 0.2158605, 1e-6);  // the usual mid-grey: 128 -> 0.216
+  EXPECT_NEAR(srgb.value(2, 0, 2), 0.2158605, 1e-6);  // the usual mid-grey: 128 -> 0.216
+  // Kept as bytes: a quarter of the float memory.
+  EXPECT_TRUE(srgb.is_8bit());
+  EXPECT_EQ(srgb.bytes(), 4 * 1 * 3);
+}
+
+TEST(TextureImage, SixteenBitImagesAreDecodedToFloatsAtLoad) {
+  TempFolder dir("texture_image_16bit");
+  const std::string png = dir.file("grey16.png");
+  write_test_image(png, 2, 1, 1, {0.5f, 1.f}, OIIO::TypeDesc::UINT16);
+  const TextureImage img = load_texture_image(png, TextureColorspace::kSrgb);
+  EXPECT_FALSE(img.is_8bit());
+  EXPECT_EQ(img.bytes(), 2 * int64_t(sizeof(float)));
+  EXPECT_NEAR(img.value(0, 0, 0), srgb_decode(32768 / 65535.0), 1e-6);
+  EXPECT_NEAR(img.value(1, 0, 0), 1.0, 1e-7);
 }
 
 TEST(TextureImage, AlphaAndGreyAlphaKeepTheirAlphaLinear) {
@@ -39,10 +53,10 @@ TEST(TextureImage, AlphaAndGreyAlphaKeepTheirAlphaLinear) {
   const TextureImage a = load_texture_image(rgba, TextureColorspace::kSrgb);
   const TextureImage b = load_texture_image(ya, TextureColorspace::kSrgb);
   const double grey = srgb_decode(128 / 255.0), alpha = 128 / 255.0;
-  EXPECT_NEAR(a.texel(0, 0)[2], grey, 1e-6);
-  EXPECT_NEAR(a.texel(0, 0)[3], alpha, 1e-7);
-  EXPECT_NEAR(b.texel(0, 0)[0], grey, 1e-6);
-  EXPECT_NEAR(b.texel(0, 0)[1], alpha, 1e-7);  // a grey image's second channel is alpha
+  EXPECT_NEAR(a.value(0, 0, 2), grey, 1e-6);
+  EXPECT_NEAR(a.value(0, 0, 3), alpha, 1e-7);
+  EXPECT_NEAR(b.value(0, 0, 0), grey, 1e-6);
+  EXPECT_NEAR(b.value(0, 0, 1), alpha, 1e-7);  // a grey image's second channel is alpha
 }
 
 TEST(TextureImage, FloatImagesKeepTheirValuesAndRowZeroIsTheTop) {
@@ -52,10 +66,10 @@ TEST(TextureImage, FloatImagesKeepTheirValuesAndRowZeroIsTheTop) {
   const TextureImage img = load_texture_image(exr, TextureColorspace::kLinear);
   ASSERT_EQ(img.width(), 2);
   ASSERT_EQ(img.channels(), 1);
-  EXPECT_EQ(img.texel(0, 0)[0], 0.25f);
-  EXPECT_EQ(img.texel(1, 0)[0], 3.5f);
-  EXPECT_EQ(img.texel(0, 1)[0], -1.f);
-  EXPECT_EQ(img.texel(1, 1)[0], 100.f);
+  EXPECT_EQ(img.value(0, 0, 0), 0.25f);
+  EXPECT_EQ(img.value(1, 0, 0), 3.5f);
+  EXPECT_EQ(img.value(0, 1, 0), -1.f);
+  EXPECT_EQ(img.value(1, 1, 0), 100.f);
   EXPECT_FLOAT_EQ(img.mean(0), (0.25f + 3.5f - 1.f + 100.f) / 4.f);
 }
 
