@@ -1,8 +1,8 @@
 #include "api/texture_parser.h"
 
-#include "api/diagnostics.h"
-
 #include <limits>
+
+#include "api/diagnostics.h"
 #include "renderer/io/image_io.h"
 
 namespace penumbra::api {
@@ -43,9 +43,9 @@ bool resolve_image(const std::string& path, const std::string& pointer, TextureR
   // Integer images hold sRGB-encoded colours by convention; float images (EXR, HDR) and
   // non-colours (roughness, normals) are linear.
   const bool is_color = role == TextureRole::kReflectance || role == TextureRole::kEmission;
-  desc.colorspace = colorspace ? *colorspace
+  desc.colorspace = colorspace                     ? *colorspace
                     : (is_color && !info.is_float) ? TextureColorspace::kSrgb
-                                                    : TextureColorspace::kLinear;
+                                                   : TextureColorspace::kLinear;
   return textures.reserve(file, desc.colorspace, info, pointer, diag);
 }
 
@@ -55,8 +55,8 @@ struct ParsedTexture {
 };
 
 // One texture object at reader's pointer, for `role`; `scale_range` bounds its scale.
-std::optional<ParsedTexture> parse_texture(ObjectReader& r, TextureRole role, const Range& scale_range,
-                                           TextureSet& textures) {
+std::optional<ParsedTexture> parse_texture(ObjectReader& r, TextureRole role,
+                                           const Range& scale_range, TextureSet& textures) {
   Diagnostics& diag = r.diagnostics();
   const std::size_t errors_before = diag.error_count();
   ParsedTexture out;
@@ -71,29 +71,34 @@ std::optional<ParsedTexture> parse_texture(ObjectReader& r, TextureRole role, co
       }
   } else {
     colorspace = read_choice<TextureColorspace>(
-        r, "colorspace", {{"srgb", TextureColorspace::kSrgb}, {"linear", TextureColorspace::kLinear}});
+        r, "colorspace",
+        {{"srgb", TextureColorspace::kSrgb}, {"linear", TextureColorspace::kLinear}});
     if (role == TextureRole::kValue) {
       if (auto c = r.integer("channel", Range::closed(0, 3))) out.desc.channel = int(*c);
       if (auto s = r.number("scale", scale_range)) out.scale = Spectrum(float(*s));
     } else {
       if (r.has("channel")) {
         r.allow({"channel"});
-        r.error("channel", "applies only to single-value textures (roughness); a colour reads the "
-                           "image's red, green and blue channels (grey images: the first)");
+        r.error("channel",
+                "applies only to single-value textures (roughness); a colour reads the "
+                "image's red, green and blue channels (grey images: the first)");
       }
       if (const Json* s = r.get("scale")) {
         if (s->is_array()) {
-          if (auto v = read_vec3(*s, r.pointer_of("scale"), diag, scale_range)) out.scale = to_spectrum(*v);
+          if (auto v = read_vec3(*s, r.pointer_of("scale"), diag, scale_range))
+            out.scale = to_spectrum(*v);
         } else if (auto v = read_number(*s, r.pointer_of("scale"), diag, scale_range)) {
           out.scale = Spectrum(float(*v));
         }
       }
     }
   }
-  if (auto w = read_choice<TextureWrap>(r, "wrap", {{"repeat", TextureWrap::kRepeat}, {"clamp", TextureWrap::kClamp}}))
+  if (auto w = read_choice<TextureWrap>(
+          r, "wrap", {{"repeat", TextureWrap::kRepeat}, {"clamp", TextureWrap::kClamp}}))
     out.desc.wrap = *w;
   if (auto f = read_choice<TextureFilter>(
-          r, "filter", {{"bilinear", TextureFilter::kBilinear}, {"nearest", TextureFilter::kNearest}}))
+          r, "filter",
+          {{"bilinear", TextureFilter::kBilinear}, {"nearest", TextureFilter::kNearest}}))
     out.desc.filter = *f;
   r.report_unknown_keys();
   if (!path || diag.error_count() != errors_before) return std::nullopt;
@@ -102,7 +107,8 @@ std::optional<ParsedTexture> parse_texture(ObjectReader& r, TextureRole role, co
     return std::nullopt;
   if (role == TextureRole::kValue && out.desc.channel >= textures.channels(out.desc.path)) {
     r.error("channel", "the image has " + std::to_string(textures.channels(out.desc.path)) +
-                           " channel(s): channel " + std::to_string(out.desc.channel) + " does not exist");
+                           " channel(s): channel " + std::to_string(out.desc.channel) +
+                           " does not exist");
     return std::nullopt;
   }
   return out;
@@ -129,7 +135,8 @@ std::optional<std::pair<std::string, AssetImageInfo>> TextureSet::probe(const st
         diag.error(pointer, "'" + path + "' is " + std::to_string(info.width) + " x " +
                                 std::to_string(info.height) + " = " + std::to_string(pixels) +
                                 " pixels, more than the limit of " +
-                                std::to_string(limits_.max_texture_pixels) + " (max_texture_pixels)");
+                                std::to_string(limits_.max_texture_pixels) +
+                                " (max_texture_pixels)");
       else
         result.emplace(file->string(), info);
       if (result) channels_[file->string()] = info.channels;
@@ -146,14 +153,17 @@ std::optional<std::pair<std::string, AssetImageInfo>> TextureSet::probe(const st
 }
 
 bool TextureSet::reserve(const std::string& file, TextureColorspace colorspace,
-                         const AssetImageInfo& info, const std::string& pointer, Diagnostics& diag) {
+                         const AssetImageInfo& info, const std::string& pointer,
+                         Diagnostics& diag) {
   const auto key = std::make_pair(file, colorspace);
   if (reserved_.count(key)) return true;
   const int64_t bytes = decoded_texture_bytes(info.width, info.height, info.channels, info.is_8bit);
   if (bytes_ + bytes > limits_.max_texture_bytes) {
-    diag.error(pointer, "this image takes " + bytes_text(bytes) + " decoded, which brings the scene's "
-                        "textures to " + bytes_text(bytes_ + bytes) + ", more than the limit of " +
-                        bytes_text(limits_.max_texture_bytes) + " (max_texture_bytes)");
+    diag.error(pointer, "this image takes " + bytes_text(bytes) +
+                            " decoded, which brings the scene's "
+                            "textures to " +
+                            bytes_text(bytes_ + bytes) + ", more than the limit of " +
+                            bytes_text(limits_.max_texture_bytes) + " (max_texture_bytes)");
     return false;
   }
   reserved_[key] = bytes;
@@ -207,7 +217,8 @@ std::optional<ImageTextureDesc> read_normal_map(ObjectReader& reader, std::strin
     return desc;
   }
   if (!value->is_object()) {
-    reader.diagnostics().error(pointer, "must be a file name or a texture {\"texture\": \"file.png\", ...}");
+    reader.diagnostics().error(pointer,
+                               "must be a file name or a texture {\"texture\": \"file.png\", ...}");
     return std::nullopt;
   }
   ObjectReader r(*value, pointer, reader.diagnostics());

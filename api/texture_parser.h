@@ -36,13 +36,16 @@ class TextureSet {
 
   // Channels of a file probe() accepted.
   int channels(const std::string& file) const { return channels_.at(file); }
-  TextureLimits renderer_limits() const { return {limits_.max_texture_pixels, limits_.max_texture_bytes}; }
+  TextureLimits renderer_limits() const {
+    return {limits_.max_texture_pixels, limits_.max_texture_bytes};
+  }
   int64_t bytes() const { return bytes_; }
 
  private:
   const Limits& limits_;
   const AssetFolder& assets_;
-  std::map<std::string, std::optional<std::pair<std::string, AssetImageInfo>>> probed_;  // by path as written
+  std::map<std::string, std::optional<std::pair<std::string, AssetImageInfo>>>
+      probed_;                           // by path as written
   std::map<std::string, int> channels_;  // by canonical file
   std::map<std::pair<std::string, TextureColorspace>, int64_t> reserved_;
   int64_t bytes_ = 0;

@@ -11,9 +11,8 @@
 //  * normal_mapped: textured, plus a 256 x 256 normal map on every material (tangent frame,
 //    a third lookup and the perturbed-frame BSDF per hit).
 // Mrays/s is rays per CPU second; the textures are written to a temporary folder first.
-#include <benchmark/benchmark.h>
-
 #include <OpenImageIO/imageio.h>
+#include <benchmark/benchmark.h>
 
 #include <cmath>
 #include <filesystem>
@@ -31,8 +30,8 @@ namespace fs = std::filesystem;
 
 // Smooth-ish deterministic values in [0, 1] (sums of sines), so bilinear lookups see variety.
 float pattern(int x, int y, int c) {
-  return 0.5f + 0.25f * std::sin(0.07f * float(x) + 1.3f * float(c)) + 0.2f * std::sin(0.11f * float(y) - 0.7f * float(c)) *
-                                                                         std::cos(0.05f * float(x + y));
+  return 0.5f + 0.25f * std::sin(0.07f * float(x) + 1.3f * float(c)) +
+         0.2f * std::sin(0.11f * float(y) - 0.7f * float(c)) * std::cos(0.05f * float(x + y));
 }
 
 void write_image(const fs::path& path, int size, int channels, bool normal = false) {
@@ -42,7 +41,8 @@ void write_image(const fs::path& path, int size, int channels, bool normal = fal
       for (int c = 0; c < channels; ++c) {
         float v = pattern(x, y, c);
         if (normal) v = c == 2 ? 0.9f : 0.5f + 0.3f * (v - 0.5f);  // mild tilts
-        px[(size_t(y) * size + x) * channels + c] = (unsigned char)std::lround(std::clamp(v, 0.f, 1.f) * 255.f);
+        px[(size_t(y) * size + x) * channels + c] =
+            (unsigned char)std::lround(std::clamp(v, 0.f, 1.f) * 255.f);
       }
   auto out = OIIO::ImageOutput::create(path.string());
   out->open(path.string(), OIIO::ImageSpec(size, size, channels, OIIO::TypeDesc::UINT8));
@@ -54,7 +54,8 @@ const fs::path& texture_folder() {
   static const fs::path folder = [] {
     const fs::path f = fs::temp_directory_path() / "penumbra_texture_cost_benchmark";
     fs::create_directories(f);
-    for (const char* name : {"white", "red", "green", "floor", "ball"}) write_image(f / (std::string(name) + ".png"), 512, 3);
+    for (const char* name : {"white", "red", "green", "floor", "ball"})
+      write_image(f / (std::string(name) + ".png"), 512, 3);
     write_image(f / "rough.png", 256, 1);
     write_image(f / "normal.png", 256, 3, true);
     return f;
@@ -70,22 +71,31 @@ struct Variant {
 
 std::string scene_json(const Variant& v) {
   auto color = [&](const char* name, const char* constant) {
-    return v.textured ? std::string(R"({"texture": ")") + name + R"(.png", "filter": ")" + v.filter + "\"}"
-                      : std::string(constant);
+    return v.textured
+               ? std::string(R"({"texture": ")") + name + R"(.png", "filter": ")" + v.filter + "\"}"
+               : std::string(constant);
   };
   const std::string normal = v.normal_maps ? R"(, "normal_map": "normal.png")" : "";
   const std::string roughness =
-      v.textured ? std::string(R"({"texture": "rough.png", "scale": 0.6, "filter": ")") + v.filter + "\"}" : "0.35";
+      v.textured
+          ? std::string(R"({"texture": "rough.png", "scale": 0.6, "filter": ")") + v.filter + "\"}"
+          : "0.35";
   return R"({"version": 1,
     "render": {"width": 64, "height": 64, "spp": 16, "max_depth": 6},
     "camera": {"position": [0, 1, 3.9], "look_at": [0, 1, 0], "fov": 40},
     "materials": {
-      "white": {"type": "diffuse", "color": )" + color("white", "[0.73, 0.73, 0.73]") + normal + R"(},
-      "red": {"type": "diffuse", "color": )" + color("red", "[0.63, 0.065, 0.05]") + normal + R"(},
-      "green": {"type": "diffuse", "color": )" + color("green", "[0.14, 0.45, 0.091]") + normal + R"(},
-      "floor": {"type": "plastic", "color": )" + color("floor", "[0.6, 0.55, 0.5]") + R"(, "roughness": 0.3)" + normal + R"(},
-      "metal": {"type": "conductor", "color": [0.9, 0.8, 0.6], "roughness": )" + roughness + normal + R"(},
-      "ball": {"type": "plastic", "color": )" + color("ball", "[0.2, 0.3, 0.7]") + normal + R"(}
+      "white": {"type": "diffuse", "color": )" +
+         color("white", "[0.73, 0.73, 0.73]") + normal + R"(},
+      "red": {"type": "diffuse", "color": )" +
+         color("red", "[0.63, 0.065, 0.05]") + normal + R"(},
+      "green": {"type": "diffuse", "color": )" +
+         color("green", "[0.14, 0.45, 0.091]") + normal + R"(},
+      "floor": {"type": "plastic", "color": )" +
+         color("floor", "[0.6, 0.55, 0.5]") + R"(, "roughness": 0.3)" + normal + R"(},
+      "metal": {"type": "conductor", "color": [0.9, 0.8, 0.6], "roughness": )" +
+         roughness + normal + R"(},
+      "ball": {"type": "plastic", "color": )" +
+         color("ball", "[0.2, 0.3, 0.7]") + normal + R"(}
     },
     "objects": [
       {"type": "quad", "origin": [-1, 0, 1], "u": [2, 0, 0], "v": [0, 0, -2], "material": "floor"},

@@ -19,10 +19,14 @@ BsdfModel make_model(const MaterialParams& params, CoatingTableCache& coatings) 
   return std::visit(
       [&coatings](const auto& p) -> BsdfModel {
         using P = std::decay_t<decltype(p)>;
-        if constexpr (std::is_same_v<P, DiffuseParams>) return DiffuseBsdf(p);
-        else if constexpr (std::is_same_v<P, ConductorParams>) return ConductorBsdf(p);
-        else if constexpr (std::is_same_v<P, DielectricParams>) return DielectricBsdf(p);
-        else return PlasticBsdf(p, PlasticBsdf::tables_for(p, coatings));
+        if constexpr (std::is_same_v<P, DiffuseParams>)
+          return DiffuseBsdf(p);
+        else if constexpr (std::is_same_v<P, ConductorParams>)
+          return ConductorBsdf(p);
+        else if constexpr (std::is_same_v<P, DielectricParams>)
+          return DielectricBsdf(p);
+        else
+          return PlasticBsdf(p, PlasticBsdf::tables_for(p, coatings));
       },
       params);
 }
@@ -30,8 +34,10 @@ BsdfModel make_model(const MaterialParams& params, CoatingTableCache& coatings) 
 // A params struct's colour texture, if that kind of material has one.
 template <typename P>
 const std::optional<ImageTextureDesc>* color_texture_of(const P& p) {
-  if constexpr (requires { p.color_texture; }) return &p.color_texture;
-  else return nullptr;
+  if constexpr (requires { p.color_texture; })
+    return &p.color_texture;
+  else
+    return nullptr;
 }
 
 }  // namespace
@@ -64,7 +70,8 @@ Material::Material(const MaterialParams& params, CoatingTableCache* coatings,
   };
   std::visit(
       [&](const auto& p) {
-        if (const auto* t = color_texture_of(p); t && *t) m.color = make_spectrum_texture(**t, image_cache());
+        if (const auto* t = color_texture_of(p); t && *t)
+          m.color = make_spectrum_texture(**t, image_cache());
         using P = std::decay_t<decltype(p)>;
         if constexpr (requires { p.roughness_texture; }) {
           if (p.roughness_texture) {

@@ -49,7 +49,8 @@ Frame SurfaceBsdf::perturbed_frame(const vec3& wi) const {
 }
 
 Spectrum SurfaceBsdf::eval_front(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const {
-  if (!normal_mapped_) return std::visit([&](const auto& m) { return m.eval(ctx, wi, wo); }, model_);
+  if (!normal_mapped_)
+    return std::visit([&](const auto& m) { return m.eval(ctx, wi, wo); }, model_);
   const Frame f = perturbed_frame(wi);
   const vec3 wo_p = f.to_local(wo), wi_p = f.to_local(wi);
   if (!(wo.z * wo_p.z > 0.f)) return Spectrum(0.f);

@@ -92,8 +92,8 @@ std::unique_ptr<ImageFloatTexture> make_float_texture(const ImageTextureDesc& de
                                                       TextureImageCache& images) {
   const TextureImage& image = images.get(desc.path, desc.colorspace);
   if (desc.channel < 0 || desc.channel >= image.channels())
-    throw ImageIoError(desc.path + ": has no channel " + std::to_string(desc.channel) + " (it has " +
-                       std::to_string(image.channels()) + ")");
+    throw ImageIoError(desc.path + ": has no channel " + std::to_string(desc.channel) +
+                       " (it has " + std::to_string(image.channels()) + ")");
   return std::make_unique<ImageFloatTexture>(image, desc.channel, desc.wrap, desc.filter);
 }
 

@@ -3,7 +3,8 @@
 // Mitsuba 3's `bitmap` texture so that references compare. Mitsuba evaluates bitmaps through
 // Dr.Jit's Texture (drjit include/drjit/texture_impl.h, tex_eval and tex_wrap):
 //  * uv (0, 0) is the image's top-left corner, (1, 1) its bottom-right; texel (x, y) covers
-//    [x, x + 1) / width x [y, y + 1) / height, its centre at ((x + 0.5) / width, (y + 0.5) / height).
+//    [x, x + 1) / width x [y, y + 1) / height, its centre at ((x + 0.5) / width, (y + 0.5) /
+//    height).
 //  * bilinear: p = uv * size - 0.5, the four texels around floor(p) weighted by the fraction;
 //    each corner index is wrapped on its own, so at the border a repeating image blends with
 //    the opposite edge and a clamped one with itself.

@@ -33,7 +33,8 @@ struct TextureLimits {
 
 // Bytes an image of this size takes once decoded (what TextureLimits::max_bytes counts).
 inline int64_t decoded_texture_bytes(int64_t width, int64_t height, int channels, bool is_8bit) {
-  return width * height * int64_t(channels < 4 ? channels : 4) * (is_8bit ? 1 : int64_t(sizeof(float)));
+  return width * height * int64_t(channels < 4 ? channels : 4) *
+         (is_8bit ? 1 : int64_t(sizeof(float)));
 }
 
 }  // namespace penumbra

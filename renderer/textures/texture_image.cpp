@@ -32,7 +32,8 @@ TextureImage load_texture_image(const std::string& path, TextureColorspace color
                                 const ImageReadLimits& limits) {
   if (probe_asset_image(path, limits).is_8bit) {
     AssetImage8 image = read_asset_image_8bit(path, limits);
-    return TextureImage(image.width, image.height, image.channels, std::move(image.pixels), colorspace);
+    return TextureImage(image.width, image.height, image.channels, std::move(image.pixels),
+                        colorspace);
   }
   AssetImage image = read_asset_image(path, limits);
   if (colorspace == TextureColorspace::kSrgb) srgb_to_linear_in_place(image);

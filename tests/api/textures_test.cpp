@@ -18,10 +18,13 @@ namespace {
 class Textures : public ::testing::Test {
  protected:
   void SetUp() override {
-    write_test_image(dir_.file("wood.png"), 4, 4, 3, std::vector<float>(48, 0.5f), OIIO::TypeDesc::UINT8);
-    write_test_image(dir_.file("grey.png"), 4, 4, 1, std::vector<float>(16, 0.5f), OIIO::TypeDesc::UINT8);
+    write_test_image(dir_.file("wood.png"), 4, 4, 3, std::vector<float>(48, 0.5f),
+                     OIIO::TypeDesc::UINT8);
+    write_test_image(dir_.file("grey.png"), 4, 4, 1, std::vector<float>(16, 0.5f),
+                     OIIO::TypeDesc::UINT8);
     write_test_image(dir_.file("hdr.exr"), 2, 2, 3, std::vector<float>(12, 2.f));
-    write_test_image(dir_.file("normal.png"), 2, 2, 3, std::vector<float>(12, 0.5f), OIIO::TypeDesc::UINT8);
+    write_test_image(dir_.file("normal.png"), 2, 2, 3, std::vector<float>(12, 0.5f),
+                     OIIO::TypeDesc::UINT8);
     assets_.root = dir_.path();
   }
 
@@ -38,7 +41,8 @@ class Textures : public ::testing::Test {
     return std::filesystem::canonical(dir_.path() / name).string();
   }
 
-  TempFolder dir_{"api_textures_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name())};
+  TempFolder dir_{"api_textures_" +
+                  std::string(::testing::UnitTest::GetInstance()->current_test_info()->name())};
   AssetFolder assets_;
 };
 
@@ -61,9 +65,10 @@ TEST_F(Textures, ColourTextureWithDefaults) {
 }
 
 TEST_F(Textures, FloatImagesAndNonColoursDefaultToLinear) {
-  const LoadResult r = load_material({{"type", "conductor"},
-                                      {"color", {{"texture", "hdr.exr"}, {"scale", 0.5}}},
-                                      {"roughness", {{"texture", "wood.png"}, {"channel", 2}, {"scale", 0.25}}}});
+  const LoadResult r =
+      load_material({{"type", "conductor"},
+                     {"color", {{"texture", "hdr.exr"}, {"scale", 0.5}}},
+                     {"roughness", {{"texture", "wood.png"}, {"channel", 2}, {"scale", 0.25}}}});
   EXPECT_LOADS(r);
   const auto& p = material0<ConductorParams>(r);
   EXPECT_EQ(p.color_texture->colorspace, TextureColorspace::kLinear);
@@ -74,14 +79,15 @@ TEST_F(Textures, FloatImagesAndNonColoursDefaultToLinear) {
 }
 
 TEST_F(Textures, EveryOptionIsRead) {
-  const LoadResult r = load_material({{"type", "plastic"},
-                                      {"color",
-                                       {{"texture", "wood.png"},
-                                        {"colorspace", "linear"},
-                                        {"scale", {0.8, 0.6, 0.4}},
-                                        {"wrap", "clamp"},
-                                        {"filter", "nearest"}}},
-                                      {"normal_map", {{"texture", "normal.png"}, {"filter", "nearest"}}}});
+  const LoadResult r =
+      load_material({{"type", "plastic"},
+                     {"color",
+                      {{"texture", "wood.png"},
+                       {"colorspace", "linear"},
+                       {"scale", {0.8, 0.6, 0.4}},
+                       {"wrap", "clamp"},
+                       {"filter", "nearest"}}},
+                     {"normal_map", {{"texture", "normal.png"}, {"filter", "nearest"}}}});
   EXPECT_LOADS(r);
   const auto& p = material0<PlasticParams>(r);
   EXPECT_EQ(p.color, Spectrum(0.8f, 0.6f, 0.4f));
@@ -124,35 +130,47 @@ TEST_F(Textures, RefusalsNameTheField) {
                m + "/color/texture", "relative");
   EXPECT_ERROR(load_material({{"type", "diffuse"}, {"color", {{"texture", "../x.png"}}}}),
                m + "/color/texture", "'..'");
-  EXPECT_ERROR(load_material({{"type", "diffuse"}, {"color", {{"scale", 0.5}}}}), m + "/color/texture",
-               "missing");
-  EXPECT_ERROR(load_material({{"type", "diffuse"}, {"color", {{"texture", "wood.png"}, {"wrap", "mirror"}}}}),
+  EXPECT_ERROR(load_material({{"type", "diffuse"}, {"color", {{"scale", 0.5}}}}),
+               m + "/color/texture", "missing");
+  EXPECT_ERROR(load_material(
+                   {{"type", "diffuse"}, {"color", {{"texture", "wood.png"}, {"wrap", "mirror"}}}}),
                m + "/color/wrap", "expected \"repeat\" or \"clamp\"");
-  EXPECT_ERROR(load_material({{"type", "diffuse"}, {"color", {{"texture", "wood.png"}, {"filter", "cubic"}}}}),
+  EXPECT_ERROR(load_material({{"type", "diffuse"},
+                              {"color", {{"texture", "wood.png"}, {"filter", "cubic"}}}}),
                m + "/color/filter", "\"bilinear\" or \"nearest\"");
-  EXPECT_ERROR(load_material({{"type", "diffuse"}, {"color", {{"texture", "wood.png"}, {"colorspace", "srgbb"}}}}),
+  EXPECT_ERROR(load_material({{"type", "diffuse"},
+                              {"color", {{"texture", "wood.png"}, {"colorspace", "srgbb"}}}}),
                m + "/color/colorspace", "did you mean 'srgb'");
-  EXPECT_ERROR(load_material({{"type", "diffuse"}, {"color", {{"texture", "wood.png"}, {"scale", 1.5}}}}),
-               m + "/color/scale", "[0, 1]");
-  EXPECT_ERROR(load_material({{"type", "diffuse"}, {"color", {{"texture", "wood.png"}, {"channel", 1}}}}),
-               m + "/color/channel", "single-value");
-  EXPECT_ERROR(load_material({{"type", "diffuse"}, {"color", {{"texture", "wood.png"}, {"wrapp", "clamp"}}}}),
+  EXPECT_ERROR(
+      load_material({{"type", "diffuse"}, {"color", {{"texture", "wood.png"}, {"scale", 1.5}}}}),
+      m + "/color/scale", "[0, 1]");
+  EXPECT_ERROR(
+      load_material({{"type", "diffuse"}, {"color", {{"texture", "wood.png"}, {"channel", 1}}}}),
+      m + "/color/channel", "single-value");
+  EXPECT_ERROR(load_material(
+                   {{"type", "diffuse"}, {"color", {{"texture", "wood.png"}, {"wrapp", "clamp"}}}}),
                m + "/color/wrapp", "wrap");
-  EXPECT_ERROR(load_material({{"type", "conductor"}, {"roughness", {{"texture", "grey.png"}, {"channel", 1}}}}),
+  EXPECT_ERROR(load_material({{"type", "conductor"},
+                              {"roughness", {{"texture", "grey.png"}, {"channel", 1}}}}),
                m + "/roughness/channel", "1 channel(s)");
-  EXPECT_ERROR(load_material({{"type", "conductor"}, {"roughness", {{"texture", "grey.png"}, {"channel", 4}}}}),
+  EXPECT_ERROR(load_material({{"type", "conductor"},
+                              {"roughness", {{"texture", "grey.png"}, {"channel", 4}}}}),
                m + "/roughness/channel", "[0, 3]");
   EXPECT_ERROR(load_material({{"type", "plastic"}, {"roughness", {{"texture", "grey.png"}}}}),
                m + "/roughness", "cannot be a texture");
-  EXPECT_ERROR(load_material({{"type", "diffuse"}, {"normal_map", {{"texture", "normal.png"}, {"colorspace", "srgb"}}}}),
+  EXPECT_ERROR(load_material({{"type", "diffuse"},
+                              {"normal_map", {{"texture", "normal.png"}, {"colorspace", "srgb"}}}}),
                m + "/normal_map/colorspace", "normal map");
-  EXPECT_ERROR(load_material({{"type", "diffuse"}, {"normal_map", "nope.png"}}), m + "/normal_map", "no such file");
-  EXPECT_ERROR(load_material({{"type", "diffuse"}, {"normal_map", 3}}), m + "/normal_map", "file name");
+  EXPECT_ERROR(load_material({{"type", "diffuse"}, {"normal_map", "nope.png"}}), m + "/normal_map",
+               "no such file");
+  EXPECT_ERROR(load_material({{"type", "diffuse"}, {"normal_map", 3}}), m + "/normal_map",
+               "file name");
   EXPECT_ERROR(load_material({{"type", "diffuse"}, {"color", "wood.png"}}), m + "/color",
                "must be an array of 3 numbers (got a string)");
   EXPECT_ERROR(load_material({{"type", "conductor"}, {"roughness", "wood.png"}}), m + "/roughness",
                "must be a number (got a string)");
-  EXPECT_ERROR(load_material({{"type", "diffuse"}, {"color", {{"texture", 5}}}}), m + "/color/texture", "string");
+  EXPECT_ERROR(load_material({{"type", "diffuse"}, {"color", {{"texture", 5}}}}),
+               m + "/color/texture", "string");
 }
 
 TEST_F(Textures, NotAnImageIsRefused) {
@@ -202,12 +220,15 @@ TEST_F(Textures, MemoryLimitCountsEachDecodedImageOnceAtTheLimitAndOneBelow) {
   // floats = 48.
   Json scene = base_scene();
   scene["materials"]["white"] = {{"type", "diffuse"}, {"color", {{"texture", "wood.png"}}}};
-  scene["materials"]["again"] = {{"type", "plastic"}, {"color", {{"texture", "wood.png"}}}};  // shared
-  scene["materials"]["raw"] = {{"type", "diffuse"},
-                               {"color", {{"texture", "wood.png"}, {"colorspace", "linear"}}}};  // a second copy
+  scene["materials"]["again"] = {{"type", "plastic"},
+                                 {"color", {{"texture", "wood.png"}}}};  // shared
+  scene["materials"]["raw"] = {
+      {"type", "diffuse"},
+      {"color", {{"texture", "wood.png"}, {"colorspace", "linear"}}}};  // a second copy
   scene["materials"]["rough"] = {{"type", "conductor"}, {"roughness", {{"texture", "grey.png"}}}};
   for (const char* name : {"again", "raw", "rough"})
-    scene["objects"].push_back({{"type", "sphere"}, {"center", {3, 0, 0}}, {"radius", 1}, {"material", name}});
+    scene["objects"].push_back(
+        {{"type", "sphere"}, {"center", {3, 0, 0}}, {"radius", 1}, {"material", name}});
   Limits limits;
   limits.max_texture_bytes = 48 + 48 + 16;
   const LoadResult ok = load_with_assets(scene, limits);
@@ -228,9 +249,8 @@ TEST_F(Textures, MemoryLimitCountsEachDecodedImageOnceAtTheLimitAndOneBelow) {
 
 TEST_F(Textures, ATexturedSceneBuildsAndRenders) {
   Json scene = base_scene();
-  scene["materials"]["white"] = {{"type", "plastic"},
-                                 {"color", {{"texture", "wood.png"}}},
-                                 {"normal_map", "normal.png"}};
+  scene["materials"]["white"] = {
+      {"type", "plastic"}, {"color", {{"texture", "wood.png"}}}, {"normal_map", "normal.png"}};
   scene["objects"][0]["emission"] = {{"texture", "hdr.exr"}};
   const LoadResult r = load_with_assets(scene);
   EXPECT_LOADS(r);

@@ -1,6 +1,8 @@
 // Image assets from untrusted files: a header that claims more pixels than the limits is refused
 // before any pixel is decoded (no allocation of its size), and broken files fail with an error
 // naming the file instead of crashing.
+#include "renderer/io/image_reader.h"
+
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -9,7 +11,6 @@
 #include <vector>
 
 #include "renderer/io/image_io.h"
-#include "renderer/io/image_reader.h"
 #include "tests/renderer/textures/texture_test_util.h"
 
 namespace penumbra::test {
@@ -38,7 +39,8 @@ std::string chunk(const std::string& type, const std::string& data) {
 std::string png_claiming(uint32_t width, uint32_t height) {
   const std::string ihdr = be32(width) + be32(height) + std::string("\x08\x02\x00\x00\x00", 5);
   const std::string idat("\x78\x9c\x63\x00\x00\x00\x01\x00\x01", 9);
-  return std::string("\x89PNG\r\n\x1a\n", 8) + chunk("IHDR", ihdr) + chunk("IDAT", idat) + chunk("IEND", "");
+  return std::string("\x89PNG\r\n\x1a\n", 8) + chunk("IHDR", ihdr) + chunk("IDAT", idat) +
+         chunk("IEND", "");
 }
 
 void write_bytes(const std::string& path, const std::string& bytes) {
@@ -118,7 +120,8 @@ TEST(ImageReader, TruncatedGarbageAndEmptyFilesFailWithTheFileNamed) {
   write_bytes(empty, "");
   expect_refused([&] { read_asset_image(garbage); }, garbage, "cannot read");
   expect_refused([&] { probe_asset_image(empty); }, empty, "cannot read");
-  expect_refused([&] { probe_asset_image(dir.file("missing.png")); }, dir.file("missing.png"), "cannot read");
+  expect_refused([&] { probe_asset_image(dir.file("missing.png")); }, dir.file("missing.png"),
+                 "cannot read");
 }
 
 TEST(ImageReader, NonFiniteTexelsBecomeZero) {

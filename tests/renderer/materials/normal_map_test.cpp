@@ -36,7 +36,8 @@ TEST(NormalMap, FlatMapChangesNothing) {
     EXPECT_EQ(flat.pdf(BsdfContext{}, wi, wo), plain.pdf(BsdfContext{}, wi, wo));
     const float ul = rng.next();
     const vec2 u = rng.next2();
-    const auto a = flat.sample(BsdfContext{}, wi, ul, u), b = plain.sample(BsdfContext{}, wi, ul, u);
+    const auto a = flat.sample(BsdfContext{}, wi, ul, u),
+               b = plain.sample(BsdfContext{}, wi, ul, u);
     ASSERT_EQ(a.has_value(), b.has_value());
     if (a) {
       EXPECT_EQ(a->wo, b->wo);
@@ -79,7 +80,8 @@ TEST(NormalMap, NormalFacingAwayFromTheViewerIsMirrored) {
 TEST(NormalMap, BackSideOfATwoSidedModelMirrorsTheMap) {
   const vec3 n = glm::normalize(vec3(0.3f, -0.2f, 0.9f));
   const SurfaceBsdf b = mapped(DiffuseBsdf(Spectrum(0.5f)), n);
-  const vec3 wi = glm::normalize(vec3(0.1f, 0.4f, 0.7f)), wo = glm::normalize(vec3(-0.5f, 0.2f, 0.6f));
+  const vec3 wi = glm::normalize(vec3(0.1f, 0.4f, 0.7f)),
+             wo = glm::normalize(vec3(-0.5f, 0.2f, 0.6f));
   const auto flip = [](const vec3& v) { return vec3(v.x, v.y, -v.z); };
   EXPECT_EQ(b.eval(BsdfContext{}, flip(wi), flip(wo)), b.eval(BsdfContext{}, wi, wo));
 }
@@ -104,7 +106,8 @@ TEST(NormalMap, SampleWeightIsEvalOverPdf) {
       const Spectrum f = b.eval(BsdfContext{}, wi, bs->wo);
       ASSERT_NEAR(pdf, bs->pdf, 1e-3f * bs->pdf + 1e-5f) << "model " << model.index();
       for (int c = 0; c < 3; ++c)
-        ASSERT_NEAR(f[c] / pdf, bs->weight[c], 2e-3f * bs->weight[c] + 1e-5f) << "model " << model.index();
+        ASSERT_NEAR(f[c] / pdf, bs->weight[c], 2e-3f * bs->weight[c] + 1e-5f)
+            << "model " << model.index();
       ++checked;
     }
     EXPECT_GT(checked, 1000) << "model " << model.index();

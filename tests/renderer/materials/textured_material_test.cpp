@@ -30,8 +30,9 @@ ImageTextureDesc two_texels(const TempFolder& dir, const std::string& name, cons
 }
 
 TEST(TexturedMaterial, ConstantMaterialsDoNotVary) {
-  for (const MaterialParams& p : {MaterialParams(DiffuseParams{}), MaterialParams(ConductorParams{}),
-                                  MaterialParams(DielectricParams{}), MaterialParams(PlasticParams{})}) {
+  for (const MaterialParams& p :
+       {MaterialParams(DiffuseParams{}), MaterialParams(ConductorParams{}),
+        MaterialParams(DielectricParams{}), MaterialParams(PlasticParams{})}) {
     const Material m(p);
     EXPECT_FALSE(m.varies());
     EXPECT_FALSE(m.normal_mapped());
@@ -121,7 +122,8 @@ TEST(TexturedMaterial, NormalMapFileGivesTheDecodedNormal) {
   const Spectrum g = expected.eval(BsdfContext{}, kWi, kWo);
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(f[c], g[c], 1e-6f);
   // The right texel is flat: the plain model.
-  EXPECT_EQ(m.bsdf_at(at(0.75f, 0.5f)).eval(BsdfContext{}, kWi, kWo), m.bsdf().eval(BsdfContext{}, kWi, kWo));
+  EXPECT_EQ(m.bsdf_at(at(0.75f, 0.5f)).eval(BsdfContext{}, kWi, kWo),
+            m.bsdf().eval(BsdfContext{}, kWi, kWo));
 }
 
 TEST(TexturedMaterial, MissingImageThrowsNamingTheFile) {

@@ -39,7 +39,8 @@ TEST(RenderTexture, EmitterTextureSeenDirectlyShowsEachTexelAtItsUv) {
     int x, y;
     float texel;
   };
-  for (const Probe& p : {Probe{2, 13, 1.f}, Probe{13, 13, 2.f}, Probe{2, 2, 3.f}, Probe{13, 2, 4.f}}) {
+  for (const Probe& p :
+       {Probe{2, 13, 1.f}, Probe{13, 13, 2.f}, Probe{2, 2, 3.f}, Probe{13, 2, 4.f}}) {
     const float* px = r.image.pixel(p.x, p.y);
     EXPECT_NEAR(px[0], p.texel, 1e-5f) << "pixel " << p.x << ", " << p.y;
     EXPECT_NEAR(px[1], 2.f * p.texel, 1e-5f);
@@ -64,9 +65,11 @@ TEST(RenderTexture, TextureOfOneValueRendersExactlyAsTheConstant) {
       metal.roughness_texture = linear_nearest(light);
     }
     in.materials = {floor, ball, metal};
-    in.objects = {quad_object({-3, 0, 3}, {6, 0, 0}, {0, 0, -6}, 0), sphere_object({-0.6f, 0.5f, 0}, 0.5f, 1),
+    in.objects = {quad_object({-3, 0, 3}, {6, 0, 0}, {0, 0, -6}, 0),
+                  sphere_object({-0.6f, 0.5f, 0}, 0.5f, 1),
                   sphere_object({0.6f, 0.5f, 0}, 0.5f, 2)};
-    ObjectDesc lamp = quad_object({-0.5f, 2.5f, -0.5f}, {1, 0, 0}, {0, 0, 1}, 0, Spectrum(textured ? 16.f : 8.f));
+    ObjectDesc lamp =
+        quad_object({-0.5f, 2.5f, -0.5f}, {1, 0, 0}, {0, 0, 1}, 0, Spectrum(textured ? 16.f : 8.f));
     if (textured) lamp.emission_texture = linear_nearest(light);
     in.objects.push_back(lamp);
     return in;
@@ -74,7 +77,8 @@ TEST(RenderTexture, TextureOfOneValueRendersExactlyAsTheConstant) {
   for (IntegratorKind kind : {IntegratorKind::kPath, IntegratorKind::kDistributed}) {
     RenderSettings s = small_settings(24, 16, 8, 6);
     s.integrator = kind;
-    const RenderResult constant = render_input(scene(false), s), textured = render_input(scene(true), s);
+    const RenderResult constant = render_input(scene(false), s),
+                       textured = render_input(scene(true), s);
     EXPECT_EQ(textured.image.rgb, constant.image.rgb);
     EXPECT_GT(image_stats(constant.image).mean[0], 0.01);
   }
@@ -130,7 +134,8 @@ TEST(RenderTexture, NormalMappedSphereInTheFurnaceGainsNothing) {
   std::vector<float> texels;
   for (int y = 0; y < 8; ++y)
     for (int x = 0; x < 8; ++x) {
-      const vec3 n = glm::normalize(vec3(0.7f * std::sin(float(x)), 0.7f * std::cos(float(y)), 1.f));
+      const vec3 n =
+          glm::normalize(vec3(0.7f * std::sin(float(x)), 0.7f * std::cos(float(y)), 1.f));
       texels.insert(texels.end(), {0.5f * (n.x + 1.f), 0.5f * (n.y + 1.f), 0.5f * (n.z + 1.f)});
     }
   write_test_image(path, 8, 8, 3, texels);

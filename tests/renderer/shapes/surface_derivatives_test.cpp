@@ -58,7 +58,8 @@ TEST(SurfaceDerivatives, MeshWithUvsSolvesTheParametrisation) {
   // Degenerate uvs (all equal): still a tangent frame of the normal.
   MeshDesc flat = m;
   flat.uvs.assign(3, vec2(0.5f));
-  const SurfaceHit d = hit_at(TriangleMesh(flat, ShapeContext{}), vec3(0.25f, 0.25f, 0.f), 0, vec2(0.25f));
+  const SurfaceHit d =
+      hit_at(TriangleMesh(flat, ShapeContext{}), vec3(0.25f, 0.25f, 0.f), 0, vec2(0.25f));
   EXPECT_NEAR(glm::dot(d.dpdu, d.ng), 0.f, 1e-6f);
   EXPECT_NEAR(glm::length(glm::cross(d.dpdu, d.dpdv)), 1.f, 1e-5f);
 }
@@ -70,8 +71,8 @@ TEST(SurfaceDerivatives, SphereMatchesFiniteDifferencesOfItsMapping) {
   // The point of the sphere at (u, v) under Mitsuba's mapping.
   auto point = [&](double u, double v) {
     const double phi = 2 * M_PI * u, theta = M_PI * v;
-    return dvec3(c) + double(r) * dvec3(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
-                                        std::cos(theta));
+    return dvec3(c) + double(r) * dvec3(std::sin(theta) * std::cos(phi),
+                                        std::sin(theta) * std::sin(phi), std::cos(theta));
   };
   for (const vec2 uv : {vec2(0.1f, 0.3f), vec2(0.6f, 0.8f), vec2(0.95f, 0.5f)}) {
     const vec3 p = vec3(point(uv.x, uv.y));

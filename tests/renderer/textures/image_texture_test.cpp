@@ -1,9 +1,9 @@
 // Image texture lookups against values computed by hand: texel centres, bilinear weights,
 // repeat and clamp at the border, nearest, the top-left origin, grey images and channels.
 // Conventions: Mitsuba 3's `bitmap` (Dr.Jit texture_impl.h), restated in image_texture.h.
-#include <gtest/gtest.h>
-
 #include "renderer/textures/image_texture.h"
+
+#include <gtest/gtest.h>
 
 namespace penumbra::test {
 namespace {
@@ -49,7 +49,8 @@ TEST(ImageTexture, RepeatBlendsWithTheOppositeEdgeAndClampWithItself) {
   EXPECT_FLOAT_EQ(lookup(img, {1.f, 1.f}, TextureWrap::kRepeat), (a + b + c + d) / 4.f);
   EXPECT_FLOAT_EQ(lookup(img, {1.f, 1.f}, TextureWrap::kClamp), d);
   // Far outside: repeat is periodic, clamp extends the border.
-  EXPECT_FLOAT_EQ(lookup(img, {2.375f, -2.75f}, TextureWrap::kRepeat), lookup(img, {0.375f, 0.25f}));
+  EXPECT_FLOAT_EQ(lookup(img, {2.375f, -2.75f}, TextureWrap::kRepeat),
+                  lookup(img, {0.375f, 0.25f}));
   EXPECT_FLOAT_EQ(lookup(img, {-3.f, 0.25f}, TextureWrap::kClamp), a);
   EXPECT_FLOAT_EQ(lookup(img, {5.f, 5.f}, TextureWrap::kClamp), d);
 }
@@ -93,7 +94,8 @@ TEST(ImageTexture, ColourChannelsInterpolateIndependently) {
 
 TEST(ImageTexture, NonFiniteOrHugeUvStaysInsideTheImage) {
   const TextureImage img = grey2x2();
-  for (const vec2 uv : {vec2(NAN, 0.5f), vec2(INFINITY, -INFINITY), vec2(1e30f, -1e30f), vec2(3e9f, 0.f)}) {
+  for (const vec2 uv :
+       {vec2(NAN, 0.5f), vec2(INFINITY, -INFINITY), vec2(1e30f, -1e30f), vec2(3e9f, 0.f)}) {
     for (TextureWrap wrap : {TextureWrap::kRepeat, TextureWrap::kClamp})
       for (TextureFilter filter : {TextureFilter::kBilinear, TextureFilter::kNearest}) {
         const float v = lookup(img, uv, wrap, filter);

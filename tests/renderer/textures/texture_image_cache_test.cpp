@@ -1,9 +1,10 @@
 // One decoded copy per (file, colorspace) per scene, within the build's texture limits (the
 // scene build's second line of defence behind api/'s header checks).
+#include "renderer/textures/texture_image_cache.h"
+
 #include <gtest/gtest.h>
 
 #include "renderer/io/image_io.h"
-#include "renderer/textures/texture_image_cache.h"
 #include "tests/renderer/textures/texture_test_util.h"
 
 namespace penumbra::test {
@@ -41,7 +42,8 @@ TEST(TextureImageCache, PixelLimitPerImage) {
   const std::string a = dir.file("a.exr");
   write_test_image(a, 4, 4, 1, std::vector<float>(16, 1.f));
   EXPECT_NO_THROW(TextureImageCache(TextureLimits{16, 1 << 20}).get(a, TextureColorspace::kLinear));
-  EXPECT_THROW(TextureImageCache(TextureLimits{15, 1 << 20}).get(a, TextureColorspace::kLinear), ImageIoError);
+  EXPECT_THROW(TextureImageCache(TextureLimits{15, 1 << 20}).get(a, TextureColorspace::kLinear),
+               ImageIoError);
 }
 
 }  // namespace

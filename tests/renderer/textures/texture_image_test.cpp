@@ -1,17 +1,20 @@
 // Decoding texture images: sRGB to linear at load (IEC 61966-2-1) for the colour channels only,
 // linear kept as stored, and row 0 of the file at the top.
+#include "renderer/textures/texture_image.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "renderer/textures/texture_image.h"
 #include "tests/renderer/textures/texture_test_util.h"
 
 namespace penumbra::test {
 namespace {
 
 // The sRGB decoding curve in double precision, written out from the standard.
-double srgb_decode(double v) { return v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4); }
+double srgb_decode(double v) {
+  return v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4);
+}
 
 TEST(TextureImage, EightBitSrgbIsDecodedAtLoadLinearIsNot) {
   TempFolder dir("texture_image_srgb");
