@@ -69,6 +69,7 @@ class SceneBuilder {
       if (!ctx.motion.is_static()) s_.features_.motion = true;
       ctx.camera_position = in_.camera.position;
       ctx.emissive = !is_black(desc.emission);
+      ctx.sample_uv = ctx.emissive && desc.emission_texture.has_value();
       s_.shapes_.push_back(make_shape(desc.shape, ctx));
       s_.objects_[i].shape = s_.shapes_.back().get();
       s_.objects_[i].material = desc.material;

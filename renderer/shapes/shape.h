@@ -18,7 +18,8 @@ struct ShapeSample {
   vec3 p;           // point on the surface
   vec3 p_error;     // its absolute error bound
   vec3 n;           // unit geometric normal (front side)
-  vec2 uv{0.f};     // surface coordinates of p, as a hit there would have (textured emitters)
+  vec2 uv{0.f};     // surface coordinates of p, as a hit there would have (if the context's
+                    // sample_uv asked for them; textured emitters)
   float pdf = 0.f;  // solid-angle density seen from the reference point (0 = failed)
 };
 
@@ -46,6 +47,7 @@ struct ShapeContext {
   vec3 offset{0.f};             // added to every position (motion baked in without a shutter)
   vec3 camera_position{0.f};    // picks how finely a moving mesh is tessellated in time
   bool emissive = false;        // an area light will sample it: prepare sampling by area
+  bool sample_uv = false;       // its emission is textured: samples need their uv
 };
 
 class Shape {

@@ -64,7 +64,8 @@ Sphere::Sphere(const SphereDesc& desc, const ShapeContext& ctx)
     : center_(desc.center + ctx.offset),
       radius_(desc.radius),
       area_(4.f * kPi * desc.radius * desc.radius),
-      motion_(ctx.motion) {}
+      motion_(ctx.motion),
+      sample_uv_(ctx.sample_uv) {}
 
 EmbreeGeometry Sphere::make_geometry(RTCDevice device) const {
   // User geometry: the exact quadratic motion path needs our own test.
@@ -110,7 +111,7 @@ void Sphere::surface_derivatives(float, SurfaceHit* hit) const {
 
 bool Sphere::sample(const vec3& ref, float time, const vec2& u, ShapeSample* out) const {
   *out = sample_sphere(center_at(time), radius_, ref, u);
-  out->uv = sphere_uv(out->n);
+  if (sample_uv_) out->uv = sphere_uv(out->n);
   return true;
 }
 

@@ -35,6 +35,7 @@ class Sphere final : public Shape {
   float radius_;
   float area_;
   ShapeMotion motion_;
+  bool sample_uv_;  // the uv of sampled points costs an atan2 and an acos: only if asked
 };
 
 // Nearest t in (0, t_max) where origin + t*dir (dir unit) meets the sphere, or a negative value.

@@ -4,6 +4,8 @@
 // furnace neither gain nor (unmapped) lose energy.
 #include <gtest/gtest.h>
 
+#include "renderer/lights/light.h"
+#include "renderer/shapes/sphere.h"
 #include "tests/renderer/render/render_test_util.h"
 #include "tests/renderer/textures/texture_test_util.h"
 
@@ -113,6 +115,33 @@ TEST(RenderTexture, TexturedEmitterLightsAsTheEquivalentConstantOne) {
     EXPECT_NEAR(a, b, 4.0 * std::sqrt(sa * sa + sb * sb)) << "columns " << x0 << ".." << x1;
     EXPECT_GT(b, 0.01);
   }
+}
+
+// Light samples on a textured emissive sphere carry the radiance of the texel under them (the
+// scene build asks the sphere for the uv of its samples only when its emission is textured).
+TEST(RenderTexture, TexturedSphereEmitterSamplesSeeTheirTexel) {
+  TempFolder dir("render_sphere_emitter");
+  const std::string path = dir.file("halves.exr");
+  write_test_image(path, 2, 1, 1, {1.f, 3.f});
+  SceneInput in;
+  in.camera = camera_looking({0, 0, 5}, {0, 0, 0}, 30.f);
+  in.materials = {DiffuseParams{}};
+  ObjectDesc ball = sphere_object({0, 0, 0}, 1.f, 0, Spectrum(2.f));
+  ball.emission_texture = linear_nearest(path);
+  in.objects = {ball};
+  const auto scene = Scene::build(in);
+  const Light& light = scene->light(0);
+  int left = 0, right = 0;
+  for (int i = 0; i < 64; ++i) {
+    LightSample ls;
+    const vec2 u((float(i % 8) + 0.5f) / 8.f, (float(i / 8) + 0.5f) / 8.f);
+    ASSERT_TRUE(light.sample(vec3(0.5f, 0.3f, 4.f), 0.f, u, &ls));
+    const float expected = sphere_uv(ls.n).x < 0.5f ? 2.f : 6.f;
+    EXPECT_EQ(ls.value, Spectrum(expected));
+    (expected == 2.f ? left : right)++;
+  }
+  EXPECT_GT(left, 0);
+  EXPECT_GT(right, 0);
 }
 
 TEST(RenderTexture, WhiteTexturedSphereInTheFurnaceRendersOne) {

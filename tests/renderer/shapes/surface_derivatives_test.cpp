@@ -93,6 +93,7 @@ TEST(SurfaceDerivatives, SphereMatchesFiniteDifferencesOfItsMapping) {
 TEST(ShapeSampleUv, SampledPointsCarryTheUvAHitThereWouldHave) {
   ShapeContext ctx;
   ctx.emissive = true;
+  ctx.sample_uv = true;
   const vec3 ref(0.3f, 0.2f, 5.f);
   const vec2 us[] = {vec2(0.1f, 0.2f), vec2(0.7f, 0.4f), vec2(0.45f, 0.9f)};
   // Quad: the point origin + s u + t v has uv (s, t), and sampling places it at s, t = u.
