@@ -71,10 +71,23 @@ std::optional<MaterialParams> parse_material(const Json& value, const std::strin
     }
     p.normal_map = read_normal_map(reader, "normal_map", textures);
     result = p;
+  } else if (*type == "metallic_roughness") {
+    // glTF 2.0's material (renderer/materials/metallic_roughness.h, docs/gltf.md).
+    MetallicRoughnessParams p;
+    read_color(reader, p, textures);
+    if (auto m = read_float_field(reader, "metallic", kRoughness, textures)) {
+      p.metallic = m->factor;
+      p.metallic_texture = m->texture;
+    }
+    read_roughness(reader, p, textures);
+    p.normal_map = read_normal_map(reader, "normal_map", textures);
+    result = p;
   } else {
     reader.error("type", "unknown material type " + quote_user_string(*type) +
-                             did_you_mean(*type, {"diffuse", "conductor", "dielectric", "plastic"}) +
-                             "; expected diffuse, conductor, dielectric or plastic");
+                             did_you_mean(*type, {"diffuse", "conductor", "dielectric", "plastic",
+                                                  "metallic_roughness"}) +
+                             "; expected diffuse, conductor, dielectric, plastic or "
+                             "metallic_roughness");
     return std::nullopt;  // the other keys cannot be judged without a type
   }
   reader.report_unknown_keys();

@@ -110,7 +110,8 @@ template <class V>
 std::optional<MeshDesc> place_mesh(ObjectReader& reader, const MeshSite& site,
                                    const AffineTransform& transform,
                                    const std::vector<V>& positions, std::vector<uint32_t> indices,
-                                   const std::vector<V>& normals, std::vector<vec2> uvs) {
+                                   const std::vector<V>& normals, std::vector<vec2> uvs,
+                                   bool allow_empty = false) {
   Diagnostics& diag = reader.diagnostics();
   const std::size_t vertex_count = positions.size();
   const std::size_t triangle_count = indices.size() / 3;
@@ -150,6 +151,12 @@ std::optional<MeshDesc> place_mesh(ObjectReader& reader, const MeshSite& site,
   }
   indices.resize(3 * kept);
   mesh.indices = std::move(indices);
+  if (mesh.indices.empty() && allow_empty) {
+    diag.warning(site.pointer("indices"),
+                 site.message("all " + std::to_string(triangle_count) +
+                              " triangles are degenerate (zero area): left out"));
+    return std::nullopt;
+  }
   if (mesh.indices.empty()) {
     diag.error(site.pointer("indices"),
                site.message("all " + std::to_string(triangle_count) +
@@ -312,6 +319,16 @@ std::optional<ParsedMesh> parse_file_mesh(ObjectReader& reader, const AffineTran
 }
 
 }  // namespace
+
+std::optional<MeshDesc> place_file_mesh(ObjectReader& reader, const std::string& label,
+                                        const AffineTransform& transform,
+                                        const std::vector<vec3>& positions,
+                                        std::vector<uint32_t> indices,
+                                        const std::vector<vec3>& normals, std::vector<vec2> uvs,
+                                        bool allow_empty) {
+  return place_mesh(reader, MeshSite(reader, label), transform, positions, std::move(indices),
+                    normals, std::move(uvs), allow_empty);
+}
 
 std::optional<ParsedMesh> parse_mesh(ObjectReader& reader, const AffineTransform& transform,
                                      const MeshBudget& budget, const Limits& limits,

@@ -28,6 +28,17 @@ struct ParsedMesh {
   std::optional<AssetUse> file;  // set for a mesh read from a file
 };
 
+// A mesh read from a file other than a mesh file (a glTF primitive), in its own coordinates,
+// placed by `transform` exactly as a mesh file is: problems reported on the object's "file",
+// naming `label`. With `allow_empty`, a mesh whose triangles are all degenerate is left out with a
+// warning (nullopt, no error) instead of being an error.
+std::optional<MeshDesc> place_file_mesh(ObjectReader& reader, const std::string& label,
+                                        const AffineTransform& transform,
+                                        const std::vector<vec3>& positions,
+                                        std::vector<uint32_t> indices,
+                                        const std::vector<vec3>& normals, std::vector<vec2> uvs,
+                                        bool allow_empty);
+
 std::optional<ParsedMesh> parse_mesh(ObjectReader& reader, const AffineTransform& transform,
                                      const MeshBudget& budget, const Limits& limits,
                                      const AssetFolder& assets);

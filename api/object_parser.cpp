@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "api/gltf_parser.h"
 #include "api/mesh_parser.h"
 #include "api/texture_parser.h"
 #include "api/transform.h"
@@ -100,7 +101,15 @@ ParsedObjects parse_objects(const Json* objects, const std::string& pointer,
     ObjectDesc object;
 
     const auto type = reader.string("type", Presence::kRequired);
-    if (const auto name = reader.string("material", Presence::kRequired)) {
+    // A glTF asset brings its own materials and emission.
+    const bool is_gltf = type && *type == "gltf";
+    if (is_gltf) {
+      for (const char* key : {"material", "emission"})
+        if (reader.has(key)) {
+          reader.allow({key});
+          reader.error(key, "a gltf object takes its materials and emission from the file");
+        }
+    } else if (const auto name = reader.string("material", Presence::kRequired)) {
       const auto it = materials.index.find(*name);
       if (it != materials.index.end()) {
         object.material = it->second;
@@ -112,7 +121,8 @@ ParsedObjects parse_objects(const Json* objects, const std::string& pointer,
                                           : did_you_mean(*name, materials.names)));
       }
     }
-    if (auto e = read_spectrum_field(reader, "emission", Range::at_least(0), TextureRole::kEmission, textures)) {
+    if (is_gltf) {
+    } else if (auto e = read_spectrum_field(reader, "emission", Range::at_least(0), TextureRole::kEmission, textures)) {
       object.emission = e->factor;
       object.emission_texture = e->texture;
     }
@@ -163,10 +173,41 @@ ParsedObjects parse_objects(const Json* objects, const std::string& pointer,
           object.shape = std::move(mesh->mesh);
         }
       }
+    } else if (*type == "gltf") {
+      reader.allow({"file"});
+      if (!transform_ok) {
+        reader.report_unknown_keys();
+        continue;
+      }
+      const MeshBudget budget{limits.max_triangles - parsed.triangles,
+                              limits.max_vertices - parsed.vertices};
+      auto gltf = parse_gltf_object(reader, transform, budget, limits, assets, textures);
+      reader.report_unknown_keys();
+      if (!gltf || diag.error_count() != errors_before) continue;
+      if (parsed.objects.size() + gltf->objects.size() > std::size_t(limits.max_objects)) {
+        reader.error("file", "its primitives at every node make the scene's objects more than " +
+                                 std::to_string(limits.max_objects) + " (max_objects)");
+        continue;
+      }
+      const uint32_t offset = uint32_t(materials.names.size() + parsed.extra_materials.size());
+      for (ObjectDesc& part : gltf->objects) {
+        part.material += offset;
+        part.velocity = object.velocity;
+        part.acceleration = object.acceleration;
+        parsed.objects.push_back(std::move(part));
+      }
+      parsed.extra_materials.insert(parsed.extra_materials.end(), gltf->materials.begin(),
+                                    gltf->materials.end());
+      parsed.lights.insert(parsed.lights.end(), gltf->lights.begin(), gltf->lights.end());
+      parsed.triangles += gltf->triangles;
+      parsed.vertices += gltf->vertices;
+      parsed.any_emission = parsed.any_emission || gltf->any_emission;
+      parsed.assets.push_back(std::move(gltf->use));
+      continue;
     } else {
       reader.error("type", "unknown object type " + quote_user_string(*type) +
-                               did_you_mean(*type, {"sphere", "quad", "mesh"}) +
-                               "; expected sphere, quad or mesh");
+                               did_you_mean(*type, {"sphere", "quad", "mesh", "gltf"}) +
+                               "; expected sphere, quad, mesh or gltf");
       continue;  // the shape's keys cannot be judged without a type
     }
     reader.report_unknown_keys();

@@ -25,6 +25,10 @@ struct ParsedObjects {
   std::vector<AssetUse> assets;      // mesh files read
   std::vector<bool> material_used;   // per material handle
   bool any_emission = false;
+  // What "gltf" objects bring: their materials (objects index them after the scene's own, in
+  // this order) and their KHR_lights_punctual lights.
+  std::vector<MaterialParams> extra_materials;
+  std::vector<LightDesc> lights;
 };
 
 // `shutter_extent` = max(|open|, |close|): motion must not carry objects out of range by then.

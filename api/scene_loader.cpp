@@ -6,6 +6,8 @@
 #include <sstream>
 
 #include "api/diagnostics.h"
+#include "api/gltf_scene.h"
+#include "renderer/io/gltf_file.h"
 #include "api/json_document.h"
 #include "api/render_overrides.h"
 #include "api/scene_parser.h"
@@ -45,6 +47,8 @@ LoadResult load_scene(std::string_view json_text, const Limits& limits,
 
 LoadResult load_scene_file(const std::string& path, const Limits& limits,
                            std::span<const RenderOverride> overrides) {
+  // A glTF asset renders as the scene gltf_scene.h builds around it.
+  if (is_gltf_file_name(path)) return load_gltf_scene_file(path, limits, overrides);
   std::error_code ec;
   std::ifstream file;
   if (!std::filesystem::is_directory(path, ec)) file.open(path, std::ios::binary);

@@ -92,7 +92,8 @@ LoadResult load_scene(std::string_view json_text, const Limits& limits = {},
                       std::span<const RenderOverride> overrides = {},
                       const AssetFolder& assets = {});
 // Reads the file (a read failure is reported as an error on pointer "") and calls load_scene
-// with the file's folder as the asset folder.
+// with the file's folder as the asset folder. A glTF file (.gltf, .glb) is loaded as the scene
+// api/gltf_scene.h builds around it.
 LoadResult load_scene_file(const std::string& path, const Limits& limits = {},
                            std::span<const RenderOverride> overrides = {});
 

@@ -217,6 +217,19 @@ std::optional<SceneRequest> parse_scene(const Json& document, const Limits& limi
 
   bool lights_lit = false;
   parse_lights(root.get("lights"), limits, origin, request.scene.lights, lights_lit, diag);
+  // glTF assets' lights follow the scene's own.
+  for (const LightDesc& light : objects.lights) {
+    if (int64_t(request.scene.lights.size()) >= limits.max_lights) {
+      diag.error("/objects", "the lights of the gltf objects bring the scene's lights beyond " +
+                                 std::to_string(limits.max_lights) + " (max_lights)");
+      break;
+    }
+    request.scene.lights.push_back(light);
+    std::visit([&](const auto& l) {
+      if constexpr (requires { l.intensity; }) lights_lit = lights_lit || !is_black(l.intensity);
+      else lights_lit = lights_lit || !is_black(l.irradiance);
+    }, light);
+  }
   root.report_unknown_keys();
   if (diag.has_errors()) return std::nullopt;
 
@@ -229,6 +242,8 @@ std::optional<SceneRequest> parse_scene(const Json& document, const Limits& limi
 
   request.world_origin = origin;
   request.scene.materials = std::move(materials.params);
+  request.scene.materials.insert(request.scene.materials.end(), objects.extra_materials.begin(),
+                                 objects.extra_materials.end());
   request.scene.objects = std::move(objects.objects);
   request.assets = std::move(objects.assets);
   request.scene.texture_limits = textures.renderer_limits();

@@ -152,6 +152,33 @@ std::optional<std::pair<std::string, AssetImageInfo>> TextureSet::probe(const st
   return result;
 }
 
+std::optional<AssetImageInfo> TextureSet::probe_memory(const std::string& key,
+                                                      const ImageSource& source,
+                                                      const std::string& pointer,
+                                                      Diagnostics& diag) {
+  if (auto it = memory_probed_.find(key); it != memory_probed_.end()) return it->second;
+  std::optional<AssetImageInfo> result;
+  ImageReadLimits header_only;
+  header_only.max_pixels = std::numeric_limits<int64_t>::max();
+  header_only.max_dimension = std::numeric_limits<int>::max();
+  try {
+    const AssetImageInfo info = probe_asset_image(source, header_only);
+    const int64_t pixels = int64_t(info.width) * info.height;
+    if (pixels > limits_.max_texture_pixels)
+      diag.error(pointer, source.path + " is " + std::to_string(info.width) + " x " +
+                              std::to_string(info.height) + " = " + std::to_string(pixels) +
+                              " pixels, more than the limit of " +
+                              std::to_string(limits_.max_texture_pixels) + " (max_texture_pixels)");
+    else
+      result = info;
+  } catch (const ImageIoError& e) {
+    diag.error(pointer, e.what());
+  }
+  if (result) channels_[key] = result->channels;
+  memory_probed_[key] = result;
+  return result;
+}
+
 bool TextureSet::reserve(const std::string& file, TextureColorspace colorspace,
                          const AssetImageInfo& info, const std::string& pointer,
                          Diagnostics& diag) {

@@ -34,6 +34,12 @@ class TextureSet {
   bool reserve(const std::string& file, TextureColorspace colorspace, const AssetImageInfo& info,
                const std::string& pointer, Diagnostics& diag);
 
+  // The header of an image held in memory (a glTF asset's), checked against the per-image limit;
+  // `key` names it uniquely in the scene (ImageTextureDesc::path). nullopt with an error on
+  // `pointer`, naming the image as source.path does.
+  std::optional<AssetImageInfo> probe_memory(const std::string& key, const ImageSource& source,
+                                             const std::string& pointer, Diagnostics& diag);
+
   // Channels of a file probe() accepted.
   int channels(const std::string& file) const { return channels_.at(file); }
   TextureLimits renderer_limits() const {
@@ -46,7 +52,8 @@ class TextureSet {
   const AssetFolder& assets_;
   std::map<std::string, std::optional<std::pair<std::string, AssetImageInfo>>>
       probed_;                           // by path as written
-  std::map<std::string, int> channels_;  // by canonical file
+  std::map<std::string, std::optional<AssetImageInfo>> memory_probed_;  // by key
+  std::map<std::string, int> channels_;  // by canonical file (or key)
   std::map<std::pair<std::string, TextureColorspace>, int64_t> reserved_;
   int64_t bytes_ = 0;
 };

@@ -14,6 +14,8 @@
 #include "app/commands.h"
 #include "app/load_report.h"
 #include "app/option_parsing.h"
+#include "api/gltf_scene.h"
+#include "renderer/io/gltf_file.h"
 #include "renderer/io/mesh_file.h"
 #include "renderer/scene/memory_estimate.h"
 
@@ -27,7 +29,8 @@ void print_help(std::FILE* out) {
   std::fprintf(out,
                "usage: penumbra info FILE [MORE ...]\n"
                "\n"
-               "Prints what each file contains: for a scene (.json) its objects, triangles,\n"
+               "Prints what each file contains: for a scene (.json) or a glTF asset (.gltf,\n"
+               ".glb, described as 'penumbra render' would render it) its objects, triangles,\n"
                "lights, the files it reads and an estimate of the memory a render needs; for a\n"
                "mesh file (.ply, .obj) its faces, triangles, vertices, attributes and bounds.\n"
                "Problems go to stderr as 'penumbra validate' prints them.\n"
@@ -75,6 +78,7 @@ std::string list_counts(const std::vector<Count>& counts) {
 // ---- scenes ----------------------------------------------------------------------------------
 
 bool is_scene(const fs::path& path) { return path.extension() == ".json"; }
+bool is_gltf(const fs::path& path) { return is_gltf_file_name(path.string()); }
 
 int print_scene(const std::string& file) {
   const api::LoadResult result = api::load_scene_file(file);
@@ -98,7 +102,8 @@ int print_scene(const std::string& file) {
   for (const LightDesc& light : scene.lights)
     (std::holds_alternative<PointLightDesc>(light) ? points : directionals)++;
 
-  std::printf("%s: scene, %d x %d pixels, %d spp\n", file.c_str(), settings.width, settings.height,
+  std::printf("%s: %s %d x %d pixels, %d spp\n", file.c_str(),
+              is_gltf(file) ? "glTF asset, rendered at" : "scene,", settings.width, settings.height,
               settings.spp);
   std::printf(
       "  objects     %zu: %s; %lld emitting\n", scene.objects.size(),
@@ -170,6 +175,7 @@ struct FileKind {
 };
 const FileKind kKinds[] = {
     {is_scene, print_scene},
+    {is_gltf, print_scene},
     {is_mesh_file_name, print_mesh_file},
 };
 
@@ -185,7 +191,8 @@ int run_info(int argc, char** argv) {
                                    [&](const FileKind& k) { return k.matches(file); });
     if (kind == std::end(kKinds)) {
       std::fprintf(stderr,
-                   "%s: unknown kind of file: expected a scene (.json) or a mesh (.ply, .obj)\n",
+                   "%s: unknown kind of file: expected a scene (.json), a glTF asset (.gltf, "
+                   ".glb) or a mesh (.ply, .obj)\n",
                    file.c_str());
       status = 1;
       continue;

@@ -20,6 +20,7 @@ namespace {
 
 const char* kUsage =
     "usage: penumbra render SCENE.json -o OUT.{png,exr} [options]\n"
+    "       penumbra render MODEL.{glb,gltf} -o OUT.{png,exr} [options]\n"
     "\n"
     "Renders a scene (format v1, see docs/scene-format.md). Options override the scene's\n"
     "\"render\" settings and are checked as those fields are, with the same limits:\n"

@@ -1,5 +1,6 @@
 #include "renderer/io/image_reader.h"
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
 #include <cmath>
@@ -34,20 +35,42 @@ AssetImageInfo check_header(const std::string& path, const OIIO::ImageSpec& spec
   return info;
 }
 
-std::unique_ptr<OIIO::ImageInput> open_image(const std::string& path) {
-  auto in = OIIO::ImageInput::open(path);
-  if (!in) fail(path, "cannot read the image: " + OIIO::geterror());
-  return in;
+// An open image and, for one in memory, the proxy it reads through (which must outlive it).
+struct OpenImage {
+  std::unique_ptr<OIIO::Filesystem::IOMemReader> proxy;
+  std::unique_ptr<OIIO::ImageInput> in;
+  OIIO::ImageInput* operator->() const { return in.get(); }
+};
+
+OpenImage open_image(const ImageSource& source) {
+  OpenImage image;
+  if (!source.bytes) {
+    image.in = OIIO::ImageInput::open(source.path);
+    if (!image.in) fail(source.path, "cannot read the image: " + OIIO::geterror());
+    return image;
+  }
+  // Only the named format's reader is tried: no guessing from a name, and never a file.
+  image.proxy = std::make_unique<OIIO::Filesystem::IOMemReader>(source.bytes->data(),
+                                                                 source.bytes->size());
+  image.in = OIIO::ImageInput::create(source.format, false, nullptr, image.proxy.get());
+  if (!image.in) fail(source.path, "no reader for the format '" + source.format + "'");
+  if (!image.in->set_ioproxy(image.proxy.get()))
+    fail(source.path, "the '" + source.format + "' reader cannot read from memory");
+  OIIO::ImageSpec spec;
+  if (!image.in->open(source.path, spec))
+    fail(source.path, "cannot read the image: " + image.in->geterror());
+  return image;
 }
 
 }  // namespace
 
-AssetImageInfo probe_asset_image(const std::string& path, const ImageReadLimits& limits) {
-  return check_header(path, open_image(path)->spec(), limits);
+AssetImageInfo probe_asset_image(const ImageSource& source, const ImageReadLimits& limits) {
+  return check_header(source.path, open_image(source)->spec(), limits);
 }
 
-AssetImage read_asset_image(const std::string& path, const ImageReadLimits& limits) {
-  auto in = open_image(path);
+AssetImage read_asset_image(const ImageSource& source, const ImageReadLimits& limits) {
+  const std::string& path = source.path;
+  auto in = open_image(source);
   const AssetImageInfo info = check_header(path, in->spec(), limits);
   AssetImage img;
   img.width = info.width;
@@ -63,8 +86,9 @@ AssetImage read_asset_image(const std::string& path, const ImageReadLimits& limi
   return img;
 }
 
-AssetImage8 read_asset_image_8bit(const std::string& path, const ImageReadLimits& limits) {
-  auto in = open_image(path);
+AssetImage8 read_asset_image_8bit(const ImageSource& source, const ImageReadLimits& limits) {
+  const std::string& path = source.path;
+  auto in = open_image(source);
   const AssetImageInfo info = check_header(path, in->spec(), limits);
   if (!info.is_8bit) fail(path, "the image does not store 8-bit values");
   AssetImage8 img;

@@ -3,6 +3,7 @@
 // against explicit limits before any pixel is decoded, so a file that claims 100k x 100k pixels
 // costs nothing; every error names the file.
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,19 @@ struct ImageReadLimits {
   int64_t max_pixels = int64_t(16384) * 8192;  // per image (a 16k x 8k environment map)
   int max_dimension = 65536;                   // per side
   int max_channels = 4;                        // channels kept (more are dropped, not an error)
+};
+
+// Where an image's encoded bytes are: a file, or memory (an image embedded in a glTF asset).
+struct ImageSource {
+  ImageSource(std::string file) : path(std::move(file)) {}  // NOLINT: a path is a source
+  ImageSource(const char* file) : path(file) {}             // NOLINT
+  ImageSource(std::string name, std::shared_ptr<const std::vector<uint8_t>> data,
+              std::string format_name)
+      : path(std::move(name)), bytes(std::move(data)), format(std::move(format_name)) {}
+
+  std::string path;  // the file; for an image in memory, how messages name it
+  std::shared_ptr<const std::vector<uint8_t>> bytes;  // set: decode these, read no file
+  std::string format;  // with bytes: the one OpenImageIO format tried ("png", "jpeg")
 };
 
 // Pixels as stored, converted to float, channel-interleaved, row 0 = the image's top row.
@@ -39,12 +53,12 @@ struct AssetImageInfo {
 // Opens the file and checks its header (size, channels, not a volume) without decoding a pixel.
 // Throws ImageIoError ("<path>: <reason>") for unreadable files, unknown formats, and images
 // over the limits.
-AssetImageInfo probe_asset_image(const std::string& path, const ImageReadLimits& limits = {});
+AssetImageInfo probe_asset_image(const ImageSource& source, const ImageReadLimits& limits = {});
 
 // Throws ImageIoError ("<path>: <reason>") for unreadable files, unknown formats, and images
 // over the limits. Non-finite float pixels are replaced by 0 (a NaN texel would poison every
 // image that samples it).
-AssetImage read_asset_image(const std::string& path, const ImageReadLimits& limits = {});
+AssetImage read_asset_image(const ImageSource& source, const ImageReadLimits& limits = {});
 
 // The stored 8-bit values of an image whose header says it holds 8-bit integers (is_8bit), not
 // converted: a quarter of the float memory. Throws ImageIoError as read_asset_image, and for an
@@ -55,7 +69,7 @@ struct AssetImage8 {
   int channels = 0;
   std::vector<uint8_t> pixels;  // channel-interleaved, row 0 = the image's top row
 };
-AssetImage8 read_asset_image_8bit(const std::string& path, const ImageReadLimits& limits = {});
+AssetImage8 read_asset_image_8bit(const ImageSource& source, const ImageReadLimits& limits = {});
 
 // IEC 61966-2-1: one sRGB-encoded value in [0, 1] to linear.
 float srgb_to_linear(float v);

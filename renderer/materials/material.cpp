@@ -25,6 +25,8 @@ BsdfModel make_model(const MaterialParams& params, CoatingTableCache& coatings) 
           return ConductorBsdf(p);
         else if constexpr (std::is_same_v<P, DielectricParams>)
           return DielectricBsdf(p);
+        else if constexpr (std::is_same_v<P, MetallicRoughnessParams>)
+          return MetallicRoughnessBsdf(p);
         else
           return PlasticBsdf(p, PlasticBsdf::tables_for(p, coatings));
       },
@@ -49,6 +51,7 @@ struct Material::Impl {
   // any value, and a reflectance above 1 would create energy.
   std::unique_ptr<ImageSpectrumTexture> color;
   std::unique_ptr<ImageFloatTexture> roughness;
+  std::unique_ptr<ImageFloatTexture> metallic;
   std::unique_ptr<ImageSpectrumTexture> normal_map;  // linear RGB = (n + 1) / 2
   std::unique_ptr<CoatingTableCache> own_coatings;
   std::unique_ptr<TextureImageCache> own_images;
@@ -82,13 +85,16 @@ Material::Material(const MaterialParams& params, CoatingTableCache* coatings,
             lobes_ |= SurfaceBsdf(make_model(smooth, *coatings)).lobes();
           }
         }
+        if constexpr (requires { p.metallic_texture; }) {
+          if (p.metallic_texture) m.metallic = make_float_texture(*p.metallic_texture, image_cache());
+        }
         if (p.normal_map) {
           m.normal_map = make_spectrum_texture(*p.normal_map, image_cache());
           normal_mapped_ = true;
         }
       },
       params);
-  varies_ = m.color || m.roughness || m.normal_map;
+  varies_ = m.color || m.roughness || m.metallic || m.normal_map;
 }
 
 Material::~Material() = default;
@@ -112,11 +118,25 @@ SurfaceBsdf Material::bsdf_at(const TextureQuery& q) const {
           return SurfaceBsdf(ConductorBsdf(color(p.color), roughness(p.roughness)));
         else if constexpr (std::is_same_v<P, DielectricParams>)
           return SurfaceBsdf(DielectricBsdf(p.ior, roughness(p.roughness), p.absorption));
+        else if constexpr (std::is_same_v<P, MetallicRoughnessParams>)
+          return SurfaceBsdf(MetallicRoughnessBsdf(
+              color(p.color), m.metallic ? p.metallic * clamp01(m.metallic->eval(q)) : p.metallic,
+              roughness(p.roughness)));
         else  // the coating (and its tables) as built; only the base colour varies
           return SurfaceBsdf(std::get<PlasticBsdf>(m.bsdf->model()).with_color(color(p.color)));
       },
       m.params);
-  if (m.normal_map) b.set_mapped_normal(2.f * m.normal_map->eval(q) - vec3(1.f));
+  if (m.normal_map) {
+    // glTF's normalTexture.scale multiplies x and y before normalising (glTF 2.0 section 3.9.3);
+    // 1 for the other materials.
+    const float s = std::visit(
+        [](const auto& p) {
+          if constexpr (requires { p.normal_scale; }) return p.normal_scale;
+          else return 1.f;
+        },
+        m.params);
+    b.set_mapped_normal((2.f * m.normal_map->eval(q) - vec3(1.f)) * vec3(s, s, 1.f));
+  }
   return b;
 }
 

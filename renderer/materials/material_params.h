@@ -43,6 +43,20 @@ struct PlasticParams {
   std::optional<ImageTextureDesc> color_texture{};
   std::optional<ImageTextureDesc> normal_map{};
 };
-using MaterialParams = std::variant<DiffuseParams, ConductorParams, DielectricParams, PlasticParams>;
+// glTF 2.0's metallic-roughness material (renderer/materials/metallic_roughness.h): its factors
+// and textures. Defaults are glTF's (base colour 1, metallic 1, roughness 1). glTF reads roughness
+// from a texture's green channel and metallic from its blue (channel 1 and 2 of the descs).
+struct MetallicRoughnessParams {
+  Spectrum color{1.f};  // base colour
+  float metallic = 1.f;
+  float roughness = 1.f;
+  std::optional<ImageTextureDesc> color_texture{};
+  std::optional<ImageTextureDesc> roughness_texture{};
+  std::optional<ImageTextureDesc> metallic_texture{};
+  std::optional<ImageTextureDesc> normal_map{};
+  float normal_scale = 1.f;  // glTF normalTexture.scale: multiplies the map's x and y
+};
+using MaterialParams = std::variant<DiffuseParams, ConductorParams, DielectricParams, PlasticParams,
+                                    MetallicRoughnessParams>;
 
 }  // namespace penumbra

@@ -10,11 +10,13 @@
 #include "renderer/materials/conductor.h"
 #include "renderer/materials/dielectric.h"
 #include "renderer/materials/diffuse.h"
+#include "renderer/materials/metallic_roughness.h"
 #include "renderer/materials/plastic.h"
 
 namespace penumbra {
 
-using BsdfModel = std::variant<DiffuseBsdf, ConductorBsdf, DielectricBsdf, PlasticBsdf>;
+using BsdfModel = std::variant<DiffuseBsdf, ConductorBsdf, DielectricBsdf, PlasticBsdf,
+                               MetallicRoughnessBsdf>;
 
 class SurfaceBsdf {
  public:

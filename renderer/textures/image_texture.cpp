@@ -84,13 +84,13 @@ float ImageFloatTexture::mean() const { return lookup_.image().mean(channel_); }
 
 std::unique_ptr<ImageSpectrumTexture> make_spectrum_texture(const ImageTextureDesc& desc,
                                                             TextureImageCache& images) {
-  return std::make_unique<ImageSpectrumTexture>(images.get(desc.path, desc.colorspace), desc.wrap,
+  return std::make_unique<ImageSpectrumTexture>(images.get(desc), desc.wrap,
                                                 desc.filter);
 }
 
 std::unique_ptr<ImageFloatTexture> make_float_texture(const ImageTextureDesc& desc,
                                                       TextureImageCache& images) {
-  const TextureImage& image = images.get(desc.path, desc.colorspace);
+  const TextureImage& image = images.get(desc);
   if (desc.channel < 0 || desc.channel >= image.channels())
     throw ImageIoError(desc.path + ": has no channel " + std::to_string(desc.channel) +
                        " (it has " + std::to_string(image.channels()) + ")");

@@ -3,7 +3,11 @@
 // is looked up. api/ fills these from `{"texture": PATH, ...}`; the scene build turns each into
 // an ImageSpectrumTexture or ImageFloatTexture over an image it decodes once per build.
 #include <cstdint>
+#include <memory>
 #include <string>
+#include <vector>
+
+#include "renderer/io/image_reader.h"
 
 namespace penumbra {
 
@@ -21,6 +25,16 @@ struct ImageTextureDesc {
   int channel = 0;  // single-value textures (roughness): the channel read
   TextureWrap wrap = TextureWrap::kRepeat;
   TextureFilter filter = TextureFilter::kBilinear;
+  // An image held in memory (embedded in a glTF asset) instead of a file: `path` is then a key
+  // unique in the scene (the decoded-image cache's), `name` how messages name the image and
+  // `format` the OpenImageIO reader ("png", "jpeg").
+  std::shared_ptr<const std::vector<uint8_t>> bytes{};
+  std::string name{};
+  std::string format{};
+
+  ImageSource source() const {
+    return bytes ? ImageSource(name.empty() ? path : name, bytes, format) : ImageSource(path);
+  }
 };
 
 // Caps on decoded textures, applied by api/ to the files' headers and again by the scene build

@@ -28,7 +28,7 @@ float TextureImage::mean(int channel) const {
   return n > 0 ? float(sum / n) : 0.f;
 }
 
-TextureImage load_texture_image(const std::string& path, TextureColorspace colorspace,
+TextureImage load_texture_image(const ImageSource& path, TextureColorspace colorspace,
                                 const ImageReadLimits& limits) {
   if (probe_asset_image(path, limits).is_8bit) {
     AssetImage8 image = read_asset_image_8bit(path, limits);

@@ -62,7 +62,7 @@ class TextureImage {
 // checked against `limits` before any pixel is decoded; sRGB-encoded values become linear (IEC
 // 61966-2-1) before any interpolation, so lookups interpolate linear values as Mitsuba 3 does.
 // Throws ImageIoError naming the file.
-TextureImage load_texture_image(const std::string& path, TextureColorspace colorspace,
+TextureImage load_texture_image(const ImageSource& path, TextureColorspace colorspace,
                                 const ImageReadLimits& limits = {});
 
 }  // namespace penumbra

@@ -16,7 +16,11 @@ class TextureImageCache {
 
   // The image, decoded on first use. Throws ImageIoError naming the file if it cannot be read or
   // exceeds the limits (per image, or the build's total with it).
-  const TextureImage& get(const std::string& path, TextureColorspace colorspace);
+  const TextureImage& get(const std::string& path, TextureColorspace colorspace) {
+    return get(ImageTextureDesc{path, colorspace});
+  }
+  // The image of a texture: `desc.path` is the key, desc.source() what is read.
+  const TextureImage& get(const ImageTextureDesc& desc);
 
   size_t size() const { return images_.size(); }
   int64_t bytes() const { return bytes_; }

@@ -37,6 +37,15 @@ std::vector<Chi2Case> chi2_cases() {
   for (float r : {0.f, 0.05f, 0.3f, 1.f})
     for (float t : {20.f, 70.f, 87.f})
       cases.push_back({"plastic", PlasticParams{Spectrum(0.3f, 0.5f, 0.8f), 1.5f, r}, kLobeAll, t});
+  for (float m : {0.f, 0.5f, 1.f})
+    for (float r : {0.f, 0.05f, 0.4f, 1.f})
+      for (float t : {15.f, 70.f, 88.f})
+        cases.push_back({"metallic_roughness",
+                         MetallicRoughnessParams{Spectrum(0.9f, 0.5f, 0.2f), m, r}, kLobeAll, t});
+  cases.push_back({"metallic_roughness", MetallicRoughnessParams{Spectrum(0.8f), 0.3f, 0.3f},
+                   kLobeDiffuse, 40.f});
+  cases.push_back({"metallic_roughness", MetallicRoughnessParams{Spectrum(0.8f), 0.3f, 0.3f},
+                   kLobeNonDiffuse, 40.f});
   for (float r : {0.f, 0.3f}) {
     cases.push_back({"plastic", PlasticParams{Spectrum(0.5f), 1.5f, r}, kLobeDiffuse, 50.f});
     cases.push_back({"plastic", PlasticParams{Spectrum(0.5f), 1.5f, r}, kLobeNonDiffuse, 50.f});

@@ -14,6 +14,7 @@ std::vector<MaterialParams> all_materials() {
     m.push_back(ConductorParams{Spectrum(1.f, 0.78f, 0.34f), r});
     m.push_back(DielectricParams{1.5f, r, Spectrum(0.f)});
     m.push_back(PlasticParams{Spectrum(0.1f, 0.2f, 0.6f), 1.5f, r});
+    m.push_back(MetallicRoughnessParams{Spectrum(0.9f, 0.6f, 0.1f), 0.5f, r});
   }
   m.push_back(DielectricParams{1.f, 0.3f, Spectrum(0.f)});
   return m;

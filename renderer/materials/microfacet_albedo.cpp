@@ -1,0 +1,136 @@
+#include "renderer/materials/microfacet_albedo.h"
+
+#include <array>
+#include <vector>
+
+#include <tbb/parallel_for.h>
+
+#include "renderer/core/quadrature.h"
+#include "renderer/materials/microfacet.h"
+
+namespace penumbra {
+namespace {
+
+constexpr int kN = kAlbedoTableRes;
+
+struct Table {
+  // [roughness node][cos node]
+  std::array<std::array<MicrofacetAlbedo, kN>, kN> albedo{};
+  std::array<MicrofacetAlbedo, kN> average{};
+};
+
+float node(int i) { return float(i) / float(kN - 1); }
+
+// E and E5 for one (mu, alpha) by quadrature over the visible normals of wi (Heitz 2018): the
+// projected disk in polar coordinates, Gauss-Legendre in the polar angle psi (radius sin psi) and the
+// midpoint rule in the angle (exponentially accurate for a periodic integrand). The estimator
+// under the visible-normal density is G1(wo, m) (Heitz 2014 eq. 19), times (1 - wi.m)^5 for E5.
+MicrofacetAlbedo integrate(float mu, float alpha) {
+  static const auto rule = [] {
+    std::vector<double> x, w;
+    gauss_legendre(40, x, w);
+    return std::make_pair(x, w);
+  }();
+  constexpr int kAngles = 32;
+  const GgxDistribution distr(alpha);
+  const float c = std::max(mu, 1e-4f);
+  const vec3 wi(std::sqrt(std::max(0.f, 1.f - c * c)), 0.f, c);
+  // Heitz 2018 listing 1 with the disk in polar coordinates instead of a warp of the square.
+  const vec3 vh = glm::normalize(vec3(alpha * wi.x, alpha * wi.y, wi.z));
+  const float len2 = vh.x * vh.x + vh.y * vh.y;
+  const vec3 t1 = len2 > 0.f ? vec3(-vh.y, vh.x, 0.f) / std::sqrt(len2) : vec3(1.f, 0.f, 0.f);
+  const vec3 t2 = glm::cross(vh, t1);
+  const float s = 0.5f * (1.f + vh.z);
+  double e = 0.0, e5 = 0.0;
+  const auto& [x, w] = rule;
+  for (size_t a = 0; a < x.size(); ++a) {
+    // rho = sin(psi), psi in [0, pi/2]: the hemisphere's height cos(psi) is smooth in psi where
+    // it is not in rho (sqrt(1 - rho^2) at the rim), so the rule converges fast.
+    const double psi = 0.25 * kPi * (x[a] + 1.0);
+    const double rho = std::sin(psi);
+    const double w_rho = 0.25 * kPi * w[a] * 2.0 * rho * std::cos(psi);  // d(rho^2)
+    for (int b = 0; b < kAngles; ++b) {
+      const double phi = 2.0 * kPi * (b + 0.5) / kAngles;
+      const float p1 = float(rho * std::cos(phi));
+      const float p2d = float(rho * std::sin(phi));
+      const float p2 = (1.f - s) * safe_sqrt(1.f - p1 * p1) + s * p2d;
+      const vec3 nh = p1 * t1 + p2 * t2 + safe_sqrt(1.f - p1 * p1 - p2 * p2) * vh;
+      const vec3 m = glm::normalize(vec3(alpha * nh.x, alpha * nh.y, std::max(0.f, nh.z)));
+      const vec3 wo = 2.f * glm::dot(wi, m) * m - wi;
+      if (wo.z <= 0.f) continue;
+      const double g1 = distr.smith_g1(wo, m);
+      const double weight = w_rho / kAngles;
+      const double one_minus = std::max(0.0, 1.0 - double(glm::dot(wi, m)));
+      const double sq = one_minus * one_minus;
+      e += weight * g1;
+      e5 += weight * g1 * sq * sq * one_minus;
+    }
+  }
+  return {float(e), float(e5)};
+}
+
+Table build() {
+  Table t;
+  // Rows in parallel: about 2 * 10^6 microfacet evaluations in all.
+  tbb::parallel_for(0, kN, [&](int j) {
+    const float r = node(j);
+    for (int i = 0; i < kN; ++i) {
+      const float mu = node(i);
+      // Roughness 0 is the smooth limit, exactly: all light reflects about the normal.
+      t.albedo[j][i] = j == 0 ? MicrofacetAlbedo{1.f, std::pow(1.f - mu, 5.f)}
+                              : integrate(mu, std::max(r * r, kMinMicrofacetAlpha));
+    }
+  });
+  for (int j = 0; j < kN; ++j) {
+    // 2 \int E(mu) mu dmu of the piecewise-linear interpolant, exactly: on [a, b] with values
+    // fa, fb the integral of the line times mu is (b - a) (fa (2a + b) + fb (a + 2b)) / 6.
+    double e = 0.0, e5 = 0.0;
+    for (int i = 0; i + 1 < kN; ++i) {
+      const double a = node(i), b = node(i + 1);
+      const auto& fa = t.albedo[j][i];
+      const auto& fb = t.albedo[j][i + 1];
+      e += (b - a) * (fa.e * (2 * a + b) + fb.e * (a + 2 * b)) / 6.0;
+      e5 += (b - a) * (fa.e5 * (2 * a + b) + fb.e5 * (a + 2 * b)) / 6.0;
+    }
+    t.average[j] = {float(2.0 * e), float(2.0 * e5)};
+  }
+  return t;
+}
+
+const Table& table() {
+  static const Table t = build();  // thread-safe initialisation (C++11 magic statics)
+  return t;
+}
+
+// Node index and fraction of x in [0, 1] on the table's uniform grid.
+inline void locate(float x, int* i, float* f) {
+  const float p = std::clamp(x, 0.f, 1.f) * float(kN - 1);
+  *i = std::min(int(p), kN - 2);
+  *f = p - float(*i);
+}
+
+inline MicrofacetAlbedo lerp(const MicrofacetAlbedo& a, const MicrofacetAlbedo& b, float f) {
+  return {a.e + (b.e - a.e) * f, a.e5 + (b.e5 - a.e5) * f};
+}
+
+}  // namespace
+
+MicrofacetAlbedo ggx_albedo(float cos_theta, float roughness) {
+  const Table& t = table();
+  int i, j;
+  float fi, fj;
+  locate(cos_theta, &i, &fi);
+  locate(roughness, &j, &fj);
+  return lerp(lerp(t.albedo[j][i], t.albedo[j][i + 1], fi),
+              lerp(t.albedo[j + 1][i], t.albedo[j + 1][i + 1], fi), fj);
+}
+
+MicrofacetAlbedo ggx_albedo_average(float roughness) {
+  const Table& t = table();
+  int j;
+  float fj;
+  locate(roughness, &j, &fj);
+  return lerp(t.average[j], t.average[j + 1], fj);
+}
+
+}  // namespace penumbra

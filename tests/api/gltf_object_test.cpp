@@ -1,0 +1,132 @@
+// The "gltf" object: a glTF asset from the scene's folder placed by its node hierarchy and then
+// the object's transform, one object per node and primitive (each node its own copy of the mesh
+// until instancing lands), its materials as metallic_roughness materials after the scene's own,
+// its lights added; every problem on the object's "file" field, naming the file.
+#include <unistd.h>
+
+#include <fstream>
+#include <variant>
+
+#include "tests/api/scene_test_util.h"
+#include "tests/renderer/io/gltf_test_util.h"
+
+namespace penumbra::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+class GltfObject : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    folder_.root = fs::temp_directory_path() / ("penumbra_gltf_object_" + std::to_string(::getpid()));
+    fs::create_directories(folder_.root / "models");
+  }
+  void TearDown() override { fs::remove_all(folder_.root); }
+
+  void write(const std::string& name, const std::vector<uint8_t>& bytes) {
+    std::ofstream(folder_.root / name, std::ios::binary)
+        .write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+  }
+  LoadResult load_with(const std::string& file, const Json& extra = Json::object()) {
+    Json scene = base_scene();
+    Json object = {{"type", "gltf"}, {"file", file}};
+    object.update(extra);
+    scene["objects"].push_back(object);
+    LoadResult r = load_scene(scene.dump(), {}, {}, folder_);
+    if (r.request) restore_json_coordinates(*r.request);
+    return r;
+  }
+
+  AssetFolder folder_;
+};
+
+GltfBuilder two_nodes_one_mesh() {
+  GltfBuilder b;
+  b.doc["materials"] = Json::array(
+      {{{"pbrMetallicRoughness", {{"baseColorFactor", {0.8, 0.1, 0.1, 1}}, {"metallicFactor", 0}, {"roughnessFactor", 0.5}}}}});
+  const int mesh = b.triangle(0);
+  b.node({{"mesh", mesh}, {"translation", {0, 0, -1}}});
+  b.node({{"mesh", mesh}, {"translation", {0, 0, -2}}});
+  return b;
+}
+
+TEST_F(GltfObject, EachNodePlacesItsMeshWithTheObjectTransformOnTop) {
+  write("models/m.glb", two_nodes_one_mesh().glb());
+  const LoadResult r = load_with("models/m.glb", {{"transform", {{"translate", {10, 0, 0}}}}});
+  ASSERT_TRUE(r.ok()) << describe(r.errors);
+  const auto& objects = r.request->scene.objects;
+  ASSERT_EQ(objects.size(), 3u);  // the base scene's sphere, then the two nodes
+  const auto& first = std::get<MeshDesc>(objects[1].shape);
+  const auto& second = std::get<MeshDesc>(objects[2].shape);
+  EXPECT_NEAR(first.positions[1].x, 11.f, 1e-5f);
+  EXPECT_NEAR(first.positions[1].z, -1.f, 1e-5f);
+  EXPECT_NEAR(second.positions[1].z, -2.f, 1e-5f);
+  EXPECT_EQ(first.uvs.size(), 3u);
+  // Materials: the scene's "white", then the file's, then glTF's default material.
+  ASSERT_EQ(r.request->scene.materials.size(), 3u);
+  EXPECT_EQ(objects[1].material, 1u);
+  const auto& m = std::get<MetallicRoughnessParams>(r.request->scene.materials[1]);
+  EXPECT_EQ(m.color, Spectrum(0.8f, 0.1f, 0.1f));
+  EXPECT_FLOAT_EQ(m.metallic, 0.f);
+  EXPECT_FLOAT_EQ(m.roughness, 0.5f);
+  ASSERT_EQ(r.request->assets.size(), 1u);
+  EXPECT_NE(r.request->assets[0].summary.find("1 mesh at 2 nodes -> 2 triangles"), std::string::npos)
+      << r.request->assets[0].summary;
+}
+
+TEST_F(GltfObject, MirroringTransformsKeepTheFrontFacesInFront) {
+  GltfBuilder b;
+  b.node({{"mesh", b.triangle()}, {"scale", {-1, 1, 1}}});
+  write("m.gltf", b.gltf_bytes());
+  const LoadResult r = load_with("m.gltf");
+  ASSERT_TRUE(r.ok()) << describe(r.errors);
+  const auto& mesh = std::get<MeshDesc>(r.request->scene.objects[1].shape);
+  // The triangle's normal stays +z (counter-clockwise seen from +z) after the mirror.
+  const vec3 n = glm::cross(mesh.positions[mesh.indices[1]] - mesh.positions[mesh.indices[0]],
+                            mesh.positions[mesh.indices[2]] - mesh.positions[mesh.indices[0]]);
+  EXPECT_GT(n.z, 0.f);
+}
+
+TEST_F(GltfObject, FilesItNamesMustStayInTheFolder) {
+  GltfBuilder b;
+  b.node({{"mesh", b.triangle()}});
+  write("models/m.gltf", b.gltf_bytes("../../secret.bin"));
+  EXPECT_ERROR(load_with("models/m.gltf"), "/objects/1/file", "'../../secret.bin': leaves the scene's folder");
+  write("models/n.gltf", b.gltf_bytes("missing.bin"));
+  EXPECT_ERROR(load_with("models/n.gltf"), "/objects/1/file", "'missing.bin': no such file");
+  // A URI relative to the asset's own folder.
+  write("models/data.bin", b.bin);
+  write("models/ok.gltf", b.gltf_bytes("data.bin"));
+  EXPECT_TRUE(load_with("models/ok.gltf").ok());
+}
+
+TEST_F(GltfObject, MaterialAndEmissionComeFromTheFile) {
+  write("m.glb", two_nodes_one_mesh().glb());
+  EXPECT_ERROR(load_with("m.glb", {{"material", "white"}}), "/objects/1/material", "from the file");
+  EXPECT_ERROR(load_with("other.ply"), "/objects/1/file", ".gltf or .glb");
+  EXPECT_ERROR(load_with("nothing.glb"), "/objects/1/file", "no such file");
+}
+
+TEST_F(GltfObject, PunctualLightsJoinTheScene) {
+  GltfBuilder b;
+  b.node({{"mesh", b.triangle()}});
+  b.doc["extensionsUsed"] = {"KHR_lights_punctual"};
+  b.doc["extensions"] = {{"KHR_lights_punctual",
+                          {{"lights", Json::array({{{"type", "point"}, {"intensity", 5}},
+                                                   {{"type", "directional"}, {"intensity", 2}}})}}}};
+  b.node({{"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}, {"translation", {1, 2, 3}}});
+  b.node({{"extensions", {{"KHR_lights_punctual", {{"light", 1}}}}}});
+  write("m.gltf", b.gltf_bytes());
+  const LoadResult r = load_with("m.gltf");
+  ASSERT_TRUE(r.ok()) << describe(r.errors);
+  ASSERT_EQ(r.request->scene.lights.size(), 2u);
+  const auto& p = std::get<PointLightDesc>(r.request->scene.lights[0]);
+  EXPECT_NEAR(p.position.y, 2.f, 1e-5f);
+  EXPECT_EQ(p.intensity, Spectrum(5.f));
+  const auto& d = std::get<DirectionalLightDesc>(r.request->scene.lights[1]);
+  EXPECT_EQ(d.direction, vec3(0, 0, -1));  // glTF lights shine along their -z
+  EXPECT_EQ(d.irradiance, Spectrum(2.f));
+}
+
+}  // namespace
+}  // namespace penumbra::test
