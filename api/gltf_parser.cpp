@@ -93,6 +93,19 @@ class GltfTextures {
     return desc;
   }
 
+  // Channels of the texture's image (0 when it cannot be read: get() reports why).
+  int channels(const GltfTextureRef& ref) {
+    const GltfImage& image = asset_.images[size_t(ref.image)];
+    const std::string key = file_ + "#images/" + std::to_string(ref.image);
+    ImageTextureDesc desc;
+    desc.path = key;
+    desc.name = image.name;
+    desc.bytes = image.bytes;
+    desc.format = image.extension;
+    const auto info = textures_.probe_memory(key, desc.source(), pointer_, diag_);
+    return info ? info->channels : 0;
+  }
+
  private:
   const GltfAsset& asset_;
   const std::string& file_;
@@ -105,6 +118,12 @@ struct MaterialAndEmission {
   MetallicRoughnessParams params;
   Spectrum emission{0.f};
   std::optional<ImageTextureDesc> emission_texture;
+  // alphaMode MASK: the cutout (base colour texture's alpha x factor against the cutoff), or,
+  // without an alpha channel, the whole surface kept or (`hidden`) left out.
+  std::optional<ImageTextureDesc> alpha_texture;
+  float alpha_factor = 1.f;
+  float alpha_cutoff = 0.5f;
+  bool hidden = false;
 };
 
 MaterialAndEmission convert_material(const GltfMaterial& m, GltfTextures& textures,
@@ -129,6 +148,15 @@ MaterialAndEmission convert_material(const GltfMaterial& m, GltfTextures& textur
   out.emission = m.emissive;
   if (m.emissive_texture && !is_black(m.emissive))
     out.emission_texture = textures.get(*m.emissive_texture, TextureColorspace::kSrgb);
+  if (m.alpha_mode == GltfAlphaMode::kMask) {
+    out.alpha_factor = m.alpha;
+    out.alpha_cutoff = m.alpha_cutoff;
+    // The alpha of an RGBA base colour texture; alpha is stored linearly in either colorspace.
+    if (m.base_color_texture && textures.channels(*m.base_color_texture) >= 4)
+      out.alpha_texture = textures.get(*m.base_color_texture, TextureColorspace::kSrgb, 3);
+    else
+      out.hidden = m.alpha < m.alpha_cutoff;
+  }
   if (m.alpha_mode == GltfAlphaMode::kBlend)
     diag.warning(pointer, label + ": alphaMode BLEND is rendered opaque (penumbra has no "
                                   "partial transparency; MASK is supported as a cutout)");
@@ -206,23 +234,19 @@ std::optional<ParsedGltf> parse_gltf_object(ObjectReader& reader, const AffineTr
   GltfTextures gltf_textures(*asset, *file, pointer, textures, diag);
   // Materials: the file's, then glTF's default material (base colour 1, metallic 1,
   // roughness 1) for primitives that name none.
-  std::vector<Spectrum> emission;
-  std::vector<std::optional<ImageTextureDesc>> emission_texture;
+  std::vector<MaterialAndEmission> converted;
   for (size_t i = 0; i < asset->materials.size(); ++i) {
     const std::string label =
         quote_user_string(*file) + ": materials[" + std::to_string(i) + "]";
-    MaterialAndEmission m = convert_material(asset->materials[i], gltf_textures, diag, pointer, label);
-    out.materials.push_back(m.params);
-    emission.push_back(m.emission);
-    emission_texture.push_back(m.emission_texture);
+    converted.push_back(convert_material(asset->materials[i], gltf_textures, diag, pointer, label));
+    out.materials.push_back(converted.back().params);
   }
   const uint32_t default_material = uint32_t(out.materials.size());
   out.materials.push_back(MetallicRoughnessParams{});
-  emission.push_back(Spectrum(0.f));
-  emission_texture.emplace_back();
+  converted.emplace_back();
   if (diag.error_count() != errors_before) return std::nullopt;
 
-  int64_t skipped_nodes = 0;
+  int64_t skipped_nodes = 0, hidden_parts = 0;
   for (const GltfMeshInstance& instance : asset->instances) {
     const AffineTransform to_world = compose(transform, affine(instance.to_world));
     const double det = glm::determinant(to_world.linear);
@@ -233,6 +257,12 @@ std::optional<ParsedGltf> parse_gltf_object(ObjectReader& reader, const AffineTr
     const GltfMesh& mesh = asset->meshes[size_t(instance.mesh)];
     for (size_t p = 0; p < mesh.primitives.size(); ++p) {
       const GltfPrimitive& prim = mesh.primitives[p];
+      const MaterialAndEmission& mat =
+          converted[prim.material < 0 ? default_material : size_t(prim.material)];
+      if (mat.hidden) {
+        ++hidden_parts;  // alpha MASK with a factor below the cutoff: nothing is left
+        continue;
+      }
       const int64_t tris = int64_t(prim.indices.size() / 3);
       if (out.triangles + tris > budget.triangles || out.vertices + int64_t(prim.positions.size()) > budget.vertices) {
         diag.error(pointer, quote_user_string(*file) + ": placing its meshes at every node exceeds the scene's limit of " +
@@ -257,8 +287,13 @@ std::optional<ParsedGltf> parse_gltf_object(ObjectReader& reader, const AffineTr
       ObjectDesc object;
       const uint32_t material = prim.material < 0 ? default_material : uint32_t(prim.material);
       object.material = material;
-      object.emission = emission[material];
-      object.emission_texture = emission_texture[material];
+      object.emission = mat.emission;
+      object.emission_texture = mat.emission_texture;
+      if (mat.alpha_texture) {
+        object.alpha_texture = mat.alpha_texture;
+        object.alpha_factor = mat.alpha_factor;
+        object.alpha_cutoff = mat.alpha_cutoff;
+      }
       if (!is_black(object.emission)) out.any_emission = true;
       out.triangles += int64_t(placed->indices.size() / 3);
       out.vertices += int64_t(placed->positions.size());
@@ -266,6 +301,9 @@ std::optional<ParsedGltf> parse_gltf_object(ObjectReader& reader, const AffineTr
       out.objects.push_back(std::move(object));
     }
   }
+  if (hidden_parts > 0)
+    diag.warning(pointer, quote_user_string(*file) + ": " + plural(hidden_parts, "primitive", "primitives") +
+                              " left out: alphaMode MASK with an alpha factor below the cutoff");
   if (skipped_nodes > 0)
     diag.warning(pointer, quote_user_string(*file) + ": " + plural(skipped_nodes, "node", "nodes") +
                               " with a zero scale (hidden) left out");

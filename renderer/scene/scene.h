@@ -67,6 +67,7 @@ class Scene {
   std::unique_ptr<CoatingTableCache> coatings_;
   std::unique_ptr<TextureImageCache> texture_images_;
   std::vector<Material> materials_;
+  std::vector<std::unique_ptr<FloatTexture>> alpha_textures_;  // cutouts, pointed to by shapes
   std::vector<std::unique_ptr<Shape>> shapes_;
   std::vector<SceneObject> objects_;  // index = Embree geometry id
   std::vector<std::unique_ptr<Light>> lights_;

@@ -77,6 +77,13 @@ class SceneBuilder {
       ctx.emissive = !is_black(desc.emission);
       ctx.need_uv = s_.features_.textures;
       ctx.sample_uv = ctx.emissive && desc.emission_texture.has_value();
+      if (desc.alpha_texture) {
+        s_.alpha_textures_.push_back(with_image_errors(
+            [&] { return make_float_texture(*desc.alpha_texture, *s_.texture_images_); }));
+        ctx.alpha = s_.alpha_textures_.back().get();
+        ctx.alpha_factor = desc.alpha_factor;
+        ctx.alpha_cutoff = desc.alpha_cutoff;
+      }
       s_.shapes_.push_back(make_shape(desc.shape, ctx));
       s_.objects_[i].shape = s_.shapes_.back().get();
       s_.objects_[i].material = desc.material;

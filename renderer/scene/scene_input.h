@@ -51,6 +51,11 @@ struct ObjectDesc {
   Spectrum emission{0.f};        // radiance leaving the front side; 0 = not a light
   // If set, the radiance at a point is `emission` times this texture there (at the hit's uv).
   std::optional<ImageTextureDesc> emission_texture{};
+  // A cutout (glTF alphaMode MASK), triangle meshes only: the surface exists where
+  // alpha_factor x the texture's value at the hit's uv is >= alpha_cutoff; elsewhere rays pass.
+  std::optional<ImageTextureDesc> alpha_texture{};
+  float alpha_factor = 1.f;
+  float alpha_cutoff = 0.5f;
   // Rigid motion: position(t) = position(0) + velocity*t + 0.5*acceleration*t^2.
   vec3 velocity{0.f};
   vec3 acceleration{0.f};

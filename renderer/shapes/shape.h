@@ -49,6 +49,11 @@ struct ShapeContext {
   bool emissive = false;        // an area light will sample it: prepare sampling by area
   bool need_uv = false;         // something reads SurfaceHit::uv (textures); else it may stay 0
   bool sample_uv = false;       // its emission is textured: samples need their uv
+  // Triangle meshes: a cutout; hits where alpha_factor x alpha(uv) < alpha_cutoff are ignored.
+  // The texture is owned by the scene and outlives the shape.
+  const class FloatTexture* alpha = nullptr;
+  float alpha_factor = 1.f;
+  float alpha_cutoff = 0.5f;
 };
 
 class Shape {

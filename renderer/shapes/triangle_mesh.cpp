@@ -5,6 +5,7 @@
 #include "renderer/core/frame.h"
 #include "renderer/embree/ray_access.h"
 #include "renderer/sampling/sampling.h"
+#include "renderer/textures/texture.h"
 
 namespace penumbra {
 namespace {
@@ -31,6 +32,11 @@ inline void filter_triangle_hit(const RTCFilterFunctionNArguments* args, unsigne
   const auto& mesh = *static_cast<const TriangleMesh*>(args->geometryUserPtr);
   if (!mesh.ahead_of_ray(RTCHitN_primID(args->hit, n, i), embree_ray_origin(args->ray, n, i),
                          embree_ray_direction(args->ray, n, i), RTCRayN_time(args->ray, n, i)))
+    args->valid[i] = 0;
+  // A cutout's holes let every ray through, camera and shadow rays alike (glTF alpha MASK).
+  else if (mesh.has_cutout() &&
+           !mesh.solid_at(RTCHitN_primID(args->hit, n, i), RTCHitN_u(args->hit, n, i),
+                          RTCHitN_v(args->hit, n, i)))
     args->valid[i] = 0;
 }
 
@@ -71,7 +77,13 @@ float triangle_area(const vec3& a, const vec3& b, const vec3& c) {
 }  // namespace
 
 TriangleMesh::TriangleMesh(const MeshDesc& desc, const ShapeContext& ctx)
-    : positions_(desc.positions), indices_(desc.indices), normals_(desc.normals), uvs_(desc.uvs) {
+    : alpha_(ctx.alpha),
+      alpha_factor_(ctx.alpha_factor),
+      alpha_cutoff_(ctx.alpha_cutoff),
+      positions_(desc.positions),
+      indices_(desc.indices),
+      normals_(desc.normals),
+      uvs_(desc.uvs) {
   for (vec3& p : positions_) p += ctx.offset;
   const size_t n = indices_.size() / 3;
   std::vector<float> areas(n);
@@ -186,6 +198,14 @@ void TriangleMesh::hit_geometry(const Ray& ray, float, uint32_t prim, const vec2
       hit->ns = glm::dot(ns, ng) < 0.f ? -ns : ns;
     }
   }
+}
+
+bool TriangleMesh::solid_at(uint32_t prim, float b1, float b2) const {
+  const uint32_t* tri = &indices_[size_t(prim) * 3];
+  TextureQuery q;
+  q.uv = uv_at(tri, 1.f - b1 - b2, b1, b2);
+  // glTF 2.0 section 3.9.4: opaque where alpha >= alphaCutoff, fully transparent elsewhere.
+  return alpha_factor_ * alpha_->eval(q) >= alpha_cutoff_;
 }
 
 void TriangleMesh::surface_derivatives(float, SurfaceHit* hit) const {

@@ -32,6 +32,9 @@ class TriangleMesh : public Shape {
   // True if the ray (origin o, direction d) meets the plane of triangle `prim` at t > 0,
   // decided in double precision (see triangle_mesh.cpp).
   bool ahead_of_ray(uint32_t prim, const vec3& o, const vec3& d, float time) const;
+  // With a cutout: whether the surface exists at barycentrics (b1, b2) of triangle `prim`.
+  bool has_cutout() const { return alpha_ != nullptr; }
+  bool solid_at(uint32_t prim, float b1, float b2) const;
 
  protected:
   // For shapes made of triangles that keep their own area and sampling (quads).
@@ -44,6 +47,8 @@ class TriangleMesh : public Shape {
     return uvs_.empty() ? vec2(b1, b2) : b0 * uvs_[tri[0]] + b1 * uvs_[tri[1]] + b2 * uvs_[tri[2]];
   }
 
+  const FloatTexture* alpha_ = nullptr;
+  float alpha_factor_ = 1.f, alpha_cutoff_ = 0.5f;
   std::vector<vec3> positions_;  // world space at time 0
   std::vector<uint32_t> indices_;
   std::vector<vec3> normals_;  // empty or one per position

@@ -9,6 +9,7 @@
 
 #include "tests/api/scene_test_util.h"
 #include "tests/renderer/io/gltf_test_util.h"
+#include "tests/renderer/textures/texture_test_util.h"
 
 namespace penumbra::test {
 namespace {
@@ -126,6 +127,36 @@ TEST_F(GltfObject, PunctualLightsJoinTheScene) {
   const auto& d = std::get<DirectionalLightDesc>(r.request->scene.lights[1]);
   EXPECT_EQ(d.direction, vec3(0, 0, -1));  // glTF lights shine along their -z
   EXPECT_EQ(d.irradiance, Spectrum(2.f));
+}
+
+TEST_F(GltfObject, AlphaMaskBecomesACutoutOrLeavesThePrimitiveOut) {
+  // An RGBA PNG embedded in the buffer as the base colour texture of a MASK material.
+  const std::string png_path = (folder_.root / "rgba.png").string();
+  write_test_image(png_path, 2, 2, 4, std::vector<float>(16, 0.5f), OIIO::TypeDesc::UINT8);
+  std::ifstream in(png_path, std::ios::binary);
+  const std::vector<uint8_t> png((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  GltfBuilder b;
+  const int view = b.view(png.data(), png.size());
+  b.doc["images"] = Json::array({{{"bufferView", view}, {"mimeType", "image/png"}}});
+  b.doc["textures"] = Json::array({{{"source", 0}}});
+  b.doc["materials"] = Json::array(
+      {{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}, {"baseColorFactor", {1, 1, 1, 0.8}}}},
+        {"alphaMode", "MASK"}, {"alphaCutoff", 0.3}},
+       {{"pbrMetallicRoughness", {{"baseColorFactor", {1, 1, 1, 0.2}}}}, {"alphaMode", "MASK"}}});
+  b.node({{"mesh", b.triangle(0)}});
+  b.node({{"mesh", b.triangle(1)}});
+  write("m.glb", b.glb());
+  const LoadResult r = load_with("m.glb");
+  ASSERT_TRUE(r.ok()) << describe(r.errors);
+  // The second primitive's alpha (0.2, no texture) is below its cutoff (0.5): left out.
+  ASSERT_EQ(r.request->scene.objects.size(), 2u);
+  const ObjectDesc& cut = r.request->scene.objects[1];
+  ASSERT_TRUE(cut.alpha_texture);
+  EXPECT_EQ(cut.alpha_texture->channel, 3);
+  EXPECT_TRUE(cut.alpha_texture->bytes);
+  EXPECT_FLOAT_EQ(cut.alpha_factor, 0.8f);
+  EXPECT_FLOAT_EQ(cut.alpha_cutoff, 0.3f);
+  EXPECT_TRUE(has(r.warnings, "/objects/1/file", "1 primitive left out"));
 }
 
 }  // namespace
