@@ -1,8 +1,9 @@
 #include "renderer/io/image_reader.h"
 
-#include <OpenImageIO/imageio.h>
-
+#include <algorithm>
 #include <cmath>
+
+#include "renderer/io/oiio_module.h"
 
 namespace penumbra {
 namespace {
@@ -18,10 +19,9 @@ float srgb_to_linear(float v) {
 }  // namespace
 
 AssetImage read_asset_image(const std::string& path, const ImageReadLimits& limits) {
-  auto in = OIIO::ImageInput::open(path);
-  if (!in) fail(path, "cannot read the image: " + OIIO::geterror());
-  const OIIO::ImageSpec spec = in->spec();
-  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
+  const auto in = open_plugin_image(path);
+  const PenumbraImageSpec spec = in->spec();
+  if (spec.width <= 0 || spec.height <= 0 || spec.channels <= 0)
     fail(path, "the image has no pixels");
   if (spec.width > limits.max_dimension || spec.height > limits.max_dimension)
     fail(path, "the image is " + std::to_string(spec.width) + " x " + std::to_string(spec.height) +
@@ -34,12 +34,10 @@ AssetImage read_asset_image(const std::string& path, const ImageReadLimits& limi
   AssetImage img;
   img.width = spec.width;
   img.height = spec.height;
-  img.channels = std::min(spec.nchannels, limits.max_channels);
-  img.is_float = spec.format.is_floating_point();
+  img.channels = std::min(spec.channels, limits.max_channels);
+  img.is_float = spec.is_float != 0;
   img.pixels.resize(size_t(pixels) * size_t(img.channels));
-  if (!in->read_image(0, 0, 0, img.channels, OIIO::TypeDesc::FLOAT, img.pixels.data()))
-    fail(path, "cannot decode the image: " + in->geterror());
-  in->close();
+  in->read(img.channels, img.pixels.data());
   for (float& v : img.pixels)
     if (!std::isfinite(v)) v = 0.f;
   return img;
