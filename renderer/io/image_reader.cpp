@@ -12,15 +12,10 @@ namespace {
   throw ImageIoError(path + ": " + reason);
 }
 
-float srgb_to_linear(float v) {
-  return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
-}
 
-}  // namespace
-
-AssetImage read_asset_image(const std::string& path, const ImageReadLimits& limits) {
-  const auto in = open_plugin_image(path);
-  const PenumbraImageSpec spec = in->spec();
+// The header of an open image, checked against the limits.
+AssetImageInfo check_header(const std::string& path, const PenumbraImageSpec& spec,
+                            const ImageReadLimits& limits) {
   if (spec.width <= 0 || spec.height <= 0 || spec.channels <= 0)
     fail(path, "the image has no pixels");
   if (spec.width > limits.max_dimension || spec.height > limits.max_dimension)
@@ -31,20 +26,59 @@ AssetImage read_asset_image(const std::string& path, const ImageReadLimits& limi
     fail(path, "the image has " + std::to_string(pixels) + " pixels; at most " +
                    std::to_string(limits.max_pixels));
   if (spec.depth > 1) fail(path, "volume images are not supported");
+  AssetImageInfo info;
+  info.width = spec.width;
+  info.height = spec.height;
+  info.channels = std::min(spec.channels, limits.max_channels);
+  info.is_float = spec.is_float != 0;
+  info.is_8bit = spec.is_uint8 != 0;
+  return info;
+}
+
+// Through the OpenImageIO plug-in, loaded on first use (oiio_module.h); its errors name the path.
+std::unique_ptr<PluginImage> open_image(const std::string& path) { return open_plugin_image(path); }
+
+}  // namespace
+
+AssetImageInfo probe_asset_image(const std::string& path, const ImageReadLimits& limits) {
+  return check_header(path, open_image(path)->spec(), limits);
+}
+
+AssetImage read_asset_image(const std::string& path, const ImageReadLimits& limits) {
+  auto in = open_image(path);
+  const AssetImageInfo info = check_header(path, in->spec(), limits);
   AssetImage img;
-  img.width = spec.width;
-  img.height = spec.height;
-  img.channels = std::min(spec.channels, limits.max_channels);
-  img.is_float = spec.is_float != 0;
-  img.pixels.resize(size_t(pixels) * size_t(img.channels));
+  img.width = info.width;
+  img.height = info.height;
+  img.channels = info.channels;
+  img.is_float = info.is_float;
+  img.pixels.resize(size_t(img.width) * size_t(img.height) * size_t(img.channels));
   in->read(img.channels, img.pixels.data());
   for (float& v : img.pixels)
     if (!std::isfinite(v)) v = 0.f;
   return img;
 }
 
+AssetImage8 read_asset_image_8bit(const std::string& path, const ImageReadLimits& limits) {
+  auto in = open_image(path);
+  const AssetImageInfo info = check_header(path, in->spec(), limits);
+  if (!info.is_8bit) fail(path, "the image does not store 8-bit values");
+  AssetImage8 img;
+  img.width = info.width;
+  img.height = info.height;
+  img.channels = info.channels;
+  img.pixels.resize(size_t(img.width) * size_t(img.height) * size_t(img.channels));
+  in->read(img.channels, img.pixels.data());
+  return img;
+}
+
+float srgb_to_linear(float v) {
+  return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
+}
+
 void srgb_to_linear_in_place(AssetImage& image) {
-  const int color_channels = std::min(image.channels, 3);
+  // RGB and RGBA: the first three; grey (Y) and grey + alpha (YA): the first only.
+  const int color_channels = image.channels >= 3 ? 3 : 1;
   for (size_t i = 0; i < image.pixels.size(); ++i)
     if (int(i % size_t(image.channels)) < color_channels) image.pixels[i] = srgb_to_linear(image.pixels[i]);
 }

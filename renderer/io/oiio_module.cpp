@@ -77,9 +77,12 @@ const Module& module() {
 
 PluginImage::~PluginImage() { module().close(handle_); }
 
-void PluginImage::read(int channels, float* pixels) {
+void PluginImage::read(int channels, float* pixels) { read(channels, PENUMBRA_OIIO_FLOAT, pixels); }
+void PluginImage::read(int channels, uint8_t* pixels) { read(channels, PENUMBRA_OIIO_UINT8, pixels); }
+
+void PluginImage::read(int channels, int type, void* pixels) {
   char error[512] = "";
-  if (!module().read(handle_, channels, pixels, error, sizeof error))
+  if (!module().read(handle_, channels, type, pixels, error, sizeof error))
     throw ImageIoError(path_ + ": cannot decode the image: " + error);
 }
 

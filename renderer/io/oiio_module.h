@@ -7,6 +7,7 @@
 //   $PENUMBRA_OIIO_MODULE (a path: only that file is tried)
 //   <dir of the executable>/../lib/penumbra/libpenumbra_oiio.so   (build tree; installed prefix)
 //   <dir of the executable>/libpenumbra_oiio.so
+#include <cstdint>
 #include <memory>
 #include <string>
 
@@ -22,13 +23,16 @@ class PluginImage {
   PluginImage& operator=(const PluginImage&) = delete;
 
   const PenumbraImageSpec& spec() const { return spec_; }
-  // Decodes the first `channels` channels as float into `pixels`; throws ImageIoError.
+  // Decodes the first `channels` channels as float (or as 8-bit values) into `pixels`; throws
+  // ImageIoError.
   void read(int channels, float* pixels);
+  void read(int channels, uint8_t* pixels);
 
  private:
   friend std::unique_ptr<PluginImage> open_plugin_image(const std::string& path);
   PluginImage(void* handle, const PenumbraImageSpec& spec, std::string path)
       : handle_(handle), spec_(spec), path_(std::move(path)) {}
+  void read(int channels, int type, void* pixels);
   void* handle_;
   PenumbraImageSpec spec_;
   std::string path_;

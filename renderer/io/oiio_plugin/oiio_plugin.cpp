@@ -49,12 +49,13 @@ __attribute__((visibility("default"))) void* penumbra_oiio_open(const char* path
   }
 }
 
-__attribute__((visibility("default"))) int penumbra_oiio_read(void* handle, int channels,
-                                                              float* pixels, char* error,
+__attribute__((visibility("default"))) int penumbra_oiio_read(void* handle, int channels, int type,
+                                                              void* pixels, char* error,
                                                               size_t error_size) {
   auto* in = static_cast<OIIO::ImageInput*>(handle);
+  const OIIO::TypeDesc format = type == PENUMBRA_OIIO_UINT8 ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT;
   try {
-    if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, pixels)) {
+    if (!in->read_image(0, 0, 0, channels, format, pixels)) {
       set_error(error, error_size, in->geterror());
       return 0;
     }
