@@ -1,9 +1,9 @@
 #include "renderer/io/image_reader.h"
 
-#include <OpenImageIO/filesystem.h>
-#include <OpenImageIO/imageio.h>
-
+#include <algorithm>
 #include <cmath>
+
+#include "renderer/io/oiio_module.h"
 
 namespace penumbra {
 namespace {
@@ -14,9 +14,9 @@ namespace {
 
 
 // The header of an open image, checked against the limits.
-AssetImageInfo check_header(const std::string& path, const OIIO::ImageSpec& spec,
+AssetImageInfo check_header(const std::string& path, const PenumbraImageSpec& spec,
                             const ImageReadLimits& limits) {
-  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
+  if (spec.width <= 0 || spec.height <= 0 || spec.channels <= 0)
     fail(path, "the image has no pixels");
   if (spec.width > limits.max_dimension || spec.height > limits.max_dimension)
     fail(path, "the image is " + std::to_string(spec.width) + " x " + std::to_string(spec.height) +
@@ -29,37 +29,16 @@ AssetImageInfo check_header(const std::string& path, const OIIO::ImageSpec& spec
   AssetImageInfo info;
   info.width = spec.width;
   info.height = spec.height;
-  info.channels = std::min(spec.nchannels, limits.max_channels);
-  info.is_float = spec.format.is_floating_point();
-  info.is_8bit = spec.format == OIIO::TypeDesc::UINT8;
+  info.channels = std::min(spec.channels, limits.max_channels);
+  info.is_float = spec.is_float != 0;
+  info.is_8bit = spec.is_uint8 != 0;
   return info;
 }
 
-// An open image and, for one in memory, the proxy it reads through (which must outlive it).
-struct OpenImage {
-  std::unique_ptr<OIIO::Filesystem::IOMemReader> proxy;
-  std::unique_ptr<OIIO::ImageInput> in;
-  OIIO::ImageInput* operator->() const { return in.get(); }
-};
-
-OpenImage open_image(const ImageSource& source) {
-  OpenImage image;
-  if (!source.bytes) {
-    image.in = OIIO::ImageInput::open(source.path);
-    if (!image.in) fail(source.path, "cannot read the image: " + OIIO::geterror());
-    return image;
-  }
-  // Only the named format's reader is tried: no guessing from a name, and never a file.
-  image.proxy = std::make_unique<OIIO::Filesystem::IOMemReader>(source.bytes->data(),
-                                                                 source.bytes->size());
-  image.in = OIIO::ImageInput::create(source.format, false, nullptr, image.proxy.get());
-  if (!image.in) fail(source.path, "no reader for the format '" + source.format + "'");
-  if (!image.in->set_ioproxy(image.proxy.get()))
-    fail(source.path, "the '" + source.format + "' reader cannot read from memory");
-  OIIO::ImageSpec spec;
-  if (!image.in->open(source.path, spec))
-    fail(source.path, "cannot read the image: " + image.in->geterror());
-  return image;
+// Through the OpenImageIO plug-in, loaded on first use (oiio_module.h); its errors name the path
+// (for an image in memory, its name).
+std::unique_ptr<PluginImage> open_image(const ImageSource& source) {
+  return open_plugin_image(source);
 }
 
 }  // namespace
@@ -78,9 +57,7 @@ AssetImage read_asset_image(const ImageSource& source, const ImageReadLimits& li
   img.channels = info.channels;
   img.is_float = info.is_float;
   img.pixels.resize(size_t(img.width) * size_t(img.height) * size_t(img.channels));
-  if (!in->read_image(0, 0, 0, img.channels, OIIO::TypeDesc::FLOAT, img.pixels.data()))
-    fail(path, "cannot decode the image: " + in->geterror());
-  in->close();
+  in->read(img.channels, img.pixels.data());
   for (float& v : img.pixels)
     if (!std::isfinite(v)) v = 0.f;
   return img;
@@ -96,9 +73,7 @@ AssetImage8 read_asset_image_8bit(const ImageSource& source, const ImageReadLimi
   img.height = info.height;
   img.channels = info.channels;
   img.pixels.resize(size_t(img.width) * size_t(img.height) * size_t(img.channels));
-  if (!in->read_image(0, 0, 0, img.channels, OIIO::TypeDesc::UINT8, img.pixels.data()))
-    fail(path, "cannot decode the image: " + in->geterror());
-  in->close();
+  in->read(img.channels, img.pixels.data());
   return img;
 }
 
