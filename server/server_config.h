@@ -30,7 +30,7 @@ struct ServerConfig {
   std::size_t min_free_bytes = std::size_t(64) << 20;
   std::string token;  // empty = no authentication
   bool insecure = false;
-  // Connections served at once, one thread each, started on demand and gone after 30 s idle;
+  // Connections served at once, one thread each, started on demand and gone after 10 s idle;
   // beyond this a connection is answered 503 at once (docs/design-notes.md, slow clients).
   int http_threads = 1024;
   double header_timeout_seconds = 10.0;  // the whole request head, however slowly it comes

@@ -57,7 +57,7 @@ HttpServer::HttpServer(const ServerConfig& config, JobService& jobs, Metrics& me
   // per-connection ones (deadlines, head caps) in GuardedServer / ConnectionStream.
   const int threads = config_.http_threads;
   s.new_task_queue = [threads] {
-    return new ConnectionPool(std::size_t(threads), std::chrono::seconds(30));
+    return new ConnectionPool(std::size_t(threads), std::chrono::seconds(10));
   };
   s.set_payload_max_length(config_.max_body_bytes);
   s.set_keep_alive_timeout(config_.keep_alive_seconds);
@@ -90,6 +90,11 @@ void HttpServer::install_handlers() {
         if (!res.body.empty() || res.content_length_ > 0)
           return httplib::Server::HandlerResponse::Unhandled;
         const std::string route = route_template(req.path);
+        // Methods the library parses but cannot route (TRACE, CONNECT) come back as 400: on a
+        // known path they are 405 like any other method it does not answer.
+        const bool unroutable_method =
+            res.status == 400 && (req.method == "TRACE" || req.method == "CONNECT");
+        if (unroutable_method) res.status = 404;  // then 405 with Allow on a known path
         if (res.status == 404 && route != "other") {
           std::string allow;
           for (const auto& m : allowed_methods(route)) allow += (allow.empty() ? "" : ", ") + m;

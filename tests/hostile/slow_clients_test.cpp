@@ -26,6 +26,7 @@ TEST(SlowClients, ProbesAnswerWithin100msUnder264SlowConnections) {
   const std::string id = submit(*c, tiny_scene(512, 512, 1));
   ASSERT_EQ(wait_for_state(*c, id, {"succeeded"})["state"], "succeeded");
   const int port = server.port();
+  const long rss_before = rss_kib(server.pid());
 
   std::vector<int> heads, bodies, readers;
   for (int i = 0; i < kSlowHeads; ++i) {
@@ -72,16 +73,21 @@ TEST(SlowClients, ProbesAnswerWithin100msUnder264SlowConnections) {
     status.push_back(probe_ms(port, "/v1/jobs/" + id));
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
   }
+  const long rss_during = rss_kib(server.pid());
   dripping = false;
   drip.join();
   for (int fd : heads) ::close(fd);
   for (int fd : bodies) ::close(fd);
   for (int fd : readers) ::close(fd);
+  std::this_thread::sleep_for(std::chrono::seconds(1));
+  const long rss_after = rss_kib(server.pid());
   std::printf(
-      "[ figures ] %d slow connections: /healthz p50 %.2f ms max %.2f ms; "
-      "status p50 %.2f ms max %.2f ms\n",
-      kSlowHeads + kSlowBodies + kSlowReaders, percentile(health, 0.5), percentile(health, 1.0),
-      percentile(status, 0.5), percentile(status, 1.0));
+      "[ figures ] %d slow connections: /healthz p50 %.2f ms p95 %.2f ms max %.2f ms; status "
+      "p50 %.2f ms p95 %.2f ms max %.2f ms; RSS %ld KiB before, %ld KiB with them, %ld KiB 1 s "
+      "after they closed\n",
+      kSlowHeads + kSlowBodies + kSlowReaders, percentile(health, 0.5), percentile(health, 0.95),
+      percentile(health, 1.0), percentile(status, 0.5), percentile(status, 0.95),
+      percentile(status, 1.0), rss_before, rss_during, rss_after);
   EXPECT_LT(percentile(health, 1.0), 100.0);
   EXPECT_LT(percentile(status, 1.0), 100.0);
 }
