@@ -187,6 +187,16 @@ TEST_F(ConnectionLimits, LibraryErrorsAreTypedProblems) {
       raw_request(server_->port(), "GET /healthz HTTP/1.1\r\nHost: x\r\nRange: bytes=z-\r\n\r\n");
   EXPECT_EQ(raw_status(range), 416);
   EXPECT_EQ(problem_of(range)["type"], "urn:penumbra:problem:range-not-satisfiable");
+  // TRACE parses but has no route: 405 with Allow on a known path, 404 elsewhere.
+  const std::string trace = raw_request(
+      server_->port(), "TRACE /v1/jobs HTTP/1.1\r\nHost: x\r\nAuthorization: Bearer s3cret\r\n\r\n");
+  EXPECT_EQ(raw_status(trace), 405) << trace.substr(0, 300);
+  EXPECT_NE(trace.find("Allow: GET, HEAD, POST"), std::string::npos) << trace.substr(0, 300);
+  EXPECT_EQ(problem_of(trace)["type"], "urn:penumbra:problem:method-not-allowed");
+  EXPECT_EQ(raw_status(raw_request(server_->port(),
+                                   "TRACE /nowhere HTTP/1.1\r\nHost: x\r\nAuthorization: Bearer "
+                                   "s3cret\r\n\r\n")),
+            404);
 }
 
 }  // namespace
