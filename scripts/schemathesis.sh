@@ -12,7 +12,7 @@ set -euo pipefail
 binary="$(realpath "$1")"
 repo_root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 venv="${2:-${PENUMBRA_SCHEMATHESIS_VENV:-$repo_root/.venv-schemathesis}}"
-examples="${3:-150}"
+examples="${3:-100}"
 st="$venv/bin/schemathesis"
 if [ ! -x "$st" ]; then
   if [ "${CI:-}" = "true" ]; then
