@@ -235,6 +235,15 @@ ssize_t ConnectionStream::write(const char* ptr, size_t size) {
     return ssize_t(size);
   }
   if (broken_) return -1;
+  if (phase_ == Phase::kBody && size >= 10 && std::memcmp(ptr, "HTTP/1.1 1", 10) == 0) {
+    // An interim answer ("100 Continue" to Expect: 100-continue), written in one piece before
+    // the body is read: the request goes on, its body still to come.
+    if (!send_all(ptr, size, rate_deadline(Clock::now(), limits_.write_grace_seconds, size))) {
+      broken_ = true;
+      return -1;
+    }
+    return ssize_t(size);
+  }
   if (phase_ != Phase::kResponse) {
     if (phase_ == Phase::kHead || body_bytes_ < content_length_) must_close_ = true;
     phase_ = Phase::kResponse;

@@ -176,6 +176,42 @@ TEST_F(ConnectionLimits, ALongAcceptCostsLittle) {
   EXPECT_LT(ms[2], 20.0);
 }
 
+TEST_F(ConnectionLimits, ExpectContinueGetsItsInterimAnswerAndTheBodyIsRead) {
+  // The interim 100 goes out before the body is read; the body is then read as a body.
+  const std::string scene = tiny_scene(8, 8, 1).dump();
+  const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_port = htons(uint16_t(server_->port()));
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ASSERT_EQ(::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
+  const std::string head =
+      "POST /v1/jobs HTTP/1.1\r\nHost: x\r\nAuthorization: Bearer s3cret\r\n"
+      "Content-Type: application/json\r\nExpect: 100-continue\r\n"
+      "Content-Length: " +
+      std::to_string(scene.size()) + "\r\n\r\n";
+  ASSERT_EQ(::send(fd, head.data(), head.size(), MSG_NOSIGNAL), ssize_t(head.size()));
+  auto read_some = [fd] {
+    std::string out;
+    char buf[4096];
+    pollfd p{fd, POLLIN, 0};
+    while (::poll(&p, 1, 1000) > 0) {
+      const ssize_t n = ::recv(fd, buf, sizeof buf, 0);
+      if (n <= 0) break;
+      out.append(buf, std::size_t(n));
+      if (out.find("\r\n\r\n") != std::string::npos && out.find('}') != std::string::npos) break;
+      if (out.rfind("HTTP/1.1 100", 0) == 0 && out.find("\r\n\r\n") != std::string::npos) break;
+    }
+    return out;
+  };
+  const std::string interim = read_some();
+  EXPECT_EQ(interim.rfind("HTTP/1.1 100", 0), 0u) << interim;
+  ASSERT_EQ(::send(fd, scene.data(), scene.size(), MSG_NOSIGNAL), ssize_t(scene.size()));
+  const std::string answer = read_some();
+  ::close(fd);
+  EXPECT_EQ(raw_status(answer), 202) << answer.substr(0, 300);
+}
+
 TEST_F(ConnectionLimits, LibraryErrorsAreTypedProblems) {
   // Answered by the library before any handler: a bad request line, an unparsable range.
   const std::string bad_line = raw_request(server_->port(), "NOT A REQUEST\r\n\r\n");
@@ -188,8 +224,9 @@ TEST_F(ConnectionLimits, LibraryErrorsAreTypedProblems) {
   EXPECT_EQ(raw_status(range), 416);
   EXPECT_EQ(problem_of(range)["type"], "urn:penumbra:problem:range-not-satisfiable");
   // TRACE parses but has no route: 405 with Allow on a known path, 404 elsewhere.
-  const std::string trace = raw_request(
-      server_->port(), "TRACE /v1/jobs HTTP/1.1\r\nHost: x\r\nAuthorization: Bearer s3cret\r\n\r\n");
+  const std::string trace =
+      raw_request(server_->port(),
+                  "TRACE /v1/jobs HTTP/1.1\r\nHost: x\r\nAuthorization: Bearer s3cret\r\n\r\n");
   EXPECT_EQ(raw_status(trace), 405) << trace.substr(0, 300);
   EXPECT_NE(trace.find("Allow: GET, HEAD, POST"), std::string::npos) << trace.substr(0, 300);
   EXPECT_EQ(problem_of(trace)["type"], "urn:penumbra:problem:method-not-allowed");
