@@ -10,6 +10,7 @@
 
 #include "renderer/materials/material_params.h"
 #include "renderer/core/math.h"
+#include "renderer/textures/texture_desc.h"
 
 namespace penumbra {
 
@@ -48,6 +49,8 @@ struct ObjectDesc {
   ShapeDesc shape;
   uint32_t material = 0;         // index into SceneInput::materials
   Spectrum emission{0.f};        // radiance leaving the front side; 0 = not a light
+  // If set, the radiance at a point is `emission` times this texture there (at the hit's uv).
+  std::optional<ImageTextureDesc> emission_texture{};
   // Rigid motion: position(t) = position(0) + velocity*t + 0.5*acceleration*t^2.
   vec3 velocity{0.f};
   vec3 acceleration{0.f};
@@ -84,6 +87,7 @@ struct SceneInput {
   std::vector<MaterialParams> materials;
   std::vector<ObjectDesc> objects;
   std::vector<LightDesc> lights;
+  TextureLimits texture_limits;  // applied again as the build decodes the textures' images
 };
 
 enum class IntegratorKind { kPath, kDistributed };

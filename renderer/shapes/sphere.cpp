@@ -19,43 +19,53 @@ void sphere_bounds_fn(const RTCBoundsFunctionArguments* args) {
   out->upper_z = b.hi.z;
 }
 
-void sphere_intersect_fn(const RTCIntersectFunctionNArguments* args) {
+// One ray of a packet of kN (0: the packet's run-time width). rtcIntersect1/rtcOccluded1 call
+// with N = 1, for which the RTCRayN accessors fold to plain fields once N is a constant.
+template <unsigned kN>
+inline void sphere_intersect_one(const RTCIntersectFunctionNArguments* args, unsigned i) {
+  const unsigned n = kN ? kN : args->N;
+  if (args->valid[i] == 0) return;
   const auto& sphere = *static_cast<const Sphere*>(args->geometryUserPtr);
-  RTCRayHitN* rayhit = args->rayhit;
-  RTCRayN* ray = RTCRayHitN_RayN(rayhit, args->N);
-  RTCHitN* hit = RTCRayHitN_HitN(rayhit, args->N);
-  for (unsigned i = 0; i < args->N; ++i) {
-    if (args->valid[i] == 0) continue;
-    const vec3 o = embree_ray_origin(ray, args->N, i), d = embree_ray_direction(ray, args->N, i);
-    const float t_near = RTCRayN_tnear(ray, args->N, i);
-    float& t_far = RTCRayN_tfar(ray, args->N, i);
-    const vec3 c = sphere.center_at(RTCRayN_time(ray, args->N, i));
-    const float t = intersect_sphere(c, sphere.radius(), o, d, t_far);
-    if (t <= t_near) continue;
-    t_far = t;
-    const vec3 n = o + t * d - c;
-    RTCHitN_Ng_x(hit, args->N, i) = n.x;
-    RTCHitN_Ng_y(hit, args->N, i) = n.y;
-    RTCHitN_Ng_z(hit, args->N, i) = n.z;
-    RTCHitN_u(hit, args->N, i) = 0.f;
-    RTCHitN_v(hit, args->N, i) = 0.f;
-    RTCHitN_primID(hit, args->N, i) = args->primID;
-    RTCHitN_geomID(hit, args->N, i) = args->geomID;
-    RTCHitN_instID(hit, args->N, i, 0) = args->context->instID[0];
-  }
+  RTCRayN* ray = RTCRayHitN_RayN(args->rayhit, n);
+  RTCHitN* hit = RTCRayHitN_HitN(args->rayhit, n);
+  const vec3 o = embree_ray_origin(ray, n, i), d = embree_ray_direction(ray, n, i);
+  float& t_far = RTCRayN_tfar(ray, n, i);
+  const vec3 c = sphere.center_at(RTCRayN_time(ray, n, i));
+  const float t = intersect_sphere(c, sphere.radius(), o, d, t_far);
+  if (t <= RTCRayN_tnear(ray, n, i)) return;
+  t_far = t;
+  const vec3 ng = o + t * d - c;
+  RTCHitN_Ng_x(hit, n, i) = ng.x;
+  RTCHitN_Ng_y(hit, n, i) = ng.y;
+  RTCHitN_Ng_z(hit, n, i) = ng.z;
+  RTCHitN_u(hit, n, i) = 0.f;
+  RTCHitN_v(hit, n, i) = 0.f;
+  RTCHitN_primID(hit, n, i) = args->primID;
+  RTCHitN_geomID(hit, n, i) = args->geomID;
+  RTCHitN_instID(hit, n, i, 0) = args->context->instID[0];
+}
+
+void sphere_intersect_fn(const RTCIntersectFunctionNArguments* args) {
+  if (args->N == 1) return sphere_intersect_one<1>(args, 0);
+  for (unsigned i = 0; i < args->N; ++i) sphere_intersect_one<0>(args, i);
+}
+
+template <unsigned kN>
+inline void sphere_occluded_one(const RTCOccludedFunctionNArguments* args, unsigned i) {
+  const unsigned n = kN ? kN : args->N;
+  if (args->valid[i] == 0) return;
+  const auto& sphere = *static_cast<const Sphere*>(args->geometryUserPtr);
+  RTCRayN* ray = args->ray;
+  const vec3 o = embree_ray_origin(ray, n, i), d = embree_ray_direction(ray, n, i);
+  float& t_far = RTCRayN_tfar(ray, n, i);
+  const vec3 c = sphere.center_at(RTCRayN_time(ray, n, i));
+  const float t = intersect_sphere(c, sphere.radius(), o, d, t_far);
+  if (t > RTCRayN_tnear(ray, n, i)) t_far = -kInfinity;
 }
 
 void sphere_occluded_fn(const RTCOccludedFunctionNArguments* args) {
-  const auto& sphere = *static_cast<const Sphere*>(args->geometryUserPtr);
-  RTCRayN* ray = args->ray;
-  for (unsigned i = 0; i < args->N; ++i) {
-    if (args->valid[i] == 0) continue;
-    const vec3 o = embree_ray_origin(ray, args->N, i), d = embree_ray_direction(ray, args->N, i);
-    float& t_far = RTCRayN_tfar(ray, args->N, i);
-    const vec3 c = sphere.center_at(RTCRayN_time(ray, args->N, i));
-    const float t = intersect_sphere(c, sphere.radius(), o, d, t_far);
-    if (t > RTCRayN_tnear(ray, args->N, i)) t_far = -kInfinity;
-  }
+  if (args->N == 1) return sphere_occluded_one<1>(args, 0);
+  for (unsigned i = 0; i < args->N; ++i) sphere_occluded_one<0>(args, i);
 }
 
 }  // namespace
@@ -65,7 +75,8 @@ Sphere::Sphere(const SphereDesc& desc, const ShapeContext& ctx)
       radius_(desc.radius),
       area_(4.f * kPi * desc.radius * desc.radius),
       motion_(ctx.motion),
-      need_uv_(ctx.need_uv) {}
+      need_uv_(ctx.need_uv),
+      sample_uv_(ctx.sample_uv) {}
 
 EmbreeGeometry Sphere::make_geometry(RTCDevice device) const {
   // User geometry: the exact quadratic motion path needs our own test.
@@ -97,17 +108,22 @@ Bounds3 Sphere::embree_bounds() const {
 void Sphere::hit_geometry(const Ray& ray, float t, uint32_t, const vec2&, SurfaceHit* hit) const {
   sphere_hit_geometry(center_at(ray.time), radius_, ray.origin + ray.direction * t, hit);
   // Two inverse trigonometric functions per hit: only when textures read the uv.
-  if (!need_uv_) return;
-  // Mitsuba 3's sphere: u = phi / 2 pi with phi = atan2(y, x) in [0, 2 pi), v = theta / pi from
-  // +z, in the sphere's frame (ours is unrotated).
+  if (need_uv_) hit->uv = sphere_uv(hit->ng);
+}
+
+void Sphere::surface_derivatives(float, SurfaceHit* hit) const {
+  // Derivatives of centre + r (sin v pi cos u 2 pi, sin v pi sin u 2 pi, cos v pi), as Mitsuba 3's
+  // sphere; at the poles, where phi is undefined, dp/dv is +x as there.
   const vec3 n = hit->ng;
-  float phi = std::atan2(n.y, n.x);
-  if (phi < 0.f) phi += 2.f * kPi;
-  hit->uv = vec2(phi * kInv2Pi, std::acos(std::clamp(n.z, -1.f, 1.f)) * kInvPi);
+  hit->dpdu = (2.f * kPi * radius_) * vec3(-n.y, n.x, 0.f);
+  const float rd = std::sqrt(n.x * n.x + n.y * n.y);
+  hit->dpdv = rd > 0.f ? (kPi * radius_) * vec3(n.z * n.x / rd, n.z * n.y / rd, -rd)
+                       : (kPi * radius_) * vec3(1.f, 0.f, 0.f);
 }
 
 bool Sphere::sample(const vec3& ref, float time, const vec2& u, ShapeSample* out) const {
   *out = sample_sphere(center_at(time), radius_, ref, u);
+  if (sample_uv_) out->uv = sphere_uv(out->n);
   return true;
 }
 
@@ -131,6 +147,12 @@ float intersect_sphere(const vec3& center, float radius, const vec3& origin, con
   if (t0 > 0.f && t0 < t_max) return t0;
   if (t1 > 0.f && t1 < t_max) return t1;
   return -1.f;
+}
+
+vec2 sphere_uv(const vec3& n) {
+  float phi = std::atan2(n.y, n.x);
+  if (phi < 0.f) phi += 2.f * kPi;
+  return vec2(phi * kInv2Pi, std::acos(std::clamp(n.z, -1.f, 1.f)) * kInvPi);
 }
 
 void sphere_hit_geometry(const vec3& center, float radius, const vec3& p_approx, SurfaceHit* hit) {

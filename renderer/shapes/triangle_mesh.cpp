@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "renderer/core/frame.h"
 #include "renderer/embree/ray_access.h"
 #include "renderer/sampling/sampling.h"
 
@@ -70,7 +71,11 @@ float triangle_area(const vec3& a, const vec3& b, const vec3& c) {
 }  // namespace
 
 TriangleMesh::TriangleMesh(const MeshDesc& desc, const ShapeContext& ctx)
-    : positions_(desc.positions), indices_(desc.indices), normals_(desc.normals), uvs_(desc.uvs) {
+    : positions_(desc.positions),
+      indices_(desc.indices),
+      normals_(desc.normals),
+      uvs_(desc.uvs),
+      need_uv_(ctx.need_uv) {
   for (vec3& p : positions_) p += ctx.offset;
   const size_t n = indices_.size() / 3;
   std::vector<float> areas(n);
@@ -145,23 +150,6 @@ EmbreeGeometry TriangleMesh::make_geometry(RTCDevice device) const {
   return geom;
 }
 
-bool TriangleMesh::ahead_of_ray(uint32_t prim, const vec3& o, const vec3& d, float time) const {
-  const uint32_t* tri = indices_.data() + size_t(prim) * 3;
-  // The same float vertices hit_geometry rebuilds hit points from.
-  vec3 a = positions_[tri[0]], b = positions_[tri[1]], c = positions_[tri[2]];
-  if (time_steps_ > 1) {  // moving (static and shutter-less objects have one step)
-    const vec3 disp = interpolated_displacement(time);
-    a += disp;
-    b += disp;
-    c += disp;
-  }
-  const dvec3 p0(a), normal = glm::cross(dvec3(b) - p0, dvec3(c) - p0);
-  const double num = glm::dot(p0 - dvec3(o), normal);
-  const double den = glm::dot(dvec3(d), normal);
-  // Signs compared, not num * den > 0, which could underflow to 0 in a tiny scene.
-  return (num > 0.0 && den > 0.0) || (num < 0.0 && den < 0.0);
-}
-
 void TriangleMesh::hit_geometry(const Ray& ray, float, uint32_t prim, const vec2& uv,
                                 SurfaceHit* hit) const {
   const vec3 disp = displacement_at(ray.time);
@@ -171,7 +159,7 @@ void TriangleMesh::hit_geometry(const Ray& ray, float, uint32_t prim, const vec2
   const vec3 p2 = positions_[tri[2]] + disp;
   const float b1 = uv.x, b2 = uv.y, b0 = 1.f - b1 - b2;
   barycentric_point(p0, p1, p2, b0, b1, b2, &hit->p, &hit->p_error);
-  hit->uv = uvs_.empty() ? vec2(b1, b2) : b0 * uvs_[tri[0]] + b1 * uvs_[tri[1]] + b2 * uvs_[tri[2]];
+  if (need_uv_) hit->uv = uv_at(tri, b0, b1, b2);
   vec3 ng = glm::cross(p1 - p0, p2 - p0);
   const float len = glm::length(ng);
   ng = len > 0.f ? ng / len : vec3(0.f, 0.f, 1.f);
@@ -184,6 +172,33 @@ void TriangleMesh::hit_geometry(const Ray& ray, float, uint32_t prim, const vec2
       ns /= ls;
       hit->ns = glm::dot(ns, ng) < 0.f ? -ns : ns;
     }
+  }
+}
+
+void TriangleMesh::surface_derivatives(float, SurfaceHit* hit) const {
+  // pbrt-v4 Triangle::InteractionFromIntersection: solve
+  //   [p0 - p2, p1 - p2] = [dp/du, dp/dv] [uv0 - uv2, uv1 - uv2]
+  // for the two derivatives (motion is a translation, so edges need no displacement).
+  const uint32_t* tri = &indices_[size_t(hit->primitive) * 3];
+  const vec3 p0 = positions_[tri[0]], p1 = positions_[tri[1]], p2 = positions_[tri[2]];
+  const vec2 uv0 = uv_at(tri, 1.f, 0.f, 0.f), uv1 = uv_at(tri, 0.f, 1.f, 0.f),
+             uv2 = uv_at(tri, 0.f, 0.f, 1.f);
+  const vec2 duv02 = uv0 - uv2, duv12 = uv1 - uv2;
+  const vec3 dp02 = p0 - p2, dp12 = p1 - p2;
+  const float det = duv02.x * duv12.y - duv02.y * duv12.x;
+  const bool degenerate = !(std::abs(det) >= 1e-9f);
+  if (!degenerate) {
+    const float inv = 1.f / det;
+    hit->dpdu = (duv12.y * dp02 - duv02.y * dp12) * inv;
+    hit->dpdv = (duv02.x * dp12 - duv12.x * dp02) * inv;
+  }
+  // Without a usable parametrisation (uvs that do not span the triangle) any tangent frame of
+  // the geometric normal will do.
+  if (degenerate || !(glm::length(glm::cross(hit->dpdu, hit->dpdv)) > 0.f) || !is_finite(hit->dpdu) ||
+      !is_finite(hit->dpdv)) {
+    const Frame f(hit->ng);
+    hit->dpdu = f.s;
+    hit->dpdv = f.t;
   }
 }
 
@@ -200,6 +215,7 @@ bool TriangleMesh::sample(const vec3& ref, float time, const vec2& u, ShapeSampl
   const vec3 p0 = positions_[tri[0]] + disp, p1 = positions_[tri[1]] + disp,
              p2 = positions_[tri[2]] + disp;
   barycentric_point(p0, p1, p2, 1.f - b.x - b.y, b.x, b.y, &out->p, &out->p_error);
+  out->uv = uv_at(tri, 1.f - b.x - b.y, b.x, b.y);
   const vec3 ng = glm::cross(p1 - p0, p2 - p0);
   const float len = glm::length(ng);
   if (!(len > 0.f)) return false;

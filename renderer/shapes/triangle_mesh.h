@@ -18,6 +18,7 @@ class TriangleMesh : public Shape {
   float area() const override { return area_; }
   void hit_geometry(const Ray& ray, float t, uint32_t prim, const vec2& uv,
                     SurfaceHit* hit) const override;
+  void surface_derivatives(float time, SurfaceHit* hit) const override;
   bool sample(const vec3& ref, float time, const vec2& u, ShapeSample* out) const override;
   float pdf(const vec3& ref, const vec3& p, const vec3& n, float time) const override;
   vec3 reference_point() const override { return positions_[indices_[0]]; }
@@ -29,8 +30,24 @@ class TriangleMesh : public Shape {
     return time_steps_ > 1 ? interpolated_displacement(time) : vec3(0.f);
   }
   // True if the ray (origin o, direction d) meets the plane of triangle `prim` at t > 0,
-  // decided in double precision (see triangle_mesh.cpp).
-  bool ahead_of_ray(uint32_t prim, const vec3& o, const vec3& d, float time) const;
+  // decided in double precision (see triangle_mesh.cpp). Inline: Embree calls it on every
+  // candidate hit, through the filter function.
+  bool ahead_of_ray(uint32_t prim, const vec3& o, const vec3& d, float time) const {
+    const uint32_t* tri = indices_.data() + size_t(prim) * 3;
+    // The same float vertices hit_geometry rebuilds hit points from.
+    vec3 a = positions_[tri[0]], b = positions_[tri[1]], c = positions_[tri[2]];
+    if (time_steps_ > 1) {  // moving (static and shutter-less objects have one step)
+      const vec3 disp = interpolated_displacement(time);
+      a += disp;
+      b += disp;
+      c += disp;
+    }
+    const dvec3 p0(a), normal = glm::cross(dvec3(b) - p0, dvec3(c) - p0);
+    const double num = glm::dot(p0 - dvec3(o), normal);
+    const double den = glm::dot(dvec3(d), normal);
+    // Signs compared, not num * den > 0, which could underflow to 0 in a tiny scene.
+    return (num > 0.0 && den > 0.0) || (num < 0.0 && den < 0.0);
+  }
 
  protected:
   // For shapes made of triangles that keep their own area and sampling (quads).
@@ -38,6 +55,10 @@ class TriangleMesh : public Shape {
 
  private:
   vec3 interpolated_displacement(float time) const;
+  // The uv of barycentric point (b0, b1, b2) of triangle `tri`: interpolated uvs, or (b1, b2).
+  vec2 uv_at(const uint32_t* tri, float b0, float b1, float b2) const {
+    return uvs_.empty() ? vec2(b1, b2) : b0 * uvs_[tri[0]] + b1 * uvs_[tri[1]] + b2 * uvs_[tri[2]];
+  }
 
   std::vector<vec3> positions_;  // world space at time 0
   std::vector<uint32_t> indices_;
@@ -50,6 +71,7 @@ class TriangleMesh : public Shape {
   // the displacement at each (all vertices share it: motion is rigid).
   int time_steps_ = 1;
   std::vector<vec3> step_displacement_;
+  bool need_uv_ = false;  // something reads SurfaceHit::uv (ShapeContext::need_uv)
 };
 
 }  // namespace penumbra
