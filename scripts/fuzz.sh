@@ -4,6 +4,7 @@
 #   scene_loader  api::load_scene (plus Scene::build and a 4x4 render of valid scenes)
 #   ply_reader    renderer/io/ply_reader (our own PLY parser)
 #   obj_reader    renderer/io/obj_reader (screening + tinyobjloader)
+#   http_head     the HTTP service's head-line checks and Range decisions (server/http)
 #   scripts/fuzz.sh [SECONDS] [TARGET...]     (default 60 seconds, all targets)
 # Builds with clang in build-fuzz/. Fails (non-zero) on any crash, sanitizer report, leak,
 # timeout (an input taking more than 10 s) or out-of-memory (2 GB). Crash reproducers are left
@@ -13,7 +14,7 @@ set -euo pipefail
 seconds="${1:-60}"
 shift || true
 targets=("$@")
-if [ ${#targets[@]} -eq 0 ]; then targets=(scene_loader ply_reader obj_reader); fi
+if [ ${#targets[@]} -eq 0 ]; then targets=(scene_loader ply_reader obj_reader http_head); fi
 root="$(cd "$(dirname "$0")/.." && pwd)"
 build="$root/build-fuzz"
 jobs="${JOBS:-2}"
