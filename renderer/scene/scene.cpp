@@ -33,8 +33,14 @@ bool Scene::intersect(const Ray& ray, SurfaceHit* hit) const {
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
 
   hit->t = rh.ray.tfar;
-  hit->object = rh.hit.geomID;
   hit->primitive = rh.hit.primID;
+  if (rh.hit.instID[0] != RTC_INVALID_GEOMETRY_ID) {  // a copy: geomID is the mesh's id in it
+    const Instance& copy = instances_[rh.hit.instID[0] - objects_.size()];
+    hit->object = copy.object();
+    copy.hit_geometry(ray, hit->t, rh.hit.primID, vec2(rh.hit.u, rh.hit.v), hit);
+    return true;
+  }
+  hit->object = rh.hit.geomID;
   objects_[rh.hit.geomID].shape->hit_geometry(ray, hit->t, rh.hit.primID, vec2(rh.hit.u, rh.hit.v),
                                               hit);
   return true;

@@ -10,6 +10,7 @@
 
 #include "renderer/materials/material_params.h"
 #include "renderer/core/math.h"
+#include "renderer/scene/instance_input.h"
 
 namespace penumbra {
 
@@ -84,6 +85,7 @@ struct SceneInput {
   std::vector<MaterialParams> materials;
   std::vector<ObjectDesc> objects;
   std::vector<LightDesc> lights;
+  std::vector<InstancesDesc> instances;  // copies of mesh objects (instance_input.h)
 };
 
 enum class IntegratorKind { kPath, kDistributed };
