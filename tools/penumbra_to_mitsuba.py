@@ -19,6 +19,11 @@ The conversion keeps every semantic of the format (issue 2, docs/accuracy.md has
   lat-long convention (:func:`convert_environment`). Mitsuba finds the file through its file
   resolver, to which :func:`use_scene_folder` adds the scene's folder.
 
+* an ``instances`` object becomes a ``shapegroup`` holding the mesh it names (converted as that
+  object is, its own ``transform`` included) and one ``instance`` per transform, whose
+  ``to_world`` is that transform: both apply the copy's transform after the mesh's own
+  (:func:`convert_instances`). The mesh is also converted where it stands, as penumbra draws it.
+
 Mitsuba 3.9 has no moving shapes. :func:`to_mitsuba` therefore builds the scene at one instant
 ``time``; a motion-blurred reference is the average of renders at many instants spread over the
 shutter (see :func:`shutter_instants` and tools/make_references.py).
@@ -381,6 +386,25 @@ def resolve_mesh_files(scene: dict, folder: str) -> dict:
     return scene
 
 
+def convert_instances(mi, index: int, obj: dict, objects: list, materials: dict, time: float,
+                      out: dict) -> None:
+    """Add a penumbra ``instances`` object to the scene dictionary ``out``: the shape group of the
+    mesh it names (once per mesh) and an ``instance`` of it per transform.
+
+    Penumbra refuses copies of emitting meshes, and Mitsuba's shape groups cannot hold emitters,
+    so the group's shape has none. The group holds a second conversion of the mesh (the first is
+    drawn where it stands): one Mitsuba shape cannot belong to two parents.
+    """
+    mesh_index = int(obj["mesh"])
+    group = f"group{mesh_index}"
+    if group not in out:
+        out[group] = {"type": "shapegroup",
+                      "shape": convert_object(mi, mesh_index, objects[mesh_index], materials, time)}
+    for k, transform in enumerate(obj["transforms"]):
+        out[f"object{index}_{k}"] = {"type": "instance", "shapegroup": {"type": "ref", "id": group},
+                                     "to_world": mi.ScalarTransform4f(object_matrix(transform))}
+
+
 def instantiate(mi, children: dict) -> dict:
     """Load plugin dictionaries into objects (what a Mesh's Properties need)."""
     return {key: mi.load_dict(value) for key, value in children.items()}
@@ -480,8 +504,12 @@ def to_mitsuba(mi, scene: dict, time: float = 0.0, spp: int | None = None,
         "sensor": convert_sensor(mi, scene, spp or render.get("spp", 64), width, height),
     }
     materials = scene.get("materials", {})
-    for i, obj in enumerate(scene.get("objects", [])):
-        out[f"object{i}"] = convert_object(mi, i, obj, materials, time)
+    objects = scene.get("objects", [])
+    for i, obj in enumerate(objects):
+        if obj.get("type") == "instances":
+            convert_instances(mi, i, obj, objects, materials, time, out)
+        else:
+            out[f"object{i}"] = convert_object(mi, i, obj, materials, time)
     for i, light in enumerate(scene.get("lights", [])):
         out[f"light{i}"] = convert_light(light)
     environment = convert_environment(mi, scene.get("environment"))

@@ -24,6 +24,9 @@ mesh_files     mesh files: a binary PLY blob with vertex normals and uvs (smooth
 kitchen_sink   depth of field + motion blur + absorbing rough glass + every light kind
 environment_map glossy and rough-glass spheres under an HDR sky with a small bright sun
                (sky_sun.hdr, made by tools/make_sky.py), scaled and rotated
+instances      a smooth-shaded lumpy mesh and copies of it placed by an ``instances`` object
+               (rotated, non-uniformly scaled and sheared, mirrored), and a cube copied by a
+               second one; Mitsuba renders them with ``shapegroup`` + ``instance``
 =============  ==============================================================================
 """
 from __future__ import annotations
@@ -450,9 +453,37 @@ def environment_map() -> dict:
     }
 
 
+def instances() -> dict:
+    """Copies of two meshes by ``instances`` objects. The blob has vertex normals, so the copies'
+    shading normals (inverse transpose under shear and non-uniform scale) reach the image; one
+    copy is mirrored (negative determinant: its front side turns inside out, which opaque,
+    two-sided materials do not see, so Mitsuba's instance, which keeps it, agrees)."""
+    unit, tris = icosphere(3)
+    x, y, z = unit[:, 0], unit[:, 1], unit[:, 2]
+    positions = unit * (1 + 0.15 * np.sin(3 * x + 1) * np.cos(2 * y) + 0.1 * np.sin(4 * z))[:, None]
+    cube_p, cube_i = cube_mesh()
+    shear = [[1.1, 0.5, 0, -1.31], [0, 0.8, 0, 0.044], [0, 0, 0.9, 0.125], [0, 0, 0, 1]]
+    mirror = [[-0.9, 0, 0, 1.2], [0, 0.9, 0, 0.03], [0, 0, 0.9, 0.1], [0, 0, 0, 1]]
+    return floor_scene(
+        [mesh(positions, tris, "coat", normals=vertex_normals(positions, tris), digits=5,
+              transform=transform([0.3, 0.3, 0.3], [0, 1, 0], 30, [0, 0.32, 0.25])),
+         {"type": "instances", "mesh": 3, "transforms": [
+             {"translate": [-0.6, 0.0, -0.55]},
+             {"rotate": {"axis": [1, 1, 0], "degrees": 50}, "translate": [0.457, 0.293, -0.684]},
+             {"matrix": [v for row in shear for v in row]},
+             {"matrix": [v for row in mirror for v in row]}]},
+         mesh(cube_p, cube_i, "metal", transform=transform([0.25, 0.25, 0.25], [0, 1, 0], 20, [-0.3, 0.125, 0.9])),
+         {"type": "instances", "mesh": 5, "transforms": [
+             {"rotate": {"axis": [0, 1, 0], "degrees": 25}, "translate": [0.14, 0, -0.02]},
+             {"scale": [1, 2.2, 1], "translate": [1.05, 0, -0.1]}]}],
+        {"coat": {"type": "plastic", "color": [0.7, 0.3, 0.12], "ior": 1.5, "roughness": 0.3},
+         "metal": {"type": "conductor", "color": [0.85, 0.85, 0.9], "roughness": 0.3}},
+        width=96, height=72, max_depth=6, cam_pos=(0, 1.3, 3.8), look=(0, 0.45, 0), fov=38)
+
+
 SCENES = {f.__name__: f for f in (cornell, glass_smooth, glass_rough, furnace, conductors, plastics,
                                   dof, motion_blur, all_lights, mesh_100k, mesh_files, kitchen_sink,
-                                  environment_map)}
+                                  environment_map, instances)}
 
 
 def write(name: str, scene: dict) -> str:
@@ -468,7 +499,10 @@ def write(name: str, scene: dict) -> str:
 
 
 def main() -> None:
-    for name, make in SCENES.items():
+    import sys
+    names = sys.argv[1:] or list(SCENES)  # e.g. ``make_scenes.py instances``: only that one
+    for name in names:
+        make = SCENES[name]
         path = write(name, make())
         print(f"{path}: {os.path.getsize(path) / 1e3:.0f} kB")
 
