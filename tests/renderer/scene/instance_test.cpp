@@ -80,7 +80,7 @@ struct Pair {
 
 // Material 0: the mesh and its copies; the hand-made copies get material k + 1 (the same
 // parameters), so a test can tell which copy a hit is on.
-Pair make_pair(const MeshDesc& mesh, const std::vector<InstanceTransform>& transforms,
+Pair scene_pair(const MeshDesc& mesh, const std::vector<InstanceTransform>& transforms,
                const vec3& velocity = vec3(0.f)) {
   Pair p;
   SceneInput base;
@@ -119,17 +119,19 @@ vec3 random_target(std::mt19937& rng, const std::vector<InstanceTransform>& tran
 
 TEST(InstanceBuild, CountsCopiesAndBoundsCoverThem) {
   const auto transforms = varied_transforms();
-  const Pair p = make_pair(faceted_sphere(vec3(0.f), 1.f, true), transforms);
+  const Pair p = scene_pair(faceted_sphere(vec3(0.f), 1.f, true), transforms);
   const auto scene = Scene::build(p.instanced);
   ASSERT_EQ(scene->object_count(), 1u);
   ASSERT_EQ(scene->instance_count(), transforms.size());
   const auto reference = Scene::build(p.by_hand);
-  // The same world bounds as the copies written out (up to rounding of the transformed corners).
+  // The bounds cover the copies written out: a copy's are its mesh's box transformed, so a
+  // rotated copy's reach a little further than its own vertices (at most a factor sqrt(3) of
+  // the copies' extent here, which is below 2).
   for (int i = 0; i < 3; ++i) {
-    EXPECT_NEAR(scene->bounds().lo[i], reference->bounds().lo[i], 0.05f) << i;
-    EXPECT_NEAR(scene->bounds().hi[i], reference->bounds().hi[i], 0.05f) << i;
-    EXPECT_LE(scene->bounds().lo[i], reference->bounds().lo[i] + 1e-5f);
-    EXPECT_GE(scene->bounds().hi[i], reference->bounds().hi[i] - 1e-5f);
+    EXPECT_LE(scene->bounds().lo[i], reference->bounds().lo[i]) << i;
+    EXPECT_GE(scene->bounds().hi[i], reference->bounds().hi[i]) << i;
+    EXPECT_GT(scene->bounds().lo[i], reference->bounds().lo[i] - 1.5f) << i;
+    EXPECT_LT(scene->bounds().hi[i], reference->bounds().hi[i] + 1.5f) << i;
   }
 }
 
@@ -179,15 +181,24 @@ void check_same_hits(const Pair& p, const std::vector<InstanceTransform>& transf
     }
     ++both;
     EXPECT_EQ(ha.object, 0u);
-    const float scale = 1.f + glm::length(hb.p);
-    ASSERT_NEAR(ha.t, hb.t, 2e-5f * (ha.t + 1.f)) << "copy " << copy_b;
+    // Embree intersects the copy in its own space, so its barycentrics round differently; the
+    // difference grows as the ray grazes the triangle (1 / |cos|).
+    const float grazing = 1.f / std::max(std::abs(glm::dot(dir, hb.ng)), 0.01f);
+    const float scale = (1.f + glm::length(hb.p)) * grazing;
+    ASSERT_NEAR(ha.t, hb.t, 2e-5f * (ha.t + 1.f) * grazing) << "copy " << copy_b;
     ASSERT_LT(glm::length(ha.p - hb.p), 2e-5f * scale) << "copy " << copy_b;
     ASSERT_GT(glm::dot(ha.ng, hb.ng), 0.99999f) << "copy " << copy_b;
-    // Shading normals: the copy interpolates and then transforms, the hand-made mesh transforms
-    // each vertex normal and then interpolates; under non-uniform scale they differ slightly.
-    ASSERT_GT(glm::dot(ha.ns, hb.ns), 0.999f) << "copy " << copy_b;
-    ASSERT_NEAR(ha.uv.x, hb.uv.x, 1e-5f);
-    ASSERT_NEAR(ha.uv.y, hb.uv.y, 1e-5f);
+    // Shading normals: the copy interpolates and then transforms (as pbrt-v4 and Mitsuba 3
+    // instances do), the hand-made mesh transforms each vertex normal and then interpolates.
+    // Under a rotation, uniform scale or mirror the two are the same; under the sheared,
+    // non-uniform copy (object 3 here) they differ by the curvature within a triangle.
+    const glm::mat3 m = copy_b == 0 ? glm::mat3(1.f) : transforms[copy_b - 1].linear;
+    const glm::mat3 gram = glm::transpose(m) * m;
+    const bool similarity = std::abs(gram[0][1]) + std::abs(gram[0][2]) + std::abs(gram[1][2]) < 1e-5f &&
+                            std::abs(gram[0][0] - gram[1][1]) + std::abs(gram[0][0] - gram[2][2]) < 1e-5f;
+    ASSERT_GT(glm::dot(ha.ns, hb.ns), similarity ? 0.99999f : 0.99f) << "copy " << copy_b;
+    ASSERT_NEAR(ha.uv.x, hb.uv.x, 2e-5f * grazing);
+    ASSERT_NEAR(ha.uv.y, hb.uv.y, 2e-5f * grazing);
   }
   EXPECT_GT(both, 5000);
   EXPECT_LE(disagree, both / 1000) << "of " << both;
@@ -195,14 +206,14 @@ void check_same_hits(const Pair& p, const std::vector<InstanceTransform>& transf
 
 TEST(InstanceIntersect, MatchesTheMeshTransformedByHand) {
   const auto transforms = varied_transforms();
-  check_same_hits(make_pair(faceted_sphere(vec3(0.1f, -0.2f, 0.f), 1.f, true), transforms), transforms,
+  check_same_hits(scene_pair(faceted_sphere(vec3(0.1f, -0.2f, 0.f), 1.f, true), transforms), transforms,
                   0.f);
 }
 
 TEST(InstanceIntersect, MatchesByHandForAMovingMesh) {
   const auto transforms = varied_transforms();
   for (float time : {0.f, 0.35f, 1.f})
-    check_same_hits(make_pair(faceted_sphere(vec3(0.f), 1.f, true), transforms, vec3(0.4f, -0.2f, 0.1f)),
+    check_same_hits(scene_pair(faceted_sphere(vec3(0.f), 1.f, true), transforms, vec3(0.4f, -0.2f, 0.1f)),
                     transforms, time);
 }
 
@@ -214,7 +225,7 @@ TEST(InstanceIntersect, HitPointWithinItsErrorBound) {
     std::vector<InstanceTransform> transforms = varied_transforms();
     for (auto& t : transforms) t.translation += vec3(far);
     const MeshDesc mesh = faceted_sphere(vec3(0.f), 1.f, false);
-    Pair p = make_pair(mesh, transforms);
+    Pair p = scene_pair(mesh, transforms);
     p.instanced.camera = camera_looking(vec3(far) + vec3(0, 0, 9), vec3(far), 40.f);
     const auto scene = Scene::build(p.instanced);
     std::mt19937 rng(5);
@@ -225,17 +236,22 @@ TEST(InstanceIntersect, HitPointWithinItsErrorBound) {
       const vec3 target = random_target(rng, transforms);
       SurfaceHit hit;
       if (!scene->intersect(Ray{target - 12.f * dir, dir, 0.f}, &hit)) continue;
-      // Which copy: the nearest centre.
-      size_t best = 0;
-      for (size_t k = 1; k < transforms.size(); ++k)
-        if (glm::length(hit.p - transforms[k].translation) < glm::length(hit.p - transforms[best].translation))
-          best = k;
-      if (glm::length(hit.p - transforms[best].translation) > 3.f) continue;  // the mesh itself
       const uint32_t* tri = &mesh.indices[3 * hit.primitive];
-      const double b1 = hit.uv.x, b2 = hit.uv.y, b0 = 1.0 - b1 - b2;
+      // b0 as the mesh computes it, in float: the bound is that of the sum (pbrt-v4 6.8.4).
+      const double b1 = hit.uv.x, b2 = hit.uv.y, b0 = 1.f - hit.uv.x - hit.uv.y;
       const dvec3 local = b0 * dvec3(mesh.positions[tri[0]]) + b1 * dvec3(mesh.positions[tri[1]]) +
                           b2 * dvec3(mesh.positions[tri[2]]);
-      const dvec3 exact = glm::dmat3(transforms[best].linear) * local + dvec3(transforms[best].translation);
+      // Which copy (or the mesh itself, transform -1): the one whose exact point is nearest.
+      int best = -1;
+      dvec3 exact = local;
+      for (size_t k = 0; k < transforms.size(); ++k) {
+        const dvec3 q = glm::dmat3(transforms[k].linear) * local + dvec3(transforms[k].translation);
+        if (glm::length(q - dvec3(hit.p)) < glm::length(exact - dvec3(hit.p))) {
+          best = int(k);
+          exact = q;
+        }
+      }
+      if (best < 0) continue;  // the mesh itself: not a copy
       for (int c = 0; c < 3; ++c)
         ASSERT_LE(std::abs(double(hit.p[c]) - exact[c]), double(hit.p_error[c]))
             << "copy " << best << " component " << c;
@@ -263,7 +279,7 @@ TEST_P(InstanceSpawn, NoSelfHits) {
   std::vector<InstanceTransform> transforms;
   for (const InstanceTransform& t : varied_transforms())
     transforms.push_back(InstanceTransform{t.linear * c.scale, t.translation * c.scale * 3.f + c.offset});
-  const Pair p = make_pair(faceted_sphere(vec3(0.f), 1.f, false), transforms,
+  const Pair p = scene_pair(faceted_sphere(vec3(0.f), 1.f, false), transforms,
                            c.moving ? vec3(0.3f, 0.1f, 0.f) : vec3(0.f));
   SceneInput in = p.instanced;
   in.camera = camera_looking(c.offset + vec3(0, 0, 30) * c.scale, c.offset, 40.f);
@@ -309,14 +325,20 @@ INSTANTIATE_TEST_SUITE_P(
 // flips a decision, so the images agree to far below their noise.
 TEST(InstanceRender, SameImageAsCopiesWrittenOut) {
   const auto transforms = varied_transforms();
-  Pair p = make_pair(faceted_sphere(vec3(0.f), 1.f, true), transforms);
+  // Flat shaded (no vertex normals), so that even the sheared copy shades exactly as written
+  // out; shading normals are compared in MatchesTheMeshTransformedByHand.
+  MeshDesc mesh = faceted_sphere(vec3(0.f), 1.f, true);
+  mesh.normals.clear();
+  Pair p = scene_pair(mesh, transforms);
   for (SceneInput* in : {&p.instanced, &p.by_hand}) {
     in->materials[0] = PlasticParams{};
     in->materials.push_back(DiffuseParams{});
     ObjectDesc light = quad_object({-2, 4, -2}, {4, 0, 0}, {0, 0, 4}, uint32_t(in->materials.size() - 1));
     light.emission = Spectrum(4.f);
     in->objects.push_back(light);
-    in->environment = Spectrum(0.2f);
+    // No environment: its share in light selection follows the scene's bounds, which for a copy
+    // are its mesh's box transformed, a little wider than the copy written out. That changes
+    // the noise (both are unbiased), not what this test compares.
   }
   for (size_t k = 1; k <= transforms.size(); ++k) p.by_hand.materials[k] = PlasticParams{};
   const RenderSettings s = small_settings(48, 48, 16, 6);
@@ -365,7 +387,7 @@ TEST(InstanceMemory, CopiesCostBytesNotTheMesh) {
     ObjectDesc o;
     o.shape = mesh;
     in.objects = {o};
-    std::vector<InstanceTransform> t(size_t(copies));
+    std::vector<InstanceTransform> t(static_cast<size_t>(copies));
     for (int k = 0; k < copies; ++k) t[size_t(k)].translation = vec3(float(k % 200) * 3.f, float(k / 200) * 3.f, 0.f);
     in.instances = {InstancesDesc{0, t}};
     return in;
