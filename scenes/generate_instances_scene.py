@@ -24,9 +24,10 @@ def copies():
                 "scale": [s, round(s * stretch, 4), s] if stretch != 1.0 else round(s, 4),
                 "rotate": {"axis": [round(rng.uniform(-0.4, 0.4), 3), 1, round(rng.uniform(-0.4, 0.4), 3)],
                            "degrees": round(rng.uniform(0, 360), 1)},
-                # The mesh stands at y = 0.6 (its own transform); the copy's scale and tilt move
-                # that point, so lift each copy by what its scale took away.
-                "translate": [round(radius * math.sin(angle), 4), round(0.6 * (1 - s * stretch) * 0.8, 4),
+                # Copies scale and turn the mesh where it stands (its lowest point just below
+                # the floor, at y = -0.07), about the world origin on the floor: lift each by
+                # what is left of that dip.
+                "translate": [round(radius * math.sin(angle), 4), round(0.07 * s * stretch + 0.02, 4),
                               round(-radius * math.cos(angle), 4)],
             })
     for c in out:
@@ -49,7 +50,7 @@ def scene():
             "light": {"type": "diffuse", "color": [0, 0, 0]},
         },
         "objects": [
-            {"type": "quad", "origin": [-8, 0, 6], "u": [16, 0, 0], "v": [0, 0, -16], "material": "floor"},
+            {"type": "quad", "origin": [-12, 0, 6], "u": [24, 0, 0], "v": [0, 0, -30], "material": "floor"},
             {"type": "quad", "origin": [-1.5, 4.5, -1.0], "u": [3, 0, 0], "v": [0, 0, 2],
              "material": "light", "emission": [6, 6, 6]},
             {"type": "mesh", "file": "meshes/trefoil.ply", "material": "glaze",
