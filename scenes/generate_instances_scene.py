@@ -41,7 +41,7 @@ def copies():
 def scene():
     return {
         "version": 1,
-        "render": {"width": 320, "height": 200, "spp": 64, "max_depth": 8, "integrator": "path"},
+        "render": {"width": 256, "height": 160, "spp": 64, "max_depth": 8, "integrator": "path"},
         "camera": {"position": [0, 3.4, 6.4], "look_at": [0, 0.3, 0], "fov": 40},
         "environment": {"radiance": [0.12, 0.13, 0.16]},
         "materials": {
