@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # Memory and time of instancing: one 100k-triangle mesh (a binary PLY, generated here) and an
 # "instances" object placing COPIES copies of it (default 1000: 100 million triangles drawn),
-# rendered by `penumbra render` under /usr/bin/time. Reports peak resident memory and wall time,
-# next to the same scene with the mesh alone (no copies), so the cost of the copies shows apart
-# from the mesh's and the process's own. Exits 1 if the peak exceeds LIMIT_MB (default 1024).
+# rendered by `penumbra render` under /usr/bin/time. Reports peak resident memory and wall time
+# of the mesh alone, with COPIES copies and with 10 x COPIES copies; the cost of one more copy is
+# the difference of the last two over 9 x COPIES (the first copy also brings the mesh's second
+# BVH, its child scene). Exits 1 if the peak with COPIES copies exceeds LIMIT_MB (default 1024).
 #
 #   bench/instancing_benchmark.sh [PENUMBRA_BINARY] [COPIES] [SPP] [LIMIT_MB]
 #   defaults: build/app/penumbra 1000 16 1024
@@ -64,19 +65,27 @@ def scene(n):
                        + ([{"type": "instances", "mesh": 0, "transforms": transforms[:n]}] if n else [])}
 json.dump(scene(copies), open(f"{work}/instances.json", "w"))
 json.dump(scene(0), open(f"{work}/mesh_alone.json", "w"))
+transforms = [{"rotate": {"axis": [0, 1, 0], "degrees": (37 * k) % 360},
+               "translate": [3.2 * (k % side - side / 2), 3.2 * (k // (side * side)), -3.2 * ((k // side) % side)]}
+              for k in range(10 * copies)]
+json.dump(scene(10 * copies), open(f"{work}/instances_x10.json", "w"))
 PY
 
-measure() {  # scene -> "peak_kb wall_s"
-  /usr/bin/time -f "%M %e" -o "$work/time.txt" "$bin" render "$work/$1" -o "$work/$1.exr" >/dev/null 2>&1
-  cat "$work/time.txt"
+measure() {  # scene -> "peak_kb wall_s summary-line"
+  /usr/bin/time -f "%M %e" -o "$work/time.txt" "$bin" render "$work/$1" -o "$work/$1.exr" 2>"$work/err.txt" >/dev/null
+  echo "$(cat "$work/time.txt") $(grep -o '[0-9.]* Mrays/s' "$work/err.txt" | tail -1)"
 }
 "$bin" info "$work/instances.json" | sed 's/^/  /'
-read -r alone_kb alone_s < <(measure mesh_alone.json)
-read -r inst_kb inst_s < <(measure instances.json)
-printf 'mesh alone (100k triangles):            peak RSS %7.1f MB, wall %6.2f s\n' "$(echo "$alone_kb / 1024" | bc -l)" "$alone_s"
-printf 'mesh + %d copies (%d M triangles): peak RSS %7.1f MB, wall %6.2f s\n' "$copies" "$(( (copies + 1) / 10 ))" "$(echo "$inst_kb / 1024" | bc -l)" "$inst_s"
-printf 'per copy: %.0f bytes of peak RSS\n' "$(echo "($inst_kb - $alone_kb) * 1024 / $copies" | bc -l)"
+read -r alone_kb alone_s alone_rays _ < <(measure mesh_alone.json)
+read -r inst_kb inst_s inst_rays _ < <(measure instances.json)
+read -r ten_kb ten_s ten_rays _ < <(measure instances_x10.json)
+mb() { echo "$1 / 1024" | bc -l; }
+printf '%-34s peak RSS %7.1f MB, wall %6.2f s, %s Mrays/s\n' "mesh alone (100k triangles):" "$(mb "$alone_kb")" "$alone_s" "$alone_rays"
+printf '%-34s peak RSS %7.1f MB, wall %6.2f s, %s Mrays/s\n' "mesh + $copies copies:" "$(mb "$inst_kb")" "$inst_s" "$inst_rays"
+printf '%-34s peak RSS %7.1f MB, wall %6.2f s, %s Mrays/s\n' "mesh + $((10 * copies)) copies:" "$(mb "$ten_kb")" "$ten_s" "$ten_rays"
+printf 'first copy and child BVH: %.1f MB; each further copy: %.0f bytes of peak RSS\n' \
+  "$(echo "($inst_kb - $alone_kb) / 1024" | bc -l)" "$(echo "($ten_kb - $inst_kb) * 1024 / (9 * $copies)" | bc -l)"
 if (( inst_kb > limit_mb * 1024 )); then
-  echo "FAIL: peak RSS above ${limit_mb} MB"
+  echo "FAIL: peak RSS above ${limit_mb} MB with $copies copies"
   exit 1
 fi
