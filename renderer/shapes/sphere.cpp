@@ -19,43 +19,53 @@ void sphere_bounds_fn(const RTCBoundsFunctionArguments* args) {
   out->upper_z = b.hi.z;
 }
 
-void sphere_intersect_fn(const RTCIntersectFunctionNArguments* args) {
+// One ray of a packet of kN (0: the packet's run-time width). rtcIntersect1/rtcOccluded1 call
+// with N = 1, for which the RTCRayN accessors fold to plain fields once N is a constant.
+template <unsigned kN>
+inline void sphere_intersect_one(const RTCIntersectFunctionNArguments* args, unsigned i) {
+  const unsigned n = kN ? kN : args->N;
+  if (args->valid[i] == 0) return;
   const auto& sphere = *static_cast<const Sphere*>(args->geometryUserPtr);
-  RTCRayHitN* rayhit = args->rayhit;
-  RTCRayN* ray = RTCRayHitN_RayN(rayhit, args->N);
-  RTCHitN* hit = RTCRayHitN_HitN(rayhit, args->N);
-  for (unsigned i = 0; i < args->N; ++i) {
-    if (args->valid[i] == 0) continue;
-    const vec3 o = embree_ray_origin(ray, args->N, i), d = embree_ray_direction(ray, args->N, i);
-    const float t_near = RTCRayN_tnear(ray, args->N, i);
-    float& t_far = RTCRayN_tfar(ray, args->N, i);
-    const vec3 c = sphere.center_at(RTCRayN_time(ray, args->N, i));
-    const float t = intersect_sphere(c, sphere.radius(), o, d, t_far);
-    if (t <= t_near) continue;
-    t_far = t;
-    const vec3 n = o + t * d - c;
-    RTCHitN_Ng_x(hit, args->N, i) = n.x;
-    RTCHitN_Ng_y(hit, args->N, i) = n.y;
-    RTCHitN_Ng_z(hit, args->N, i) = n.z;
-    RTCHitN_u(hit, args->N, i) = 0.f;
-    RTCHitN_v(hit, args->N, i) = 0.f;
-    RTCHitN_primID(hit, args->N, i) = args->primID;
-    RTCHitN_geomID(hit, args->N, i) = args->geomID;
-    RTCHitN_instID(hit, args->N, i, 0) = args->context->instID[0];
-  }
+  RTCRayN* ray = RTCRayHitN_RayN(args->rayhit, n);
+  RTCHitN* hit = RTCRayHitN_HitN(args->rayhit, n);
+  const vec3 o = embree_ray_origin(ray, n, i), d = embree_ray_direction(ray, n, i);
+  float& t_far = RTCRayN_tfar(ray, n, i);
+  const vec3 c = sphere.center_at(RTCRayN_time(ray, n, i));
+  const float t = intersect_sphere(c, sphere.radius(), o, d, t_far);
+  if (t <= RTCRayN_tnear(ray, n, i)) return;
+  t_far = t;
+  const vec3 ng = o + t * d - c;
+  RTCHitN_Ng_x(hit, n, i) = ng.x;
+  RTCHitN_Ng_y(hit, n, i) = ng.y;
+  RTCHitN_Ng_z(hit, n, i) = ng.z;
+  RTCHitN_u(hit, n, i) = 0.f;
+  RTCHitN_v(hit, n, i) = 0.f;
+  RTCHitN_primID(hit, n, i) = args->primID;
+  RTCHitN_geomID(hit, n, i) = args->geomID;
+  RTCHitN_instID(hit, n, i, 0) = args->context->instID[0];
+}
+
+void sphere_intersect_fn(const RTCIntersectFunctionNArguments* args) {
+  if (args->N == 1) return sphere_intersect_one<1>(args, 0);
+  for (unsigned i = 0; i < args->N; ++i) sphere_intersect_one<0>(args, i);
+}
+
+template <unsigned kN>
+inline void sphere_occluded_one(const RTCOccludedFunctionNArguments* args, unsigned i) {
+  const unsigned n = kN ? kN : args->N;
+  if (args->valid[i] == 0) return;
+  const auto& sphere = *static_cast<const Sphere*>(args->geometryUserPtr);
+  RTCRayN* ray = args->ray;
+  const vec3 o = embree_ray_origin(ray, n, i), d = embree_ray_direction(ray, n, i);
+  float& t_far = RTCRayN_tfar(ray, n, i);
+  const vec3 c = sphere.center_at(RTCRayN_time(ray, n, i));
+  const float t = intersect_sphere(c, sphere.radius(), o, d, t_far);
+  if (t > RTCRayN_tnear(ray, n, i)) t_far = -kInfinity;
 }
 
 void sphere_occluded_fn(const RTCOccludedFunctionNArguments* args) {
-  const auto& sphere = *static_cast<const Sphere*>(args->geometryUserPtr);
-  RTCRayN* ray = args->ray;
-  for (unsigned i = 0; i < args->N; ++i) {
-    if (args->valid[i] == 0) continue;
-    const vec3 o = embree_ray_origin(ray, args->N, i), d = embree_ray_direction(ray, args->N, i);
-    float& t_far = RTCRayN_tfar(ray, args->N, i);
-    const vec3 c = sphere.center_at(RTCRayN_time(ray, args->N, i));
-    const float t = intersect_sphere(c, sphere.radius(), o, d, t_far);
-    if (t > RTCRayN_tnear(ray, args->N, i)) t_far = -kInfinity;
-  }
+  if (args->N == 1) return sphere_occluded_one<1>(args, 0);
+  for (unsigned i = 0; i < args->N; ++i) sphere_occluded_one<0>(args, i);
 }
 
 }  // namespace

@@ -70,7 +70,11 @@ float triangle_area(const vec3& a, const vec3& b, const vec3& c) {
 }  // namespace
 
 TriangleMesh::TriangleMesh(const MeshDesc& desc, const ShapeContext& ctx)
-    : positions_(desc.positions), indices_(desc.indices), normals_(desc.normals), uvs_(desc.uvs) {
+    : positions_(desc.positions),
+      indices_(desc.indices),
+      normals_(desc.normals),
+      uvs_(desc.uvs),
+      need_uv_(ctx.need_uv) {
   for (vec3& p : positions_) p += ctx.offset;
   const size_t n = indices_.size() / 3;
   std::vector<float> areas(n);
@@ -145,23 +149,6 @@ EmbreeGeometry TriangleMesh::make_geometry(RTCDevice device) const {
   return geom;
 }
 
-bool TriangleMesh::ahead_of_ray(uint32_t prim, const vec3& o, const vec3& d, float time) const {
-  const uint32_t* tri = indices_.data() + size_t(prim) * 3;
-  // The same float vertices hit_geometry rebuilds hit points from.
-  vec3 a = positions_[tri[0]], b = positions_[tri[1]], c = positions_[tri[2]];
-  if (time_steps_ > 1) {  // moving (static and shutter-less objects have one step)
-    const vec3 disp = interpolated_displacement(time);
-    a += disp;
-    b += disp;
-    c += disp;
-  }
-  const dvec3 p0(a), normal = glm::cross(dvec3(b) - p0, dvec3(c) - p0);
-  const double num = glm::dot(p0 - dvec3(o), normal);
-  const double den = glm::dot(dvec3(d), normal);
-  // Signs compared, not num * den > 0, which could underflow to 0 in a tiny scene.
-  return (num > 0.0 && den > 0.0) || (num < 0.0 && den < 0.0);
-}
-
 void TriangleMesh::hit_geometry(const Ray& ray, float, uint32_t prim, const vec2& uv,
                                 SurfaceHit* hit) const {
   const vec3 disp = displacement_at(ray.time);
@@ -171,7 +158,8 @@ void TriangleMesh::hit_geometry(const Ray& ray, float, uint32_t prim, const vec2
   const vec3 p2 = positions_[tri[2]] + disp;
   const float b1 = uv.x, b2 = uv.y, b0 = 1.f - b1 - b2;
   barycentric_point(p0, p1, p2, b0, b1, b2, &hit->p, &hit->p_error);
-  hit->uv = uvs_.empty() ? vec2(b1, b2) : b0 * uvs_[tri[0]] + b1 * uvs_[tri[1]] + b2 * uvs_[tri[2]];
+  if (need_uv_)
+    hit->uv = uvs_.empty() ? vec2(b1, b2) : b0 * uvs_[tri[0]] + b1 * uvs_[tri[1]] + b2 * uvs_[tri[2]];
   vec3 ng = glm::cross(p1 - p0, p2 - p0);
   const float len = glm::length(ng);
   ng = len > 0.f ? ng / len : vec3(0.f, 0.f, 1.f);

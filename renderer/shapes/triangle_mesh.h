@@ -29,8 +29,24 @@ class TriangleMesh : public Shape {
     return time_steps_ > 1 ? interpolated_displacement(time) : vec3(0.f);
   }
   // True if the ray (origin o, direction d) meets the plane of triangle `prim` at t > 0,
-  // decided in double precision (see triangle_mesh.cpp).
-  bool ahead_of_ray(uint32_t prim, const vec3& o, const vec3& d, float time) const;
+  // decided in double precision (see triangle_mesh.cpp). Inline: Embree calls it on every
+  // candidate hit, through the filter function.
+  bool ahead_of_ray(uint32_t prim, const vec3& o, const vec3& d, float time) const {
+    const uint32_t* tri = indices_.data() + size_t(prim) * 3;
+    // The same float vertices hit_geometry rebuilds hit points from.
+    vec3 a = positions_[tri[0]], b = positions_[tri[1]], c = positions_[tri[2]];
+    if (time_steps_ > 1) {  // moving (static and shutter-less objects have one step)
+      const vec3 disp = interpolated_displacement(time);
+      a += disp;
+      b += disp;
+      c += disp;
+    }
+    const dvec3 p0(a), normal = glm::cross(dvec3(b) - p0, dvec3(c) - p0);
+    const double num = glm::dot(p0 - dvec3(o), normal);
+    const double den = glm::dot(dvec3(d), normal);
+    // Signs compared, not num * den > 0, which could underflow to 0 in a tiny scene.
+    return (num > 0.0 && den > 0.0) || (num < 0.0 && den < 0.0);
+  }
 
  protected:
   // For shapes made of triangles that keep their own area and sampling (quads).
@@ -50,6 +66,7 @@ class TriangleMesh : public Shape {
   // the displacement at each (all vertices share it: motion is rigid).
   int time_steps_ = 1;
   std::vector<vec3> step_displacement_;
+  bool need_uv_ = false;  // something reads SurfaceHit::uv (ShapeContext::need_uv)
 };
 
 }  // namespace penumbra

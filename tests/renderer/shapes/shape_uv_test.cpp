@@ -2,21 +2,37 @@
 // interpolated uvs (barycentrics without them).
 #include <gtest/gtest.h>
 
-#include "renderer/scene/scene.h"
+#include "renderer/embree/device.h"
+#include "renderer/shapes/make_shape.h"
 #include "renderer/shapes/sphere.h"
 
 namespace penumbra::test {
 namespace {
 
-SurfaceHit hit_from_above(const ShapeDesc& shape, const vec3& target) {
-  SceneInput in;
-  in.materials = {DiffuseParams{}};
-  ObjectDesc o;
-  o.shape = shape;
-  in.objects = {o};
-  const auto scene = Scene::build(in);
+// Shapes compute their uv only when the scene reads it (ShapeContext::need_uv, set by textured
+// materials): the shape is built with it, put alone in an Embree scene and hit from +z.
+SurfaceHit hit_from_above(const ShapeDesc& desc, const vec3& target, bool need_uv = true) {
+  ShapeContext ctx;
+  ctx.need_uv = need_uv;
+  const auto shape = make_shape(desc, ctx);
+  EmbreeScene scene(rtcNewScene(embree_device()));
+  EmbreeGeometry geom = shape->make_geometry(embree_device());
+  rtcAttachGeometry(scene.get(), geom.get());
+  rtcCommitScene(scene.get());
+  const Ray ray{target + vec3(0.f, 0.f, 5.f), vec3(0.f, 0.f, -1.f), 0.f};
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RTCRayHit rh{};
+  rh.ray.org_x = ray.origin.x, rh.ray.org_y = ray.origin.y, rh.ray.org_z = ray.origin.z;
+  rh.ray.dir_x = ray.direction.x, rh.ray.dir_y = ray.direction.y, rh.ray.dir_z = ray.direction.z;
+  rh.ray.tfar = kInfinity;
+  rh.ray.mask = 0xFFFFFFFFu;
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(scene.get(), &context, &rh);
   SurfaceHit hit;
-  EXPECT_TRUE(scene->intersect(Ray{target + vec3(0.f, 0.f, 5.f), vec3(0.f, 0.f, -1.f), 0.f}, &hit));
+  EXPECT_NE(rh.hit.geomID, RTC_INVALID_GEOMETRY_ID);
+  if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID)
+    shape->hit_geometry(ray, rh.ray.tfar, rh.hit.primID, vec2(rh.hit.u, rh.hit.v), &hit);
   return hit;
 }
 
@@ -63,6 +79,14 @@ TEST(ShapeUv, MeshInterpolatesItsUvsOrGivesBarycentrics) {
   const SurfaceHit mapped = hit_from_above(m, vec3(0.2f, 0.3f, 0.f));
   EXPECT_NEAR(mapped.uv.x, 0.5f + 0.5f * 0.2f, 1e-5f);
   EXPECT_NEAR(mapped.uv.y, 0.5f - 0.5f * 0.3f, 1e-5f);
+}
+
+// Without a reader of uv the mesh skips the interpolation (a hot path): uv keeps its default.
+TEST(ShapeUv, MeshSkipsUvWhenNothingReadsIt) {
+  const MeshDesc m{{vec3(0.f), vec3(1.f, 0.f, 0.f), vec3(0.f, 1.f, 0.f)}, {0, 1, 2}, {}, {}};
+  const SurfaceHit h = hit_from_above(m, vec3(0.2f, 0.3f, 0.f), /*need_uv=*/false);
+  EXPECT_EQ(h.uv, vec2(0.f));
+  EXPECT_NEAR(h.p.x, 0.2f, 1e-5f);
 }
 
 }  // namespace
