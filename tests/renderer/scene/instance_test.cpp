@@ -8,8 +8,10 @@
 #include <random>
 
 #include "renderer/core/frame.h"
+#include "renderer/embree/device.h"
 #include "renderer/sampling/sampling.h"
 #include "renderer/scene/scene.h"
+#include "renderer/shapes/make_shape.h"
 #include "tests/renderer/render/render_test_util.h"
 
 namespace penumbra::test {
@@ -197,6 +199,7 @@ void check_same_hits(const Pair& p, const std::vector<InstanceTransform>& transf
     const bool similarity = std::abs(gram[0][1]) + std::abs(gram[0][2]) + std::abs(gram[1][2]) < 1e-5f &&
                             std::abs(gram[0][0] - gram[1][1]) + std::abs(gram[0][0] - gram[2][2]) < 1e-5f;
     ASSERT_GT(glm::dot(ha.ns, hb.ns), similarity ? 0.99999f : 0.99f) << "copy " << copy_b;
+    // uv: both 0 here (no textures, ShapeContext::need_uv); InstanceHit checks a copy's uv.
     ASSERT_NEAR(ha.uv.x, hb.uv.x, 2e-5f * grazing);
     ASSERT_NEAR(ha.uv.y, hb.uv.y, 2e-5f * grazing);
   }
@@ -217,17 +220,59 @@ TEST(InstanceIntersect, MatchesByHandForAMovingMesh) {
                     transforms, time);
 }
 
-// The rebuilt world point lies within its error bound of the exact point: the float barycentrics
-// (a mesh without uvs reports them as uv) applied in double to the float vertices, then the
-// float transform applied in double.
-TEST(InstanceIntersect, HitPointWithinItsErrorBound) {
+// The copies built at the Embree level as Scene::build builds them, but with the mesh's uv
+// computation on (ShapeContext::need_uv, which a scene sets only for textured materials), so a
+// test sees Embree's barycentrics and the uv a copy reports.
+struct DirectCopies {
+  std::unique_ptr<Shape> mesh;
+  std::vector<Instance> copies;
+  EmbreeScene child, top;
+
+  DirectCopies(const MeshDesc& m, const std::vector<InstanceTransform>& transforms) {
+    ShapeContext ctx;
+    ctx.need_uv = true;
+    mesh = make_shape(m, ctx);
+    const EmbreeGeometry geom = mesh->make_geometry(embree_device());
+    child = make_instanced_scene(embree_device(), geom.get());
+    top = EmbreeScene(rtcNewScene(embree_device()));
+    rtcSetSceneFlags(top.get(), RTC_SCENE_FLAG_ROBUST);
+    for (size_t k = 0; k < transforms.size(); ++k) {
+      copies.emplace_back(*mesh, 0, transforms[k]);
+      const EmbreeGeometry g = copies.back().make_geometry(embree_device(), child.get());
+      rtcAttachGeometryByID(top.get(), g.get(), unsigned(k));
+    }
+    rtcCommitScene(top.get());
+  }
+
+  // The copy hit (or -1), its primitive and barycentrics, and the copy's rebuilt hit.
+  int intersect(const Ray& ray, SurfaceHit* hit, uint32_t* prim, vec2* bary) const {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    RTCRayHit rh{};
+    rh.ray.org_x = ray.origin.x, rh.ray.org_y = ray.origin.y, rh.ray.org_z = ray.origin.z;
+    rh.ray.dir_x = ray.direction.x, rh.ray.dir_y = ray.direction.y, rh.ray.dir_z = ray.direction.z;
+    rh.ray.tfar = kInfinity;
+    rh.ray.mask = 0xFFFFFFFFu;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(top.get(), &context, &rh);
+    if (rh.hit.instID[0] == RTC_INVALID_GEOMETRY_ID) return -1;
+    *prim = rh.hit.primID;
+    *bary = vec2(rh.hit.u, rh.hit.v);
+    copies[rh.hit.instID[0]].hit_geometry(ray, rh.ray.tfar, rh.hit.primID, *bary, hit);
+    return int(rh.hit.instID[0]);
+  }
+};
+
+// The rebuilt world point lies within its error bound of the exact point: Embree's float
+// barycentrics applied in double to the float vertices, then the float transform applied in
+// double. Near the origin and far from it.
+TEST(InstanceHit, PointWithinItsErrorBound) {
   for (const dvec3 far : {dvec3(0.0), dvec3(3e4, -1e4, 2e4)}) {
     std::vector<InstanceTransform> transforms = varied_transforms();
     for (auto& t : transforms) t.translation += vec3(far);
     const MeshDesc mesh = faceted_sphere(vec3(0.f), 1.f, false);
-    Pair p = scene_pair(mesh, transforms);
-    p.instanced.camera = camera_looking(vec3(far) + vec3(0, 0, 9), vec3(far), 40.f);
-    const auto scene = Scene::build(p.instanced);
+    const DirectCopies copies(mesh, transforms);
     std::mt19937 rng(5);
     std::uniform_real_distribution<float> u01(0.f, 0.99999994f);
     int checked = 0;
@@ -235,32 +280,55 @@ TEST(InstanceIntersect, HitPointWithinItsErrorBound) {
       const vec3 dir = square_to_uniform_sphere({u01(rng), u01(rng)});
       const vec3 target = random_target(rng, transforms);
       SurfaceHit hit;
-      if (!scene->intersect(Ray{target - 12.f * dir, dir, 0.f}, &hit)) continue;
-      const uint32_t* tri = &mesh.indices[3 * hit.primitive];
+      uint32_t prim = 0;
+      vec2 b;
+      const int k = copies.intersect(Ray{target - 12.f * dir, dir, 0.f}, &hit, &prim, &b);
+      if (k < 0) continue;
+      const uint32_t* tri = &mesh.indices[3 * prim];
       // b0 as the mesh computes it, in float: the bound is that of the sum (pbrt-v4 6.8.4).
-      const double b1 = hit.uv.x, b2 = hit.uv.y, b0 = 1.f - hit.uv.x - hit.uv.y;
+      const double b1 = b.x, b2 = b.y, b0 = 1.f - b.x - b.y;
       const dvec3 local = b0 * dvec3(mesh.positions[tri[0]]) + b1 * dvec3(mesh.positions[tri[1]]) +
                           b2 * dvec3(mesh.positions[tri[2]]);
-      // Which copy (or the mesh itself, transform -1): the one whose exact point is nearest.
-      int best = -1;
-      dvec3 exact = local;
-      for (size_t k = 0; k < transforms.size(); ++k) {
-        const dvec3 q = glm::dmat3(transforms[k].linear) * local + dvec3(transforms[k].translation);
-        if (glm::length(q - dvec3(hit.p)) < glm::length(exact - dvec3(hit.p))) {
-          best = int(k);
-          exact = q;
-        }
-      }
-      if (best < 0) continue;  // the mesh itself: not a copy
+      const dvec3 exact = glm::dmat3(transforms[size_t(k)].linear) * local + dvec3(transforms[size_t(k)].translation);
       for (int c = 0; c < 3; ++c)
         ASSERT_LE(std::abs(double(hit.p[c]) - exact[c]), double(hit.p_error[c]))
-            << "copy " << best << " component " << c;
+            << "copy " << k << " component " << c;
       // And the bound is not vacuous: within a few hundred ulps of the magnitude.
       ASSERT_LT(max_component(hit.p_error), 1e-4f * (1.f + max_component(glm::abs(hit.p))));
       ++checked;
     }
     EXPECT_GT(checked, 1000);
   }
+}
+
+// A copy reports the mesh's interpolated uv, and its geometric normal is that of the
+// transformed triangle (front side turned round by the mirror).
+TEST(InstanceHit, UvKeptAndNormalOfTheTransformedTriangle) {
+  const auto transforms = varied_transforms();
+  const MeshDesc mesh = faceted_sphere(vec3(0.f), 1.f, true);
+  const DirectCopies copies(mesh, transforms);
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<float> u01(0.f, 0.99999994f);
+  int checked = 0;
+  for (int i = 0; i < 3000; ++i) {
+    const vec3 dir = square_to_uniform_sphere({u01(rng), u01(rng)});
+    SurfaceHit hit;
+    uint32_t prim = 0;
+    vec2 b;
+    const int k = copies.intersect(Ray{random_target(rng, transforms) - 12.f * dir, dir, 0.f}, &hit, &prim, &b);
+    if (k < 0) continue;
+    const uint32_t* tri = &mesh.indices[3 * prim];
+    const vec2 uv = (1.f - b.x - b.y) * mesh.uvs[tri[0]] + b.x * mesh.uvs[tri[1]] + b.y * mesh.uvs[tri[2]];
+    ASSERT_NEAR(hit.uv.x, uv.x, 1e-6f);
+    ASSERT_NEAR(hit.uv.y, uv.y, 1e-6f);
+    const glm::dmat3 a(transforms[size_t(k)].linear);
+    const dvec3 p0 = a * dvec3(mesh.positions[tri[0]]), p1 = a * dvec3(mesh.positions[tri[1]]),
+                p2 = a * dvec3(mesh.positions[tri[2]]);
+    const dvec3 n = glm::normalize(glm::cross(p1 - p0, p2 - p0));
+    ASSERT_GT(glm::dot(dvec3(hit.ng), n), 1.0 - 1e-5) << "copy " << k;
+    ++checked;
+  }
+  EXPECT_GT(checked, 1000);
 }
 
 struct SpawnCase {
