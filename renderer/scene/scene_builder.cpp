@@ -10,7 +10,6 @@
 #include "renderer/materials/coating_tables.h"
 #include "renderer/scene/scene.h"
 #include "renderer/shapes/make_shape.h"
-#include "renderer/shapes/triangle_mesh.h"
 
 namespace penumbra {
 
@@ -61,12 +60,16 @@ class SceneBuilder {
   // Copies of meshes (shapes/instance.h). Only a mesh that does not emit can be copied: an
   // area light samples its own shape, and a copy has none (the api reports this on the field).
   void instances() {
+    size_t copies = 0;
+    for (const InstancesDesc& desc : in_.instances) copies += desc.transforms.size();
+    s_.instances_.reserve(copies);
     for (const InstancesDesc& desc : in_.instances) {
       if (desc.object >= s_.objects_.size())
         throw SceneBuildError("instances of object " + std::to_string(desc.object) +
                               ": no such object");
       const Shape& shape = *s_.objects_[desc.object].shape;
-      if (!dynamic_cast<const TriangleMesh*>(&shape) || !is_black(in_.objects[desc.object].emission))
+      if (!std::holds_alternative<MeshDesc>(in_.objects[desc.object].shape) ||
+          !is_black(in_.objects[desc.object].emission))
         throw SceneBuildError("instances of object " + std::to_string(desc.object) +
                               ": only a mesh that does not emit can be instanced");
       for (const InstanceTransform& t : desc.transforms)
