@@ -1,5 +1,7 @@
 #include "api/material_parser.h"
 
+#include "api/texture_parser.h"
+
 namespace penumbra::api {
 
 namespace {
@@ -12,8 +14,25 @@ const Range kIor = Range::greater_than(0);
 
 Spectrum to_spectrum(const glm::dvec3& v) { return Spectrum(float(v.x), float(v.y), float(v.z)); }
 
+// A colour or roughness may be a constant or a texture: the texture's scale becomes the
+// constant factor it multiplies (glTF's factor x texture).
+template <typename P>
+void read_color(ObjectReader& reader, P& p, TextureSet& textures) {
+  if (auto c = read_spectrum_field(reader, "color", kReflectance, TextureRole::kReflectance, textures)) {
+    p.color = c->factor;
+    p.color_texture = c->texture;
+  }
+}
+template <typename P>
+void read_roughness(ObjectReader& reader, P& p, TextureSet& textures) {
+  if (auto r = read_float_field(reader, "roughness", kRoughness, textures)) {
+    p.roughness = r->factor;
+    p.roughness_texture = r->texture;
+  }
+}
+
 std::optional<MaterialParams> parse_material(const Json& value, const std::string& pointer,
-                                             Diagnostics& diag) {
+                                             TextureSet& textures, Diagnostics& diag) {
   ObjectReader reader(value, pointer, diag);
   if (!reader.valid()) return std::nullopt;
   const std::size_t errors_before = diag.error_count();
@@ -23,24 +42,34 @@ std::optional<MaterialParams> parse_material(const Json& value, const std::strin
   MaterialParams result;
   if (*type == "diffuse") {
     DiffuseParams p;
-    if (auto c = reader.vec3("color", kReflectance)) p.color = to_spectrum(*c);
+    read_color(reader, p, textures);
+    p.normal_map = read_normal_map(reader, "normal_map", textures);
     result = p;
   } else if (*type == "conductor") {
     ConductorParams p;
-    if (auto c = reader.vec3("color", kReflectance)) p.color = to_spectrum(*c);
-    if (auto r = reader.number("roughness", kRoughness)) p.roughness = float(*r);
+    read_color(reader, p, textures);
+    read_roughness(reader, p, textures);
+    p.normal_map = read_normal_map(reader, "normal_map", textures);
     result = p;
   } else if (*type == "dielectric") {
     DielectricParams p;
     if (auto ior = reader.number("ior", kIor)) p.ior = float(*ior);
-    if (auto r = reader.number("roughness", kRoughness)) p.roughness = float(*r);
+    read_roughness(reader, p, textures);
     if (auto a = reader.vec3("absorption", Range::at_least(0))) p.absorption = to_spectrum(*a);
+    p.normal_map = read_normal_map(reader, "normal_map", textures);
     result = p;
   } else if (*type == "plastic") {
     PlasticParams p;
-    if (auto c = reader.vec3("color", kReflectance)) p.color = to_spectrum(*c);
+    read_color(reader, p, textures);
     if (auto ior = reader.number("ior", kIor)) p.ior = float(*ior);
-    if (auto r = reader.number("roughness", kRoughness)) p.roughness = float(*r);
+    if (const Json* r = reader.get("roughness"); r && r->is_object()) {
+      reader.error("roughness", "a plastic's roughness cannot be a texture: its coating's tables "
+                                "are precomputed per roughness (as Mitsuba's roughplastic, whose "
+                                "alpha is not texturable either); use a number");
+    } else if (r) {
+      if (auto v = read_number(*r, reader.pointer_of("roughness"), diag, kRoughness)) p.roughness = float(*v);
+    }
+    p.normal_map = read_normal_map(reader, "normal_map", textures);
     result = p;
   } else {
     reader.error("type", "unknown material type " + quote_user_string(*type) +
@@ -56,7 +85,7 @@ std::optional<MaterialParams> parse_material(const Json& value, const std::strin
 }  // namespace
 
 ParsedMaterials parse_materials(const Json* materials, const std::string& pointer,
-                                const Limits& limits, const AssetFolder& assets, Diagnostics& diag) {
+                                const Limits& limits, TextureSet& textures, Diagnostics& diag) {
   ParsedMaterials parsed;
   if (!materials) return parsed;
   if (!materials->is_object()) {
@@ -67,7 +96,7 @@ ParsedMaterials parse_materials(const Json* materials, const std::string& pointe
                           pointer, diag))
     return parsed;
   for (const auto& [name, value] : materials->items()) {
-    const auto material = parse_material(value, child_pointer(pointer, name), diag);
+    const auto material = parse_material(value, child_pointer(pointer, name), textures, diag);
     parsed.index[name] = uint32_t(parsed.names.size());
     parsed.names.push_back(name);
     // A placeholder keeps handles dense; it is never rendered because errors stop the load.

@@ -1,10 +1,10 @@
 #pragma once
-// "materials": name -> {"type": diffuse | conductor | dielectric | plastic, ...}.
+// "materials": name -> {"type": diffuse | conductor | dielectric | plastic, ...}. A colour or
+// roughness may be a texture (api/texture_parser.h); every material may have a normal_map.
 #include <map>
 #include <string>
 #include <vector>
 
-#include "api/asset_path.h"
 #include "api/json_reader.h"
 #include "api/scene_loader.h"
 #include "renderer/materials/material_params.h"
@@ -19,8 +19,10 @@ struct ParsedMaterials {
 };
 
 // Materials with errors are left out of the result (their errors are in `diag`), but their
-// names are kept in `index` so objects naming them get no second, misleading error.
+// names are kept in `index` so objects naming them get no second, misleading error. Texture
+// files are resolved, probed and counted through `textures`.
+class TextureSet;
 ParsedMaterials parse_materials(const Json* materials, const std::string& pointer,
-                                const Limits& limits, const AssetFolder& assets, Diagnostics& diag);
+                                const Limits& limits, TextureSet& textures, Diagnostics& diag);
 
 }  // namespace penumbra::api

@@ -4,6 +4,7 @@
 
 #include "api/instances_parser.h"
 #include "api/mesh_parser.h"
+#include "api/texture_parser.h"
 #include "api/transform.h"
 
 namespace penumbra::api {
@@ -81,7 +82,7 @@ std::optional<QuadDesc> parse_quad(ObjectReader& reader, const AffineTransform& 
 ParsedObjects parse_objects(const Json* objects, const std::string& pointer,
                             const ParsedMaterials& materials, double shutter_extent,
                             const glm::dvec3& origin, const Limits& limits,
-                            const AssetFolder& assets, Diagnostics& diag) {
+                            const AssetFolder& assets, TextureSet& textures, Diagnostics& diag) {
   ParsedObjects parsed;
   parsed.material_used.assign(materials.names.size(), false);
   if (!objects) return parsed;
@@ -121,7 +122,10 @@ ParsedObjects parse_objects(const Json* objects, const std::string& pointer,
                                           : did_you_mean(*name, materials.names)));
       }
     }
-    if (auto e = reader.vec3("emission", Range::at_least(0))) object.emission = to_float(*e);
+    if (auto e = read_spectrum_field(reader, "emission", Range::at_least(0), TextureRole::kEmission, textures)) {
+      object.emission = e->factor;
+      object.emission_texture = e->texture;
+    }
     const glm::dvec3 velocity = reader.vec3("velocity").value_or(glm::dvec3(0.0));
     const glm::dvec3 acceleration = reader.vec3("acceleration").value_or(glm::dvec3(0.0));
     object.velocity = to_float(velocity);

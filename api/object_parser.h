@@ -31,9 +31,10 @@ struct ParsedObjects {
 
 // `shutter_extent` = max(|open|, |close|): motion must not carry objects out of range by then.
 // `origin` (the camera position) is subtracted from every position, in double precision.
+// An emission texture's file goes through `textures` (api/texture_parser.h).
 ParsedObjects parse_objects(const Json* objects, const std::string& pointer,
                             const ParsedMaterials& materials, double shutter_extent,
                             const glm::dvec3& origin, const Limits& limits,
-                            const AssetFolder& assets, Diagnostics& diag);
+                            const AssetFolder& assets, TextureSet& textures, Diagnostics& diag);
 
 }  // namespace penumbra::api

@@ -40,6 +40,12 @@ struct Limits {
   int max_lights = 10'000;
   int max_json_depth = 64;
   double max_time_limit = 24 * 3600.0;  // seconds
+  // Textures (docs/scene-format.md): width x height of any one image, read from its header
+  // before a pixel is decoded; and the decoded size of all of a scene's distinct images (each
+  // file once per colorspace, at most 4 channels of 1 byte for 8-bit images, else 4-byte
+  // floats: an 8192^2 RGBA PNG takes 256 MiB, the same as float EXR 1 GiB).
+  int64_t max_texture_pixels = int64_t(8192) * 8192;
+  int64_t max_texture_bytes = int64_t(1) << 30;
 };
 
 enum class LoadErrorKind {

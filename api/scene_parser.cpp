@@ -5,6 +5,7 @@
 #include "api/environment_parser.h"
 #include "api/material_parser.h"
 #include "api/object_parser.h"
+#include "api/texture_parser.h"
 
 namespace penumbra::api {
 
@@ -204,14 +205,15 @@ std::optional<SceneRequest> parse_scene(const Json& document, const Limits& limi
   const bool environment_lit =
       parse_environment(root.get("environment"), assets, request.scene, diag);
 
+  TextureSet textures(limits, assets);
   ParsedMaterials materials =
-      parse_materials(root.get("materials"), "/materials", limits, assets, diag);
+      parse_materials(root.get("materials"), "/materials", limits, textures, diag);
   const auto& camera = request.scene.camera;
   const double shutter_extent =
       std::max(std::abs(double(camera.shutter_open)), std::abs(double(camera.shutter_close)));
   ParsedObjects objects =
       parse_objects(root.get("objects"), "/objects", materials, shutter_extent, origin, limits,
-                    assets, diag);
+                    assets, textures, diag);
 
   bool lights_lit = false;
   parse_lights(root.get("lights"), limits, origin, request.scene.lights, lights_lit, diag);
@@ -230,6 +232,7 @@ std::optional<SceneRequest> parse_scene(const Json& document, const Limits& limi
   request.scene.objects = std::move(objects.objects);
   request.scene.instances = std::move(objects.instances);
   request.assets = std::move(objects.assets);
+  request.scene.texture_limits = textures.renderer_limits();
   return request;
 }
 

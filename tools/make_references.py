@@ -43,10 +43,11 @@ def default_variant() -> str:
     return "llvm_ad_rgb" if os.path.exists(p2m.DEBIAN_LIBLLVM) else "scalar_rgb"
 
 
-def render_reference(mi, scene: dict, spp: int, batches: int, instants: int):
+def render_reference(mi, scene: dict, spp: int, batches: int, instants: int, assets: str = "."):
     """Mean image and per-pixel standard error of the mean over ``batches`` independent renders
     of spp / batches samples each."""
-    images = [p2m.render_average(mi, scene, spp // batches, instants, seed=1000 + b) for b in range(batches)]
+    images = [p2m.render_average(mi, scene, spp // batches, instants, seed=1000 + b, assets=assets)
+              for b in range(batches)]
     stack = np.stack(images)
     mean = stack.mean(axis=0)
     stderr = stack.std(axis=0, ddof=1) / np.sqrt(batches)
@@ -112,7 +113,8 @@ def main(argv: list[str]) -> int:
         p2m.use_scene_folder(mi, path)
         instants = len(p2m.shutter_instants(scene, args.instants))
         start = time.time()
-        mean, stderr = render_reference(mi, scene, args.spp, args.batches, args.instants)
+        mean, stderr = render_reference(mi, scene, args.spp, args.batches, args.instants,
+                                        assets=os.path.dirname(os.path.abspath(path)))
         seconds = time.time() - start
         write_exr(mi, os.path.join(args.out, f"{name}.exr"), mean)
         write_exr(mi, os.path.join(args.out, f"{name}.stderr.exr"), stderr)

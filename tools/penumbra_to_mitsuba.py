@@ -18,6 +18,10 @@ The conversion keeps every semantic of the format (issue 2, docs/accuracy.md has
   same rotation: both renderers look a world direction d up at to_world^-1 d with the same
   lat-long convention (:func:`convert_environment`). Mitsuba finds the file through its file
   resolver, to which :func:`use_scene_folder` adds the scene's folder.
+* textures (``{"texture": ...}`` colours, roughness, emission; ``normal_map``) become ``bitmap``
+  textures of linear float EXRs baked with penumbra's decoding, scale and channel (sRGB decoded
+  by Mitsuba's own Bitmap), ``raw``, with the same ``filter_type`` and ``wrap_mode``; a normal
+  map wraps the BSDF in ``normalmap`` inside ``twosided`` (see :class:`TextureBaker`).
 
 * an ``instances`` object becomes a ``shapegroup`` holding the mesh it names (converted as that
   object is, its own ``transform`` included) and one ``instance`` per transform, whose
@@ -173,47 +177,161 @@ def rgb(values) -> dict:
     return {"type": "rgb", "value": [float(x) for x in vec(values)]}
 
 
-def ggx(alpha: float) -> dict:
-    """Microfacet parameters shared by the rough plugins: GGX, visible-normal sampling."""
-    return {"distribution": "ggx", "alpha": float(alpha), "sample_visible": True}
+def ggx(alpha) -> dict:
+    """Microfacet parameters shared by the rough plugins: GGX, visible-normal sampling.
+    ``alpha`` is a number or a texture dictionary."""
+    return {"distribution": "ggx", "alpha": alpha if isinstance(alpha, dict) else float(alpha),
+            "sample_visible": True}
 
 
-def convert_material(mat: dict) -> dict:
+def convert_material(mat: dict, textures: TextureBaker | None = None) -> dict:
     """A penumbra material -> Mitsuba BSDF dictionary (opaque ones wrapped in ``twosided``).
 
     The interior medium of an absorbing dielectric is attached to the shape, not the BSDF
-    (see :func:`convert_medium`).
+    (see :func:`convert_medium`). Textured parameters and normal maps need ``textures``.
     """
     kind = mat["type"]
     color = mat.get("color", DEFAULT_COLOR.get(kind))
-    roughness = float(mat.get("roughness", 0.0))
-    alpha = roughness * roughness  # glTF convention, as in penumbra
+    roughness = mat.get("roughness", 0.0)
+    if is_texture(color) or is_texture(roughness) or "normal_map" in mat:
+        if textures is None:
+            raise ValueError("a textured material needs a TextureBaker")
+        color_value = textures.spectrum(color, "color") if color is not None else None
+        alpha = textures.alpha(roughness)
+    else:
+        color_value = rgb(color) if color is not None else None
+        alpha = float(roughness) ** 2  # glTF convention, as in penumbra
+    rough = isinstance(alpha, dict) or alpha > 0
     if kind == "diffuse":
-        bsdf = {"type": "diffuse", "reflectance": rgb(color)}
+        bsdf = {"type": "diffuse", "reflectance": color_value}
     elif kind == "conductor":
         # material 'none' = a perfect reflector (F = 1) that specular_reflectance scales:
         # a constant Fresnel reflectance equal to the colour.
-        bsdf = {"type": "conductor", "material": "none", "specular_reflectance": rgb(color)}
-        if alpha > 0:
+        bsdf = {"type": "conductor", "material": "none", "specular_reflectance": color_value}
+        if rough:
             bsdf.update(type="roughconductor", **ggx(alpha))
     elif kind == "plastic":
         bsdf = {
             "type": "plastic",
-            "diffuse_reflectance": rgb(color),
+            "diffuse_reflectance": color_value,
             "int_ior": float(mat.get("ior", 1.5)),
             "ext_ior": 1.0,
             "nonlinear": False,
         }
-        if alpha > 0:
+        if rough:
             bsdf.update(type="roughplastic", **ggx(alpha))
     elif kind == "dielectric":
         bsdf = {"type": "dielectric", "int_ior": float(mat.get("ior", 1.5)), "ext_ior": 1.0}
-        if alpha > 0:
+        if rough:
             bsdf.update(type="roughdielectric", **ggx(alpha))
-        return bsdf  # transmissive: the surface orientation matters, no twosided
+        # transmissive: the surface orientation matters, no twosided
+        return textures.normal_mapped(bsdf, mat["normal_map"]) if "normal_map" in mat else bsdf
     else:
         raise ValueError(f"unknown material type {kind!r}")
+    if "normal_map" in mat:
+        # twosided outside: the side is judged by the unperturbed normal, and the back is the
+        # mirrored front, as penumbra's SurfaceBsdf.
+        bsdf = textures.normal_mapped(bsdf, mat["normal_map"])
     return {"type": "twosided", "material": bsdf}
+
+
+# --------------------------------------------------------------------------------------------
+# Textures
+# --------------------------------------------------------------------------------------------
+
+def is_texture(value) -> bool:
+    """True for penumbra's ``{"texture": PATH, ...}`` form of a parameter."""
+    return isinstance(value, dict) and "texture" in value
+
+
+def srgb_to_linear(v: np.ndarray) -> np.ndarray:
+    """IEC 61966-2-1 decoding (for values the user declares sRGB that are not colours)."""
+    return np.where(v <= 0.04045, v / 12.92, ((v + 0.055) / 1.055) ** 2.4)
+
+
+class TextureBaker:
+    """Penumbra textures as Mitsuba ``bitmap`` textures.
+
+    Every texture is decoded as penumbra decodes it (docs/scene-format.md, "Textures"): sRGB for
+    colours read from integer images unless ``colorspace`` is ``linear``, linear otherwise;
+    ``scale`` multiplied in; one ``channel`` for single values; grey images as grey RGB. The
+    linear values are written to a float EXR in a temporary folder and handed to Mitsuba with
+    ``raw = true`` and the same ``filter_type`` and ``wrap_mode``, so Mitsuba interpolates exactly
+    the values penumbra interpolates. The sRGB decoding itself is Mitsuba's (``Bitmap.convert``).
+
+    Roughness r becomes GGX alpha = (scale r)^2 per texel, which only nearest filtering keeps
+    exact (penumbra squares after interpolating); a bilinear roughness texture is refused.
+    """
+
+    def __init__(self, mi, assets: str):
+        import tempfile
+
+        self.mi = mi
+        self.assets = assets
+        self.folder = tempfile.mkdtemp(prefix="penumbra_textures_")
+        self.count = 0
+
+    def _pixels(self, spec: dict, color: bool) -> np.ndarray:
+        """The image as float64 (h, w, c) linear values (before scale)."""
+        mi = self.mi
+        path = os.path.join(self.assets, spec["texture"])
+        bitmap = mi.Bitmap(path)
+        is_float = bitmap.component_format() in (mi.Struct.Type.Float16, mi.Struct.Type.Float32,
+                                                  mi.Struct.Type.Float64)
+        colorspace = spec.get("colorspace", "srgb" if color and not is_float else "linear")
+        raw = np.array(bitmap, dtype=np.float64)
+        if raw.ndim == 2:
+            raw = raw[:, :, None]
+        if not is_float:
+            raw /= float(np.iinfo(np.array(bitmap).dtype).max)
+        if colorspace == "srgb" and color:
+            # Mitsuba's own decoding of the colour channels (alpha stays linear).
+            bitmap.set_srgb_gamma(True)
+            fmt = mi.Bitmap.PixelFormat.RGB if raw.shape[2] >= 3 else mi.Bitmap.PixelFormat.Y
+            decoded = np.array(bitmap.convert(fmt, mi.Struct.Type.Float32, srgb_gamma=False), dtype=np.float64)
+            return decoded if decoded.ndim == 3 else decoded[:, :, None]
+        if colorspace == "srgb":
+            return srgb_to_linear(raw)
+        return raw
+
+    def _bitmap(self, values: np.ndarray, spec: dict) -> dict:
+        """Write linear values (h, w, 1 or 3) to an EXR and return the bitmap dictionary."""
+        self.count += 1
+        path = os.path.join(self.folder, f"texture{self.count}.exr")
+        fmt = self.mi.Bitmap.PixelFormat.RGB if values.shape[2] == 3 else self.mi.Bitmap.PixelFormat.Y
+        self.mi.Bitmap(np.ascontiguousarray(values, dtype=np.float32), fmt).write(path)
+        return {"type": "bitmap", "filename": path, "raw": True,
+                "filter_type": spec.get("filter", "bilinear"), "wrap_mode": spec.get("wrap", "repeat")}
+
+    def spectrum(self, value, role: str) -> dict:
+        """A colour (``role`` 'color') or radiance ('emission'): RGB constant or bitmap."""
+        if not is_texture(value):
+            return rgb(value)
+        pixels = self._pixels(value, color=True)
+        rgb_pixels = pixels[:, :, :3] if pixels.shape[2] >= 3 else np.repeat(pixels[:, :, :1], 3, axis=2)
+        if role == "color":
+            rgb_pixels = np.clip(rgb_pixels, 0.0, 1.0)  # penumbra clamps reflectance texels
+        else:
+            rgb_pixels = np.maximum(rgb_pixels, 0.0)
+        return self._bitmap(rgb_pixels * vec(value.get("scale", 1.0)), value)
+
+    def alpha(self, roughness):
+        """GGX alpha = roughness^2: a number, or a bitmap of squared texels (nearest only)."""
+        if not is_texture(roughness):
+            return float(roughness) ** 2
+        if roughness.get("filter", "bilinear") != "nearest":
+            raise ValueError("a roughness texture converts to Mitsuba exactly only with filter "
+                             "'nearest' (penumbra squares the interpolated roughness)")
+        pixels = self._pixels(roughness, color=False)
+        r = np.clip(pixels[:, :, int(roughness.get("channel", 0))], 0.0, 1.0) * float(roughness.get("scale", 1.0))
+        return self._bitmap((r * r)[:, :, None], roughness)
+
+    def normal_mapped(self, bsdf: dict, normal_map) -> dict:
+        """``bsdf`` under a normal map (a file name or a texture object), read linearly."""
+        spec = {"texture": normal_map} if isinstance(normal_map, str) else normal_map
+        pixels = self._pixels(spec, color=False)
+        rgb_pixels = pixels[:, :, :3] if pixels.shape[2] >= 3 else np.repeat(pixels[:, :, :1], 3, axis=2)
+        return {"type": "normalmap", "normalmap": self._bitmap(rgb_pixels, spec), "bsdf": bsdf}
 
 
 def convert_medium(mat: dict) -> dict | None:
@@ -292,17 +410,22 @@ def build_mesh(mi, name: str, positions, faces, normals, children: dict):
     return mesh
 
 
-def convert_object(mi, index: int, obj: dict, materials: dict, time: float):
+def convert_object(mi, index: int, obj: dict, materials: dict, time: float,
+                   textures: TextureBaker | None = None):
     """One penumbra object at ``time`` -> a Mitsuba shape (a dict, or a Mesh instance)."""
     matrix = object_matrix(obj.get("transform"))
     offset = motion_offset(obj, time)
     mat = materials[obj["material"]]
-    children: dict[str, Any] = {"bsdf": convert_material(mat)}
+    children: dict[str, Any] = {"bsdf": convert_material(mat, textures)}
     medium = convert_medium(mat)
     if medium is not None:
         children["interior"] = medium
-    emission = vec(obj.get("emission", [0, 0, 0]))
-    if np.any(emission > 0):
+    emission = obj.get("emission", [0, 0, 0])
+    if is_texture(emission):
+        if textures is None:
+            raise ValueError("a textured emission needs a TextureBaker")
+        children["emitter"] = {"type": "area", "radiance": textures.spectrum(emission, "emission")}
+    elif np.any(vec(emission) > 0):
         children["emitter"] = {"type": "area", "radiance": rgb(emission)}
 
     kind = obj["type"]
@@ -387,7 +510,7 @@ def resolve_mesh_files(scene: dict, folder: str) -> dict:
 
 
 def convert_instances(mi, index: int, obj: dict, objects: list, materials: dict, time: float,
-                      out: dict) -> None:
+                      textures, out: dict) -> None:
     """Add a penumbra ``instances`` object to the scene dictionary ``out``: the shape group of the
     mesh it names (once per mesh) and an ``instance`` of it per transform.
 
@@ -399,7 +522,8 @@ def convert_instances(mi, index: int, obj: dict, objects: list, materials: dict,
     group = f"group{mesh_index}"
     if group not in out:
         out[group] = {"type": "shapegroup",
-                      "shape": convert_object(mi, mesh_index, objects[mesh_index], materials, time)}
+                      "shape": convert_object(mi, mesh_index, objects[mesh_index], materials, time,
+                                              textures)}
     for k, transform in enumerate(obj["transforms"]):
         out[f"object{index}_{k}"] = {"type": "instance", "shapegroup": {"type": "ref", "id": group},
                                      "to_world": mi.ScalarTransform4f(object_matrix(transform))}
@@ -490,10 +614,11 @@ def convert_integrator(scene: dict) -> dict:
 
 
 def to_mitsuba(mi, scene: dict, time: float = 0.0, spp: int | None = None,
-               width: int | None = None, height: int | None = None) -> dict:
+               width: int | None = None, height: int | None = None, assets: str = ".") -> dict:
     """The Mitsuba scene dictionary of a penumbra scene at instant ``time``.
 
-    ``spp``, ``width`` and ``height`` override the scene's render settings.
+    ``spp``, ``width`` and ``height`` override the scene's render settings; texture files are
+    relative to ``assets`` (the scene file's folder).
     """
     if scene.get("version") != 1:
         raise ValueError("only penumbra scene format version 1 is supported")
@@ -504,12 +629,13 @@ def to_mitsuba(mi, scene: dict, time: float = 0.0, spp: int | None = None,
         "sensor": convert_sensor(mi, scene, spp or render.get("spp", 64), width, height),
     }
     materials = scene.get("materials", {})
+    textures = TextureBaker(mi, assets)
     objects = scene.get("objects", [])
     for i, obj in enumerate(objects):
         if obj.get("type") == "instances":
-            convert_instances(mi, i, obj, objects, materials, time, out)
+            convert_instances(mi, i, obj, objects, materials, time, textures, out)
         else:
-            out[f"object{i}"] = convert_object(mi, i, obj, materials, time)
+            out[f"object{i}"] = convert_object(mi, i, obj, materials, time, textures)
     for i, light in enumerate(scene.get("lights", [])):
         out[f"light{i}"] = convert_light(light)
     environment = convert_environment(mi, scene.get("environment"))
@@ -526,7 +652,7 @@ def load_json(path: str) -> dict:
 
 
 def render_average(mi, scene: dict, spp: int, instants: int = 64, seed: int = 0,
-                   width: int | None = None, height: int | None = None) -> np.ndarray:
+                   width: int | None = None, height: int | None = None, assets: str = ".") -> np.ndarray:
     """Render ``scene`` with ``spp`` samples per pixel in total, as the mean over the shutter
     instants (one instant without motion blur), and return an (h, w, 3) float64 array.
 
@@ -536,7 +662,8 @@ def render_average(mi, scene: dict, spp: int, instants: int = 64, seed: int = 0,
     per_instant = max(1, spp // len(times))
     total = None
     for k, t in enumerate(times):
-        mscene = mi.load_dict(to_mitsuba(mi, scene, time=t, spp=per_instant, width=width, height=height))
+        mscene = mi.load_dict(to_mitsuba(mi, scene, time=t, spp=per_instant, width=width, height=height,
+                                         assets=assets))
         img = np.asarray(mi.render(mscene, spp=per_instant, seed=seed * len(times) + k), dtype=np.float64)
         total = img if total is None else total + img
     return total / len(times)
@@ -554,7 +681,8 @@ def main(argv: list[str]) -> int:
     args = ap.parse_args(argv)
     mi = import_mitsuba(args.variant)
     use_scene_folder(mi, args.scene)
-    img = render_average(mi, load_json(args.scene), args.spp, args.instants, args.seed)
+    img = render_average(mi, load_json(args.scene), args.spp, args.instants, args.seed,
+                         assets=os.path.dirname(os.path.abspath(args.scene)))
     mi.Bitmap(img.astype(np.float32), mi.Bitmap.PixelFormat.RGB).write(args.output)
     return 0
 

@@ -68,6 +68,9 @@ struct SurfaceHit {
   vec3 ng;         // unit geometric normal, the shape's front side (u x v, CCW, outside)
   vec3 ns;         // unit shading normal, same hemisphere as ng
   vec2 uv{0.f};    // surface coordinates for textures (each shape documents its mapping)
+  // dp/du and dp/dv of the uv parametrisation, for a tangent frame (normal maps). Not set by
+  // intersect(): Shape::surface_derivatives fills them when a material needs them.
+  vec3 dpdu{0.f}, dpdv{0.f};
   uint32_t object = 0;
   uint32_t primitive = 0;
 };

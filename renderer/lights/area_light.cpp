@@ -13,7 +13,7 @@ bool AreaLight::sample(const vec3& ref, float time, const vec2& u, LightSample* 
   out->distance = dist;
   // Emission leaves the front side only.
   if (glm::dot(ss.n, out->wi) >= 0.f) return false;
-  out->value = radiance_;
+  out->value = radiance(TextureQuery{ss.p, ss.uv, time});
   out->pdf = ss.pdf;
   out->is_delta = false;
   out->p = ss.p;
@@ -22,7 +22,12 @@ bool AreaLight::sample(const vec3& ref, float time, const vec2& u, LightSample* 
   return true;
 }
 
-// A Lambertian emitter of radiance L and area A emits pi L A.
-float AreaLight::power(float) const { return luminance(radiance_) * shape_.area() * kPi; }
+// A Lambertian emitter of radiance L and area A emits pi L A; a textured one, its mean radiance
+// (the texture's mean over the image, which is its mean over the surface when the uv map
+// preserves area, and close enough to choose lights by otherwise).
+float AreaLight::power(float) const {
+  const Spectrum mean = texture_ ? radiance_ * glm::max(texture_->mean(), Spectrum(0.f)) : radiance_;
+  return luminance(mean) * shape_.area() * kPi;
+}
 
 }  // namespace penumbra

@@ -1,19 +1,30 @@
 #pragma once
-// A diffuse emitter: constant radiance leaving the front side of the shape it holds.
+// A diffuse emitter: radiance leaving the front side of the shape it holds, constant or
+// textured over the shape's uv (the constant times the texture, as a material's parameters).
+#include <memory>
+
 #include "renderer/lights/light.h"
 #include "renderer/shapes/shape.h"
+#include "renderer/textures/texture.h"
 
 namespace penumbra {
 
 class AreaLight final : public Light {
  public:
-  AreaLight(const Shape& shape, const Spectrum& radiance) : shape_(shape), radiance_(radiance) {}
+  // `texture` (may be null) multiplies `radiance`; negative texels emit nothing.
+  AreaLight(const Shape& shape, const Spectrum& radiance,
+            std::unique_ptr<const SpectrumTexture> texture = nullptr)
+      : shape_(shape), radiance_(radiance), texture_(std::move(texture)) {}
 
+  // Points are sampled uniformly by the shape (by area or solid angle), not by the texture:
+  // unbiased for any texture, only noisier for a very uneven one.
   bool sample(const vec3& ref, float time, const vec2& u, LightSample* out) const override;
   float power(float scene_radius) const override;
 
-  // Radiance leaving the front side.
-  const Spectrum& radiance() const { return radiance_; }
+  // Radiance leaving the front side at a point of the surface.
+  Spectrum radiance(const TextureQuery& q) const {
+    return texture_ ? radiance_ * glm::max(texture_->eval(q), Spectrum(0.f)) : radiance_;
+  }
   // Solid-angle density with which sample() reaches point p (normal n) from ref.
   float pdf(const vec3& ref, const vec3& p, const vec3& n, float time) const {
     return shape_.pdf(ref, p, n, time);
@@ -23,6 +34,7 @@ class AreaLight final : public Light {
  private:
   const Shape& shape_;
   Spectrum radiance_;
+  std::unique_ptr<const SpectrumTexture> texture_;
 };
 
 }  // namespace penumbra

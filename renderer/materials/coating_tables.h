@@ -1,6 +1,6 @@
 #pragma once
 // What a plastic's coating needs that depends only on (alpha, eta): computed once per distinct
-// coating of a scene build and copied into each PlasticBsdf.
+// coating of a scene, owned by the scene's cache, and pointed to (not copied) by each PlasticBsdf.
 #include <array>
 #include <cstdint>
 #include <map>
@@ -35,11 +35,11 @@ struct CoatingTables {
 // The tables of a smooth (alpha ignored) or rough GGX coating of relative ior eta.
 CoatingTables make_coating_tables(bool smooth, const GgxDistribution& distr, float eta);
 
-// Tables shared by the materials of one scene build. The rough tables cost ~10^6 microfacet
+// Tables shared by the materials of one scene. The rough tables cost ~10^6 microfacet
 // evaluations (the smooth ones a few hundred Fresnel evaluations) and depend only on
-// (alpha, eta), so every plastic with the same coating computes them once. The cache lives as
-// long as the build that owns it: a long-running service that renders many distinct materials
-// keeps nothing between scenes.
+// (alpha, eta), so every plastic with the same coating computes them once. The scene owns the
+// cache and its plastics point into it (entries never move: they are held by unique_ptr), so a
+// long-running service that renders many distinct materials keeps nothing between scenes.
 class CoatingTableCache {
  public:
   const CoatingTables& get(bool smooth, const GgxDistribution& distr, float eta);

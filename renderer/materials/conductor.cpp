@@ -4,10 +4,10 @@
 
 namespace penumbra {
 
-ConductorBsdf::ConductorBsdf(const ConductorParams& params)
-    : color_(params.color),
-      smooth_(roughness_to_alpha(params.roughness) < kMinMicrofacetAlpha),
-      distr_(roughness_to_alpha(params.roughness)) {}
+ConductorBsdf::ConductorBsdf(const Spectrum& color, float roughness)
+    : color_(color),
+      smooth_(roughness_to_alpha(roughness) < kMinMicrofacetAlpha),
+      distr_(roughness_to_alpha(roughness)) {}
 
 Spectrum ConductorBsdf::eval(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const {
   if (smooth_ || !(ctx.lobes & kLobeGlossyReflection) || wi.z <= 0.f || wo.z <= 0.f)

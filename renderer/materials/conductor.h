@@ -11,7 +11,8 @@ namespace penumbra {
 // Front-side model (wi.z > 0); Material mirrors back-side queries to the front.
 class ConductorBsdf : public OpaqueBsdf {
  public:
-  explicit ConductorBsdf(const ConductorParams& params);
+  ConductorBsdf(const Spectrum& color, float roughness);
+  explicit ConductorBsdf(const ConductorParams& params) : ConductorBsdf(params.color, params.roughness) {}
 
   bool smooth() const { return smooth_; }
   uint32_t lobes() const { return smooth_ ? kLobeDeltaReflection : kLobeGlossyReflection; }

@@ -10,12 +10,12 @@ namespace {
 constexpr float kIndexMatchedTolerance = 1e-4f;
 }  // namespace
 
-DielectricBsdf::DielectricBsdf(const DielectricParams& params)
-    : eta_(params.ior),
-      absorption_(params.absorption),
-      index_matched_(std::abs(params.ior - 1.f) < kIndexMatchedTolerance),
-      smooth_(roughness_to_alpha(params.roughness) < kMinMicrofacetAlpha),
-      distr_(roughness_to_alpha(params.roughness)) {}
+DielectricBsdf::DielectricBsdf(float ior, float roughness, const Spectrum& absorption)
+    : eta_(ior),
+      absorption_(absorption),
+      index_matched_(std::abs(ior - 1.f) < kIndexMatchedTolerance),
+      smooth_(roughness_to_alpha(roughness) < kMinMicrofacetAlpha),
+      distr_(roughness_to_alpha(roughness)) {}
 
 uint32_t DielectricBsdf::lobes() const {
   if (index_matched_) return kLobeDeltaTransmission;

@@ -12,7 +12,9 @@ namespace penumbra {
 
 class DielectricBsdf {
  public:
-  explicit DielectricBsdf(const DielectricParams& params);
+  DielectricBsdf(float ior, float roughness, const Spectrum& absorption);
+  explicit DielectricBsdf(const DielectricParams& params)
+      : DielectricBsdf(params.ior, params.roughness, params.absorption) {}
 
   // Index-matched (ior == 1): the interface is invisible, a Dirac transmission of weight 1.
   bool index_matched() const { return index_matched_; }

@@ -8,7 +8,8 @@ namespace penumbra {
 // Front-side model (wi.z > 0); Material mirrors back-side queries to the front.
 class DiffuseBsdf : public OpaqueBsdf {
  public:
-  explicit DiffuseBsdf(const DiffuseParams& params) : color_(params.color) {}
+  explicit DiffuseBsdf(const Spectrum& color) : color_(color) {}
+  explicit DiffuseBsdf(const DiffuseParams& params) : DiffuseBsdf(params.color) {}
 
   uint32_t lobes() const { return kLobeDiffuseReflection; }
   Spectrum eval(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;

@@ -1,85 +1,140 @@
-// Material: a closed set of BSDF models behind one value type, with the two-sided handling of
-// opaque models done once here.
+// Material: a closed set of BSDF models behind one value type; textured parameters looked up per
+// hit (factor x texture, as glTF) and a normal map handed to the SurfaceBsdf.
+#include "renderer/materials/material.h"
+
 #include <type_traits>
 
-#include "renderer/materials/material.h"
-#include "renderer/materials/conductor.h"
-#include "renderer/materials/dielectric.h"
-#include "renderer/materials/diffuse.h"
-#include "renderer/materials/plastic.h"
+#include "renderer/materials/coating_tables.h"
+#include "renderer/materials/surface_bsdf.h"
+#include "renderer/textures/image_texture.h"
+#include "renderer/textures/texture_image_cache.h"
 
 namespace penumbra {
-
 namespace {
 
-using BsdfModel = std::variant<DiffuseBsdf, ConductorBsdf, DielectricBsdf, PlasticBsdf>;
+inline Spectrum clamp01(const Spectrum& s) { return glm::clamp(s, Spectrum(0.f), Spectrum(1.f)); }
+inline float clamp01(float v) { return std::clamp(v, 0.f, 1.f); }
 
-BsdfModel make_model(const MaterialParams& params, CoatingTableCache* cache) {
+BsdfModel make_model(const MaterialParams& params, CoatingTableCache& coatings) {
   return std::visit(
-      [cache](const auto& p) -> BsdfModel {
+      [&coatings](const auto& p) -> BsdfModel {
         using P = std::decay_t<decltype(p)>;
-        if constexpr (std::is_same_v<P, DiffuseParams>) return DiffuseBsdf(p);
-        else if constexpr (std::is_same_v<P, ConductorParams>) return ConductorBsdf(p);
-        else if constexpr (std::is_same_v<P, DielectricParams>) return DielectricBsdf(p);
-        else return PlasticBsdf(p, cache);
+        if constexpr (std::is_same_v<P, DiffuseParams>)
+          return DiffuseBsdf(p);
+        else if constexpr (std::is_same_v<P, ConductorParams>)
+          return ConductorBsdf(p);
+        else if constexpr (std::is_same_v<P, DielectricParams>)
+          return DielectricBsdf(p);
+        else
+          return PlasticBsdf(p, PlasticBsdf::tables_for(p, coatings));
       },
       params);
 }
 
-// Opaque models are two-sided: seen from the back (wi.z < 0) the surface behaves as its front
-// with the frame mirrored through the tangent plane.
-inline vec3 flip_z(const vec3& v) { return vec3(v.x, v.y, -v.z); }
+// A params struct's colour texture, if that kind of material has one.
+template <typename P>
+const std::optional<ImageTextureDesc>* color_texture_of(const P& p) {
+  if constexpr (requires { p.color_texture; })
+    return &p.color_texture;
+  else
+    return nullptr;
+}
 
 }  // namespace
 
 struct Material::Impl {
-  BsdfModel model;
-  bool two_sided;
+  MaterialParams params;
+  std::optional<SurfaceBsdf> bsdf;
+  // Reflectances and roughness are clamped to [0, 1] after the lookup: a float image may hold
+  // any value, and a reflectance above 1 would create energy.
+  std::unique_ptr<ImageSpectrumTexture> color;
+  std::unique_ptr<ImageFloatTexture> roughness;
+  std::unique_ptr<ImageSpectrumTexture> normal_map;  // linear RGB = (n + 1) / 2
+  std::unique_ptr<CoatingTableCache> own_coatings;
+  std::unique_ptr<TextureImageCache> own_images;
 };
 
-Material::Material(const MaterialParams& params, CoatingTableCache* cache) {
-  BsdfModel model = make_model(params, cache);
-  const bool two_sided = std::visit([](const auto& m) { return m.two_sided(); }, model);
-  impl_ = std::make_unique<Impl>(Impl{std::move(model), two_sided});
+Material::Material(const MaterialParams& params, CoatingTableCache* coatings,
+                   TextureImageCache* images)
+    : impl_(std::make_unique<Impl>()) {
+  Impl& m = *impl_;
+  m.params = params;
+  if (!coatings) coatings = (m.own_coatings = std::make_unique<CoatingTableCache>()).get();
+  m.bsdf.emplace(make_model(params, *coatings));
+  bsdf_ = &*m.bsdf;
+  lobes_ = bsdf_->lobes();
+
+  auto image_cache = [&]() -> TextureImageCache& {
+    if (!images) images = (m.own_images = std::make_unique<TextureImageCache>()).get();
+    return *images;
+  };
+  std::visit(
+      [&](const auto& p) {
+        if (const auto* t = color_texture_of(p); t && *t)
+          m.color = make_spectrum_texture(**t, image_cache());
+        using P = std::decay_t<decltype(p)>;
+        if constexpr (requires { p.roughness_texture; }) {
+          if (p.roughness_texture) {
+            m.roughness = make_float_texture(*p.roughness_texture, image_cache());
+            // Where the texture reaches 0 the model is smooth: its Dirac lobes are possible too.
+            P smooth = p;
+            smooth.roughness = 0.f;
+            lobes_ |= SurfaceBsdf(make_model(smooth, *coatings)).lobes();
+          }
+        }
+        if (p.normal_map) {
+          m.normal_map = make_spectrum_texture(*p.normal_map, image_cache());
+          normal_mapped_ = true;
+        }
+      },
+      params);
+  varies_ = m.color || m.roughness || m.normal_map;
 }
+
 Material::~Material() = default;
 Material::Material(Material&&) noexcept = default;
 Material& Material::operator=(Material&&) noexcept = default;
 
+SurfaceBsdf Material::bsdf_at(const TextureQuery& q) const {
+  const Impl& m = *impl_;
+  auto color = [&](const Spectrum& factor) {
+    return m.color ? factor * clamp01(m.color->eval(q)) : factor;
+  };
+  auto roughness = [&](float factor) {
+    return m.roughness ? factor * clamp01(m.roughness->eval(q)) : factor;
+  };
+  SurfaceBsdf b = std::visit(
+      [&](const auto& p) -> SurfaceBsdf {
+        using P = std::decay_t<decltype(p)>;
+        if constexpr (std::is_same_v<P, DiffuseParams>)
+          return SurfaceBsdf(DiffuseBsdf(color(p.color)));
+        else if constexpr (std::is_same_v<P, ConductorParams>)
+          return SurfaceBsdf(ConductorBsdf(color(p.color), roughness(p.roughness)));
+        else if constexpr (std::is_same_v<P, DielectricParams>)
+          return SurfaceBsdf(DielectricBsdf(p.ior, roughness(p.roughness), p.absorption));
+        else  // the coating (and its tables) as built; only the base colour varies
+          return SurfaceBsdf(std::get<PlasticBsdf>(m.bsdf->model()).with_color(color(p.color)));
+      },
+      m.params);
+  if (m.normal_map) b.set_mapped_normal(2.f * m.normal_map->eval(q) - vec3(1.f));
+  return b;
+}
+
 Spectrum Material::eval(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const {
-  const bool flip = impl_->two_sided && wi.z < 0.f;
-  const vec3 a = flip ? flip_z(wi) : wi, b = flip ? flip_z(wo) : wo;
-  const Spectrum f = std::visit([&](const auto& m) { return m.eval(ctx, a, b); }, impl_->model);
-  return is_finite(f) ? f : Spectrum(0.f);
+  return bsdf_->eval(ctx, wi, wo);
 }
 
 float Material::pdf(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const {
-  const bool flip = impl_->two_sided && wi.z < 0.f;
-  const vec3 a = flip ? flip_z(wi) : wi, b = flip ? flip_z(wo) : wo;
-  const float p = std::visit([&](const auto& m) { return m.pdf(ctx, a, b); }, impl_->model);
-  return std::isfinite(p) ? p : 0.f;
+  return bsdf_->pdf(ctx, wi, wo);
 }
 
 std::optional<BsdfSample> Material::sample(const BsdfContext& ctx, const vec3& wi, float u_lobe,
                                            const vec2& u) const {
-  const bool flip = impl_->two_sided && wi.z < 0.f;
-  const vec3 a = flip ? flip_z(wi) : wi;
-  std::optional<BsdfSample> bs =
-      std::visit([&](const auto& m) { return m.sample(ctx, a, u_lobe, u); }, impl_->model);
-  if (!bs) return std::nullopt;
-  if (!is_finite(bs->weight) || !std::isfinite(bs->pdf) || !is_finite(bs->wo)) return std::nullopt;
-  if (flip) bs->wo = flip_z(bs->wo);
-  return bs;
+  return bsdf_->sample(ctx, wi, u_lobe, u);
 }
 
-uint32_t Material::lobes() const {
-  return std::visit([](const auto& m) { return m.lobes(); }, impl_->model);
-}
+bool Material::two_sided() const { return bsdf_->two_sided(); }
 
-Spectrum Material::absorption() const {
-  return std::visit([](const auto& m) { return m.absorption(); }, impl_->model);
-}
-
-bool Material::two_sided() const { return impl_->two_sided; }
+Spectrum Material::absorption() const { return bsdf_->absorption(); }
 
 }  // namespace penumbra

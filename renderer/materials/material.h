@@ -1,32 +1,56 @@
 #pragma once
-// A material ready for rendering: one BSDF model behind a value type.
+// A material ready for rendering: its BSDF where every parameter is constant, and the textures
+// it looks up per hit where some parameter varies over the surface.
 #include <memory>
 #include <optional>
 
 #include "renderer/materials/bsdf.h"
 #include "renderer/materials/material_params.h"
+#include "renderer/textures/texture.h"
 
 namespace penumbra {
 
 class CoatingTableCache;
+class SurfaceBsdf;
+class TextureImageCache;
 
-// A material ready for rendering: parameters plus any precomputed data (e.g. the rough plastic
-// transmittance tables). Immutable after construction and safe to share between threads.
+// Immutable after construction and safe to share between threads.
+//
+// Per hit the integrator asks `varies()`: if false (no texture, no normal map) it uses `bsdf()`,
+// built once, exactly as before textures existed; if true it asks `bsdf_at(query)` for a BSDF
+// with the textures looked up there (pbrt-v4's Material::GetBSDF). A constant parameter is never
+// a texture object, so an untextured material costs no lookup and no virtual call.
 class Material {
  public:
-  // `cache` shares precomputed tables between the materials of one scene build (may be null).
-  explicit Material(const MaterialParams& params, CoatingTableCache* cache = nullptr);
+  // `coatings` shares precomputed coating tables and `images` decoded texture images between the
+  // materials of one scene; both must outlive the material. Either may be null: the material then
+  // keeps its own. Throws ImageIoError if a texture's image cannot be read.
+  explicit Material(const MaterialParams& params, CoatingTableCache* coatings = nullptr,
+                    TextureImageCache* images = nullptr);
   ~Material();
   Material(Material&&) noexcept;
   Material& operator=(Material&&) noexcept;
 
+  // The BSDF with every texture replaced by 1 (its factor alone): the BSDF everywhere for an
+  // untextured material.
+  const SurfaceBsdf& bsdf() const { return *bsdf_; }
+  // Some parameter is textured or a normal map is set: ask bsdf_at at each hit.
+  bool varies() const { return varies_; }
+  // The BSDF needs the shading frame's tangent along dp/du (SurfaceBsdf::set_mapped_normal).
+  bool normal_mapped() const { return normal_mapped_; }
+  // The BSDF at a surface point, its textures looked up there.
+  SurfaceBsdf bsdf_at(const TextureQuery& q) const;
+
+  // bsdf()'s answers (tests and untextured materials).
   Spectrum eval(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
   float pdf(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
   // u_lobe picks a lobe, u the direction; both in [0,1).
   std::optional<BsdfSample> sample(const BsdfContext& ctx, const vec3& wi, float u_lobe,
                                    const vec2& u) const;
 
-  uint32_t lobes() const;  // union of BsdfLobe bits this material can produce
+  // Union of BsdfLobe bits this material can produce anywhere on the surface (a roughness
+  // texture that reaches 0 adds the Dirac lobes of the smooth limit).
+  uint32_t lobes() const { return lobes_; }
   bool has_transmission() const { return (lobes() & kLobeTransmission) != 0; }
   // Opaque models are two-sided (the back behaves as the front); oriented ones are not.
   bool two_sided() const;
@@ -37,6 +61,10 @@ class Material {
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
+  const SurfaceBsdf* bsdf_ = nullptr;  // inside impl_ (heap), so moves keep it valid
+  bool varies_ = false;
+  bool normal_mapped_ = false;
+  uint32_t lobes_ = 0;
 };
 
 }  // namespace penumbra

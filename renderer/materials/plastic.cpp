@@ -8,36 +8,49 @@
 
 namespace penumbra {
 
-PlasticBsdf::PlasticBsdf(const PlasticParams& params, CoatingTableCache* cache)
-    : color_(params.color),
-      eta_(params.ior),
+PlasticBsdf::PlasticBsdf(const PlasticParams& params, const CoatingTables& tables)
+    : eta_(params.ior),
       smooth_(roughness_to_alpha(params.roughness) < kMinMicrofacetAlpha),
-      distr_(roughness_to_alpha(params.roughness)) {
+      distr_(roughness_to_alpha(params.roughness)),
+      tables_(&tables),
+      internal_reflectance_(tables.internal_reflectance),
+      diffuse_scale_(tables.diffuse_scale) {
+  set_color(params.color);
+}
+
+const CoatingTables& PlasticBsdf::tables_for(const PlasticParams& params, CoatingTableCache& cache) {
+  const float alpha = roughness_to_alpha(params.roughness);
+  return cache.get(alpha < kMinMicrofacetAlpha, GgxDistribution(alpha), params.ior);
+}
+
+PlasticBsdf PlasticBsdf::with_color(const Spectrum& color) const {
+  PlasticBsdf b = *this;
+  b.set_color(color);
+  return b;
+}
+
+void PlasticBsdf::set_color(const Spectrum& color) {
+  color_ = color;
   // Steer samples between coating and base by their mean reflectances (coating reflectance 1),
   // as Mitsuba does, so the integrator sees the same sampling weights. Only the variance depends
   // on them: every sample is weighted by eval / pdf (or F / P(coating) for the Dirac lobe).
+  // (Mitsuba takes a textured base's mean over the whole texture; the colour at the hit steers
+  // better and changes nothing but the noise.)
   const float d_mean = (color_.x + color_.y + color_.z) / 3.f;
   specular_sampling_weight_ = 1.f / (d_mean + 1.f);
-
-  CoatingTableCache own;
-  const CoatingTables& tables = (cache ? *cache : own).get(smooth_, distr_, eta_);
-  nodes_ = tables.nodes;
-  cosines_ = tables.cosines;
-  transmittance_ = tables.transmittance;
-  internal_reflectance_ = tables.internal_reflectance;
-  diffuse_scale_ = tables.diffuse_scale;
 }
 
 float PlasticBsdf::external_transmittance(float cos_theta) const {
   if (smooth_) return 1.f - fresnel_dielectric(cos_theta, eta_).reflectance;
   // Linear interpolation between the table's nodes.
   const float mu = std::clamp(cos_theta, 0.f, 1.f);
-  const auto upper = std::upper_bound(cosines_.begin() + 1, cosines_.begin() + nodes_ - 1, mu);
-  const int i = int(upper - cosines_.begin()) - 1;
+  const float* cosines = tables_->cosines.data();
+  const float* upper = std::upper_bound(cosines + 1, cosines + tables_->nodes - 1, mu);
+  const int i = int(upper - cosines) - 1;
   // Nodes coincide where the critical cosine rounds to 1 (ior < ~3e-4).
-  const float width = cosines_[i + 1] - cosines_[i];
-  const float w = width > 0.f ? (mu - cosines_[i]) / width : 1.f;
-  return (1.f - w) * transmittance_[i] + w * transmittance_[i + 1];
+  const float width = cosines[i + 1] - cosines[i];
+  const float w = width > 0.f ? (mu - cosines[i]) / width : 1.f;
+  return (1.f - w) * tables_->transmittance[i] + w * tables_->transmittance[i + 1];
 }
 
 float PlasticBsdf::specular_probability(const BsdfContext& ctx, float cos_i) const {

@@ -10,8 +10,6 @@
 // (1 - F(cos_i)) (1 - F(cos_o)) and fdr_int by exact quadrature (Mitsuba uses a polynomial fit,
 // which gains energy at high ior); rough coating: the precomputed rough-dielectric transmittance
 // table t(cos) and internal reflectance.
-#include <array>
-
 #include "renderer/materials/bsdf.h"
 #include "renderer/materials/coating_tables.h"
 #include "renderer/materials/material_params.h"
@@ -22,9 +20,14 @@ namespace penumbra {
 // Front-side model (wi.z > 0); Material mirrors back-side queries to the front.
 class PlasticBsdf : public OpaqueBsdf {
  public:
-  // `cache` shares the coating's tables between the materials of one scene build; without one
-  // they are computed for this material alone.
-  explicit PlasticBsdf(const PlasticParams& params, CoatingTableCache* cache = nullptr);
+  // `tables` are the coating's (tables_for), owned elsewhere (by the scene's CoatingTableCache)
+  // and held by pointer, so a per-hit copy of the model (a textured colour) copies no table.
+  PlasticBsdf(const PlasticParams& params, const CoatingTables& tables);
+  // The coating's tables for these parameters, from (and owned by) `cache`.
+  static const CoatingTables& tables_for(const PlasticParams& params, CoatingTableCache& cache);
+
+  // The same coating over a base of another colour (a textured base, per hit).
+  PlasticBsdf with_color(const Spectrum& color) const;
 
   bool smooth() const { return smooth_; }
   uint32_t lobes() const {
@@ -44,16 +47,16 @@ class PlasticBsdf : public OpaqueBsdf {
   float specular_probability(const BsdfContext& ctx, float cos_i) const;
   uint32_t coating_lobe() const { return smooth_ ? kLobeDeltaReflection : kLobeGlossyReflection; }
 
+  void set_color(const Spectrum& color);
+
   Spectrum color_;
   float eta_;
   bool smooth_;
   GgxDistribution distr_;
   float specular_sampling_weight_;
+  const CoatingTables* tables_;  // the rough transmittance table t(cos) lives here
   float internal_reflectance_;  // fdr_int (smooth) or its rough counterpart
   float diffuse_scale_;         // 1 / (eta^2 (1 - internal_reflectance_)), computed in double
-  int nodes_ = 0;                                       // used entries of the rough table
-  std::array<float, kCoatingTableCapacity> cosines_{};  // the rough table's nodes, increasing
-  std::array<float, kCoatingTableCapacity> transmittance_{};
 };
 
 }  // namespace penumbra

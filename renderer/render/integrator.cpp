@@ -6,6 +6,8 @@
 
 #include "renderer/core/frame.h"
 #include "renderer/lights/area_light.h"
+#include "renderer/materials/surface_bsdf.h"
+#include "renderer/shapes/shape.h"
 #include "renderer/sampling/sampling.h"
 
 namespace penumbra {
@@ -19,6 +21,22 @@ bool geometry_agrees(const vec3& wi_world, const vec3& wo_world, const vec3& ng,
   const float geo = glm::dot(wi_world, ng) * glm::dot(wo_world, ng);
   const float shade = wi_local.z * wo_local.z;
   return geo != 0.f && (geo > 0.f) == (shade > 0.f);
+}
+
+// The shading frame with its tangent along dp/du, which a normal map's x axis follows
+// (Mitsuba 3's SurfaceInteraction::initialize_sh_frame: Gram-Schmidt of dp/du against the
+// shading normal). Any frame of the normal where the parametrisation degenerates.
+Frame tangent_frame(const Shape& shape, float time, SurfaceHit* hit) {
+  shape.surface_derivatives(time, hit);
+  const vec3 n = hit->ns;
+  const vec3 s = hit->dpdu - n * glm::dot(n, hit->dpdu);
+  const float len = glm::length(s);
+  if (!(len > 0.f) || !std::isfinite(len)) return Frame(n);
+  Frame f;
+  f.n = n;
+  f.s = s / len;
+  f.t = glm::cross(n, f.s);
+  return f;
 }
 
 // Feature bits an instantiation is compiled for. A bit that is off removes that code from the
@@ -77,14 +95,19 @@ Spectrum integrate(const Scene& scene, const IntegratorSettings& settings, Ray r
       if (!prev_delta)
         w = power_heuristic(prev_pdf, lights.pmf(obj.light) * obj.area_light->pdf(prev_p, hit.p, hit.ng,
                                                                                   ray.time));
-      radiance += beta * obj.area_light->radiance() * w;
+      radiance += beta * obj.area_light->radiance(TextureQuery{hit.p, hit.uv, ray.time}) * w;
     }
     if (depth >= max_depth) break;
 
-    const Frame frame(hit.ns);
+    // The BSDF here: the material's own where nothing varies over its surface (no lookup, the
+    // path untextured scenes take), else the one with its textures looked up at this point.
+    std::optional<SurfaceBsdf> textured;
+    const SurfaceBsdf* bsdf = &material.bsdf();
+    if (material.varies()) bsdf = &textured.emplace(material.bsdf_at(TextureQuery{hit.p, hit.uv, ray.time}));
+    const Frame frame = material.normal_mapped() ? tangent_frame(*obj.shape, ray.time, &hit) : Frame(hit.ns);
     const vec3 wi_world = -ray.direction;
     const vec3 wi = frame.to_local(wi_world);
-    const uint32_t lobes = material.lobes();
+    const uint32_t lobes = bsdf->lobes();
 
     // Next-event estimation.
     if ((kFeatures & kFeatureLights) != 0 && (lobes & ~uint32_t(kLobeDelta)) && !lights.empty()) {
@@ -101,13 +124,13 @@ Spectrum integrate(const Scene& scene, const IntegratorSettings& settings, Ray r
             // Diffuse lobes see direct light through light sampling alone; the other lobes
             // share it with their own sampling by MIS.
             const BsdfContext diffuse{kLobeDiffuse}, rest{kLobeNonDiffuse};
-            const Spectrum f_rest = material.eval(rest, wi, wo);
-            const float w = ls.is_delta ? 1.f : power_heuristic(ls.pdf, material.pdf(rest, wi, wo));
-            f = material.eval(diffuse, wi, wo) + f_rest * w;
+            const Spectrum f_rest = bsdf->eval(rest, wi, wo);
+            const float w = ls.is_delta ? 1.f : power_heuristic(ls.pdf, bsdf->pdf(rest, wi, wo));
+            f = bsdf->eval(diffuse, wi, wo) + f_rest * w;
           } else {
             const BsdfContext all{};
-            const float w = ls.is_delta ? 1.f : power_heuristic(ls.pdf, material.pdf(all, wi, wo));
-            f = material.eval(all, wi, wo) * w;
+            const float w = ls.is_delta ? 1.f : power_heuristic(ls.pdf, bsdf->pdf(all, wi, wo));
+            f = bsdf->eval(all, wi, wo) * w;
           }
           if (!is_black(f)) {
             const vec3 origin = offset_ray_origin(hit.p, hit.p_error, hit.ng, ls.wi);
@@ -139,7 +162,7 @@ Spectrum integrate(const Scene& scene, const IntegratorSettings& settings, Ray r
     }
     const float u_lobe = sampler.get_1d();
     const vec2 u_dir = sampler.get_2d();
-    const auto bs = material.sample(BsdfContext{kContinueLobes}, wi, u_lobe, u_dir);
+    const auto bs = bsdf->sample(BsdfContext{kContinueLobes}, wi, u_lobe, u_dir);
     if (!bs) break;
     const vec3 wo_world = frame.to_world(bs->wo);
     if (!geometry_agrees(wi_world, wo_world, hit.ng, wi, bs->wo)) break;

@@ -3,7 +3,9 @@
 #include <embree3/rtcore.h>
 
 #include "renderer/lights/light.h"
+#include "renderer/materials/coating_tables.h"
 #include "renderer/shapes/shape.h"
+#include "renderer/textures/texture_image_cache.h"
 
 namespace penumbra {
 

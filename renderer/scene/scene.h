@@ -22,6 +22,8 @@ namespace penumbra {
 
 class Shape;
 class Light;
+class CoatingTableCache;
+class TextureImageCache;
 
 class Scene {
  public:
@@ -65,6 +67,10 @@ class Scene {
   CameraDesc camera_;
   SceneFeatures features_;
   Bounds3 bounds_;
+  // What materials and emitters point into: the plastics' coating tables and the decoded
+  // texture images, each computed or decoded once per scene.
+  std::unique_ptr<CoatingTableCache> coatings_;
+  std::unique_ptr<TextureImageCache> texture_images_;
   std::vector<Material> materials_;
   std::vector<std::unique_ptr<Shape>> shapes_;
   std::vector<SceneObject> objects_;  // index = Embree geometry id

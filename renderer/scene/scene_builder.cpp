@@ -10,8 +10,25 @@
 #include "renderer/materials/coating_tables.h"
 #include "renderer/scene/scene.h"
 #include "renderer/shapes/make_shape.h"
+#include "renderer/textures/image_texture.h"
+#include "renderer/textures/texture_image_cache.h"
 
 namespace penumbra {
+
+namespace {
+
+// A texture's image that cannot be read now (api/ checked its header; the file may have
+// changed since, or its pixels may be corrupt) fails the build like any other resource.
+template <typename F>
+auto with_image_errors(F&& f) {
+  try {
+    return f();
+  } catch (const ImageIoError& e) {
+    throw SceneBuildError(std::string("texture ") + e.what());
+  }
+}
+
+}  // namespace
 
 class SceneBuilder {
  public:
@@ -24,15 +41,23 @@ class SceneBuilder {
     s_.features_.lens = in_.camera.aperture_radius > 0.f;
   }
 
-  // Materials answer for themselves what the integrator must be compiled for.
+  // Materials answer for themselves what the integrator must be compiled for. Their coating
+  // tables and texture images are shared through caches the scene keeps.
   void materials() {
+    s_.coatings_ = std::make_unique<CoatingTableCache>();
+    s_.texture_images_ = std::make_unique<TextureImageCache>(in_.texture_limits);
     s_.materials_.reserve(in_.materials.size());
-    CoatingTableCache coatings;  // shared by this build's plastics, gone with it
     for (const MaterialParams& params : in_.materials) {
-      const Material& m = s_.materials_.emplace_back(params, &coatings);
+      const Material& m = *with_image_errors(
+          [&] { return &s_.materials_.emplace_back(params, s_.coatings_.get(), s_.texture_images_.get()); });
       if (m.has_transmission()) s_.features_.transmission = true;
       if (m.has_absorption()) s_.features_.absorption = true;
+      // A textured parameter or a normal map reads the hit's uv (spheres compute it only then).
+      if (m.varies()) s_.features_.textures = true;
     }
+    // Textured emission is looked up at the hit's uv too.
+    for (const ObjectDesc& desc : in_.objects)
+      if (desc.emission_texture) s_.features_.textures = true;
   }
 
   void shapes() {
@@ -51,6 +76,7 @@ class SceneBuilder {
       ctx.camera_position = in_.camera.position;
       ctx.emissive = !is_black(desc.emission);
       ctx.need_uv = s_.features_.textures;
+      ctx.sample_uv = ctx.emissive && desc.emission_texture.has_value();
       s_.shapes_.push_back(make_shape(desc.shape, ctx));
       s_.objects_[i].shape = s_.shapes_.back().get();
       s_.objects_[i].material = desc.material;
@@ -91,7 +117,11 @@ class SceneBuilder {
     for (size_t i = 0; i < in_.objects.size(); ++i) {
       const Shape& shape = *s_.shapes_[i];
       if (is_black(in_.objects[i].emission) || shape.area() <= 0.f) continue;
-      auto light = std::make_unique<AreaLight>(shape, in_.objects[i].emission);
+      const auto& texture = in_.objects[i].emission_texture;
+      auto light = std::make_unique<AreaLight>(
+          shape, in_.objects[i].emission,
+          texture ? with_image_errors([&] { return make_spectrum_texture(*texture, *s_.texture_images_); })
+                  : nullptr);
       s_.objects_[i].area_light = light.get();
       s_.objects_[i].light = int(s_.lights_.size());
       s_.lights_.push_back(std::move(light));

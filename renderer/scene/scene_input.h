@@ -11,6 +11,7 @@
 #include "renderer/materials/material_params.h"
 #include "renderer/core/math.h"
 #include "renderer/scene/instance_input.h"
+#include "renderer/textures/texture_desc.h"
 
 namespace penumbra {
 
@@ -49,6 +50,8 @@ struct ObjectDesc {
   ShapeDesc shape;
   uint32_t material = 0;         // index into SceneInput::materials
   Spectrum emission{0.f};        // radiance leaving the front side; 0 = not a light
+  // If set, the radiance at a point is `emission` times this texture there (at the hit's uv).
+  std::optional<ImageTextureDesc> emission_texture{};
   // Rigid motion: position(t) = position(0) + velocity*t + 0.5*acceleration*t^2.
   vec3 velocity{0.f};
   vec3 acceleration{0.f};
@@ -86,6 +89,7 @@ struct SceneInput {
   std::vector<ObjectDesc> objects;
   std::vector<LightDesc> lights;
   std::vector<InstancesDesc> instances;  // copies of mesh objects (instance_input.h)
+  TextureLimits texture_limits;  // applied again as the build decodes the textures' images
 };
 
 enum class IntegratorKind { kPath, kDistributed };

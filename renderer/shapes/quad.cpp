@@ -36,6 +36,7 @@ bool Quad::sample(const vec3& ref, float time, const vec2& u, ShapeSample* out) 
   // Three products and two sums per coordinate, rounded once each (pbrt-v4 section 6.8.1).
   out->p_error = gamma_bound(6) * (glm::abs(o) + glm::abs(su) + glm::abs(sv));
   out->n = glm::normalize(glm::cross(quad_.u, quad_.v));
+  out->uv = u;
   out->pdf = area_to_solid_angle(ref, out->p, out->n, area());
   return true;
 }

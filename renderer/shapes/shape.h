@@ -18,6 +18,8 @@ struct ShapeSample {
   vec3 p;           // point on the surface
   vec3 p_error;     // its absolute error bound
   vec3 n;           // unit geometric normal (front side)
+  vec2 uv{0.f};     // surface coordinates of p, as a hit there would have (if the context's
+                    // sample_uv asked for them; textured emitters)
   float pdf = 0.f;  // solid-angle density seen from the reference point (0 = failed)
 };
 
@@ -46,6 +48,7 @@ struct ShapeContext {
   vec3 camera_position{0.f};    // picks how finely a moving mesh is tessellated in time
   bool emissive = false;        // an area light will sample it: prepare sampling by area
   bool need_uv = false;         // something reads SurfaceHit::uv (textures); else it may stay 0
+  bool sample_uv = false;       // its emission is textured: samples need their uv
 };
 
 class Shape {
@@ -64,6 +67,10 @@ class Shape {
   // error grows with t (pbrt-v4 section 6.8.4).
   virtual void hit_geometry(const Ray& ray, float t, uint32_t prim, const vec2& uv,
                             SurfaceHit* hit) const = 0;
+  // Fills dpdu and dpdv of a hit hit_geometry filled (at normalised time `time`): the partial
+  // derivatives of the surface point with respect to its uv (pbrt-v4 section 6.2.2). Asked only
+  // for materials that need a tangent frame, so other hits do not pay for it.
+  virtual void surface_derivatives(float time, SurfaceHit* hit) const = 0;
   // Samples a point of the surface as seen from `ref` at normalised time `time`; false if none.
   virtual bool sample(const vec3& ref, float time, const vec2& u, ShapeSample* out) const = 0;
   // Solid-angle density with which sample() yields point p (normal n) from ref.

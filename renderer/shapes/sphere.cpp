@@ -75,7 +75,8 @@ Sphere::Sphere(const SphereDesc& desc, const ShapeContext& ctx)
       radius_(desc.radius),
       area_(4.f * kPi * desc.radius * desc.radius),
       motion_(ctx.motion),
-      need_uv_(ctx.need_uv) {}
+      need_uv_(ctx.need_uv),
+      sample_uv_(ctx.sample_uv) {}
 
 EmbreeGeometry Sphere::make_geometry(RTCDevice device) const {
   // User geometry: the exact quadratic motion path needs our own test.
@@ -107,17 +108,22 @@ Bounds3 Sphere::embree_bounds() const {
 void Sphere::hit_geometry(const Ray& ray, float t, uint32_t, const vec2&, SurfaceHit* hit) const {
   sphere_hit_geometry(center_at(ray.time), radius_, ray.origin + ray.direction * t, hit);
   // Two inverse trigonometric functions per hit: only when textures read the uv.
-  if (!need_uv_) return;
-  // Mitsuba 3's sphere: u = phi / 2 pi with phi = atan2(y, x) in [0, 2 pi), v = theta / pi from
-  // +z, in the sphere's frame (ours is unrotated).
+  if (need_uv_) hit->uv = sphere_uv(hit->ng);
+}
+
+void Sphere::surface_derivatives(float, SurfaceHit* hit) const {
+  // Derivatives of centre + r (sin v pi cos u 2 pi, sin v pi sin u 2 pi, cos v pi), as Mitsuba 3's
+  // sphere; at the poles, where phi is undefined, dp/dv is +x as there.
   const vec3 n = hit->ng;
-  float phi = std::atan2(n.y, n.x);
-  if (phi < 0.f) phi += 2.f * kPi;
-  hit->uv = vec2(phi * kInv2Pi, std::acos(std::clamp(n.z, -1.f, 1.f)) * kInvPi);
+  hit->dpdu = (2.f * kPi * radius_) * vec3(-n.y, n.x, 0.f);
+  const float rd = std::sqrt(n.x * n.x + n.y * n.y);
+  hit->dpdv = rd > 0.f ? (kPi * radius_) * vec3(n.z * n.x / rd, n.z * n.y / rd, -rd)
+                       : (kPi * radius_) * vec3(1.f, 0.f, 0.f);
 }
 
 bool Sphere::sample(const vec3& ref, float time, const vec2& u, ShapeSample* out) const {
   *out = sample_sphere(center_at(time), radius_, ref, u);
+  if (sample_uv_) out->uv = sphere_uv(out->n);
   return true;
 }
 
@@ -141,6 +147,12 @@ float intersect_sphere(const vec3& center, float radius, const vec3& origin, con
   if (t0 > 0.f && t0 < t_max) return t0;
   if (t1 > 0.f && t1 < t_max) return t1;
   return -1.f;
+}
+
+vec2 sphere_uv(const vec3& n) {
+  float phi = std::atan2(n.y, n.x);
+  if (phi < 0.f) phi += 2.f * kPi;
+  return vec2(phi * kInv2Pi, std::acos(std::clamp(n.z, -1.f, 1.f)) * kInvPi);
 }
 
 void sphere_hit_geometry(const vec3& center, float radius, const vec3& p_approx, SurfaceHit* hit) {

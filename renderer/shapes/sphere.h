@@ -16,6 +16,7 @@ class Sphere final : public Shape {
   float area() const override { return area_; }
   void hit_geometry(const Ray& ray, float t, uint32_t prim, const vec2& uv,
                     SurfaceHit* hit) const override;
+  void surface_derivatives(float time, SurfaceHit* hit) const override;
   bool sample(const vec3& ref, float time, const vec2& u, ShapeSample* out) const override;
   float pdf(const vec3& ref, const vec3& p, const vec3& n, float time) const override;
   vec3 reference_point() const override { return center_; }
@@ -34,7 +35,8 @@ class Sphere final : public Shape {
   float radius_;
   float area_;
   ShapeMotion motion_;
-  bool need_uv_;
+  bool need_uv_;    // hits compute their uv (an atan2 and an acos) only if something reads it
+  bool sample_uv_;  // the uv of sampled points costs the same: only if asked
 };
 
 // Nearest t in (0, t_max) where origin + t*dir (dir unit) meets the sphere, or a negative value.
@@ -44,6 +46,9 @@ class Sphere final : public Shape {
 float intersect_sphere(const vec3& center, float radius, const vec3& origin, const vec3& dir,
                        float t_max);
 
+// Mitsuba 3's sphere mapping of a unit normal: u = phi / 2 pi with phi = atan2(y, x) in
+// [0, 2 pi), v = theta / pi from +z (the sphere's frame is unrotated).
+vec2 sphere_uv(const vec3& n);
 // Re-projects a hit onto the sphere and fills position, error bound and normal.
 void sphere_hit_geometry(const vec3& center, float radius, const vec3& p_approx, SurfaceHit* hit);
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "renderer/core/frame.h"
 #include "renderer/embree/ray_access.h"
 #include "renderer/sampling/sampling.h"
 
@@ -158,8 +159,7 @@ void TriangleMesh::hit_geometry(const Ray& ray, float, uint32_t prim, const vec2
   const vec3 p2 = positions_[tri[2]] + disp;
   const float b1 = uv.x, b2 = uv.y, b0 = 1.f - b1 - b2;
   barycentric_point(p0, p1, p2, b0, b1, b2, &hit->p, &hit->p_error);
-  if (need_uv_)
-    hit->uv = uvs_.empty() ? vec2(b1, b2) : b0 * uvs_[tri[0]] + b1 * uvs_[tri[1]] + b2 * uvs_[tri[2]];
+  if (need_uv_) hit->uv = uv_at(tri, b0, b1, b2);
   vec3 ng = glm::cross(p1 - p0, p2 - p0);
   const float len = glm::length(ng);
   ng = len > 0.f ? ng / len : vec3(0.f, 0.f, 1.f);
@@ -172,6 +172,33 @@ void TriangleMesh::hit_geometry(const Ray& ray, float, uint32_t prim, const vec2
       ns /= ls;
       hit->ns = glm::dot(ns, ng) < 0.f ? -ns : ns;
     }
+  }
+}
+
+void TriangleMesh::surface_derivatives(float, SurfaceHit* hit) const {
+  // pbrt-v4 Triangle::InteractionFromIntersection: solve
+  //   [p0 - p2, p1 - p2] = [dp/du, dp/dv] [uv0 - uv2, uv1 - uv2]
+  // for the two derivatives (motion is a translation, so edges need no displacement).
+  const uint32_t* tri = &indices_[size_t(hit->primitive) * 3];
+  const vec3 p0 = positions_[tri[0]], p1 = positions_[tri[1]], p2 = positions_[tri[2]];
+  const vec2 uv0 = uv_at(tri, 1.f, 0.f, 0.f), uv1 = uv_at(tri, 0.f, 1.f, 0.f),
+             uv2 = uv_at(tri, 0.f, 0.f, 1.f);
+  const vec2 duv02 = uv0 - uv2, duv12 = uv1 - uv2;
+  const vec3 dp02 = p0 - p2, dp12 = p1 - p2;
+  const float det = duv02.x * duv12.y - duv02.y * duv12.x;
+  const bool degenerate = !(std::abs(det) >= 1e-9f);
+  if (!degenerate) {
+    const float inv = 1.f / det;
+    hit->dpdu = (duv12.y * dp02 - duv02.y * dp12) * inv;
+    hit->dpdv = (duv02.x * dp12 - duv12.x * dp02) * inv;
+  }
+  // Without a usable parametrisation (uvs that do not span the triangle) any tangent frame of
+  // the geometric normal will do.
+  if (degenerate || !(glm::length(glm::cross(hit->dpdu, hit->dpdv)) > 0.f) || !is_finite(hit->dpdu) ||
+      !is_finite(hit->dpdv)) {
+    const Frame f(hit->ng);
+    hit->dpdu = f.s;
+    hit->dpdv = f.t;
   }
 }
 
@@ -188,6 +215,7 @@ bool TriangleMesh::sample(const vec3& ref, float time, const vec2& u, ShapeSampl
   const vec3 p0 = positions_[tri[0]] + disp, p1 = positions_[tri[1]] + disp,
              p2 = positions_[tri[2]] + disp;
   barycentric_point(p0, p1, p2, 1.f - b.x - b.y, b.x, b.y, &out->p, &out->p_error);
+  out->uv = uv_at(tri, 1.f - b.x - b.y, b.x, b.y);
   const vec3 ng = glm::cross(p1 - p0, p2 - p0);
   const float len = glm::length(ng);
   if (!(len > 0.f)) return false;

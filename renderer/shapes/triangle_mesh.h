@@ -18,6 +18,7 @@ class TriangleMesh : public Shape {
   float area() const override { return area_; }
   void hit_geometry(const Ray& ray, float t, uint32_t prim, const vec2& uv,
                     SurfaceHit* hit) const override;
+  void surface_derivatives(float time, SurfaceHit* hit) const override;
   bool sample(const vec3& ref, float time, const vec2& u, ShapeSample* out) const override;
   float pdf(const vec3& ref, const vec3& p, const vec3& n, float time) const override;
   vec3 reference_point() const override { return positions_[indices_[0]]; }
@@ -54,6 +55,10 @@ class TriangleMesh : public Shape {
 
  private:
   vec3 interpolated_displacement(float time) const;
+  // The uv of barycentric point (b0, b1, b2) of triangle `tri`: interpolated uvs, or (b1, b2).
+  vec2 uv_at(const uint32_t* tri, float b0, float b1, float b2) const {
+    return uvs_.empty() ? vec2(b1, b2) : b0 * uvs_[tri[0]] + b1 * uvs_[tri[1]] + b2 * uvs_[tri[2]];
+  }
 
   std::vector<vec3> positions_;  // world space at time 0
   std::vector<uint32_t> indices_;

@@ -1,7 +1,8 @@
 #pragma once
-// Textures: a value evaluated at a surface point (pbrt-v4 textures.h, Mitsuba 3 Texture). Today
-// every material parameter is a constant; image textures (the asset issue) implement the same
-// interfaces, and materials will evaluate them per hit.
+// Textures: a value evaluated at a surface point (pbrt-v4 textures.h, Mitsuba 3 Texture). Image
+// textures (image_texture.h) implement these interfaces; materials and emitters look them up per
+// hit. A constant parameter stays a plain value in the material (no texture object, no virtual
+// call); ConstantSpectrumTexture / ConstantFloatTexture exist for code that wants any texture.
 //
 // Adding a texture: a file pair here deriving from SpectrumTexture or FloatTexture, one line
 // where the scene build turns its input into the class, and its tests (docs/architecture.md).
@@ -20,12 +21,15 @@ class SpectrumTexture {
  public:
   virtual ~SpectrumTexture() = default;
   virtual Spectrum eval(const TextureQuery& q) const = 0;
+  // The mean over the texture's domain (e.g. an emitter's power estimate).
+  virtual Spectrum mean() const = 0;
 };
 
 class FloatTexture {
  public:
   virtual ~FloatTexture() = default;
   virtual float eval(const TextureQuery& q) const = 0;
+  virtual float mean() const = 0;
 };
 
 }  // namespace penumbra

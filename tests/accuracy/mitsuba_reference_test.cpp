@@ -36,7 +36,8 @@ constexpr double kMaxMeanZ2 = 2.0;  // mean of z^2 over a scene's blocks: catche
 const std::vector<std::string> kScenes = {"all_lights", "conductors",   "cornell",      "dof",
                                           "furnace",    "glass_rough",  "glass_smooth", "kitchen_sink",
                                           "mesh_100k",  "mesh_files",   "motion_blur",  "plastics",
-                                          "environment_map", "instances"};
+                                          "environment_map", "textured_diffuse", "textured_roughness",
+                                          "normal_map", "instances"};
 
 std::string accuracy_dir() { return std::string(PENUMBRA_SOURCE_DIR) + "/tests/accuracy/"; }
 

@@ -62,10 +62,13 @@ TEST(Schema, DocumentsEveryField) {
                      "uvs", "file", "mesh", "transforms"},
                     "object");
   const Json& materials = defs["material"]["oneOf"];
-  expect_documented(materials[0]["properties"], {"type", "color"}, "diffuse");
-  expect_documented(materials[1]["properties"], {"type", "color", "roughness"}, "conductor");
-  expect_documented(materials[2]["properties"], {"type", "ior", "roughness", "absorption"}, "dielectric");
-  expect_documented(materials[3]["properties"], {"type", "color", "ior", "roughness"}, "plastic");
+  expect_documented(materials[0]["properties"], {"type", "color", "normal_map"}, "diffuse");
+  expect_documented(materials[1]["properties"], {"type", "color", "roughness", "normal_map"}, "conductor");
+  expect_documented(materials[2]["properties"], {"type", "ior", "roughness", "absorption", "normal_map"},
+                    "dielectric");
+  expect_documented(materials[3]["properties"], {"type", "color", "ior", "roughness", "normal_map"}, "plastic");
+  expect_documented(defs["texture"]["properties"],
+                    {"texture", "colorspace", "channel", "scale", "wrap", "filter"}, "texture");
   expect_documented(defs["transform"]["oneOf"][0]["properties"], {"scale", "rotate", "translate"}, "transform");
   expect_documented(defs["transform"]["oneOf"][1]["properties"], {"matrix"}, "transform matrix");
   expect_documented(defs["light"]["oneOf"][0]["properties"], {"type", "position", "intensity"}, "point");

@@ -8,7 +8,6 @@ only to change a scene, then remake the references (tools/make_references.py). E
 small (<= 128 x 128, max_depth <= 8) so that penumbra renders it at 16-64 spp in seconds.
 Together they cover every feature of the format and combinations of them:
 
-=============  ==============================================================================
 cornell        diffuse Cornell box, ceiling quad light, two box meshes placed by transforms
 glass_smooth   smooth glass spheres, one with Beer-Lambert absorption; quad light, environment
 glass_rough    rough glass sphere and rotated rough glass cube mesh, both absorbing
@@ -28,6 +27,35 @@ instances      a smooth-shaded lumpy mesh and copies of it placed by an ``instan
                (rotated, non-uniformly scaled and sheared, mirrored), and a cube copied by a
                second one; Mitsuba renders them with ``shapegroup`` + ``instance``
 =============  ==============================================================================
+=======
+==================  ==============================================================================
+cornell             diffuse Cornell box, ceiling quad light, two box meshes placed by transforms
+glass_smooth        smooth glass spheres, one with Beer-Lambert absorption; quad light, environment
+glass_rough         rough glass sphere and rotated rough glass cube mesh, both absorbing
+furnace             rough glass and rough plastic spheres in a white environment (energy balance)
+conductors          smooth and rough (GGX) conductors of constant reflectance; mirror quad
+plastics            smooth and rough plastics of several ior; plastic floor
+dof                 thin-lens depth of field, 96 x 64 (non-square: checks the vertical fov)
+motion_blur         velocity and acceleration on spheres, an emitter and a transformed mesh
+all_lights          point + directional + quad + sphere + mesh emitters + environment together
+mesh_100k           a 102,400-triangle torus knot with vertex normals, rough conductor
+mesh_files          mesh files: a binary PLY blob with vertex normals and uvs (smooth), an OBJ prism
+                    of quads and hexagons without normals (flat), both placed by transforms
+kitchen_sink        depth of field + motion blur + absorbing rough glass + every light kind
+environment_map     glossy and rough-glass spheres under an HDR sky with a small bright sun
+                    (sky_sun.hdr, made by tools/make_sky.py), scaled and rotated
+textured_diffuse    colour textures: bilinear checker floor (repeat), nearest wood wall (clamp),
+                    textured spheres (linear, scaled), a checker-textured emitter
+textured_roughness  rough conductors with roughness maps (nearest), textured conductor colour,
+                    textured plastic base, rough glass with a roughness map
+normal_map          normal maps on a diffuse floor, a rough plastic wall, a conductor and a
+                    textured diffuse sphere (quad and sphere tangent frames)
+instances           a smooth-shaded lumpy mesh and copies of it placed by an ``instances`` object
+                    (rotated, non-uniformly scaled and sheared, mirrored), and a cube copied by a
+                    second one; Mitsuba renders them with ``shapegroup`` + ``instance``
+==================  ==============================================================================
+
+The textured scenes read the images in ``textures/`` (tools/make_textures.py writes them).
 """
 from __future__ import annotations
 
@@ -265,6 +293,53 @@ def plastics() -> dict:
         max_depth=6)
 
 
+def texture(path: str, **options) -> dict:
+    """A texture reference (docs/scene-format.md, "Textures"); images live in textures/."""
+    return {"texture": f"textures/{path}", **options}
+
+
+def textured_diffuse() -> dict:
+    scene = floor_scene(
+        [sphere([-0.7, 0.45, 0.2], 0.45, "wood"), sphere([0.65, 0.4, 0.3], 0.4, "tiles"),
+         quad([0.9, 0.2, -1.45], [1.2, 0, 0], [0, 1.2, 0], "black", emission=texture("checker.png", scale=3))],
+        {"floor": {"type": "diffuse", "color": texture("checker.png")},
+         "wall": {"type": "diffuse", "color": texture("wood.png", wrap="clamp", filter="nearest")},
+         "wood": {"type": "diffuse", "color": texture("wood.png")},
+         "tiles": {"type": "diffuse",
+                   "color": texture("checker.png", colorspace="linear", scale=[0.9, 0.8, 0.6])},
+         "black": {"type": "diffuse", "color": [0, 0, 0]}},
+        width=80, height=80, max_depth=6)
+    return scene
+
+
+def textured_roughness() -> dict:
+    return floor_scene(
+        [sphere([-1.2, 0.4, 0], 0.4, "brushed"), sphere([-0.4, 0.4, 0], 0.4, "inlay"),
+         sphere([0.4, 0.4, 0], 0.4, "tiles"), sphere([1.2, 0.4, 0], 0.4, "frosted")],
+        {"floor": {"type": "conductor", "color": [0.8, 0.8, 0.8],
+                   "roughness": texture("rough.png", filter="nearest")},
+         "brushed": {"type": "conductor", "color": [0.95, 0.64, 0.54],
+                     "roughness": texture("rough.png", channel=0, scale=0.8, filter="nearest")},
+         "inlay": {"type": "conductor", "color": texture("wood.png"), "roughness": 0.3},
+         "tiles": {"type": "plastic", "color": texture("checker.png"), "ior": 1.5, "roughness": 0.25},
+         "frosted": {"type": "dielectric", "ior": 1.5,
+                     "roughness": texture("rough.png", filter="nearest", wrap="clamp")}},
+        width=80, height=80, max_depth=6, cam_pos=(0, 1.1, 5.4), look=(0, 0.5, 0), fov=38)
+
+
+def normal_map() -> dict:
+    return floor_scene(
+        [sphere([-0.7, 0.45, 0.2], 0.45, "bumpy_metal"), sphere([0.65, 0.4, 0.3], 0.4, "bumpy_wood")],
+        {"floor": {"type": "diffuse", "color": [0.6, 0.6, 0.6], "normal_map": "textures/normal.png"},
+         "wall": {"type": "plastic", "color": [0.35, 0.45, 0.6], "ior": 1.5, "roughness": 0.2,
+                  "normal_map": texture("normal.png", wrap="clamp")},
+         "bumpy_metal": {"type": "conductor", "color": [0.9, 0.9, 0.9], "roughness": 0.25,
+                         "normal_map": "textures/normal.png"},
+         "bumpy_wood": {"type": "diffuse", "color": texture("wood.png"),
+                        "normal_map": texture("normal.png", filter="nearest")}},
+        width=80, height=80, max_depth=6)
+
+
 def dof() -> dict:
     spheres = [sphere([-1.2 + 0.6 * k, 0.3, 1.2 - 0.7 * k], 0.3, ["a", "b", "c"][k % 3]) for k in range(5)]
     return floor_scene(
@@ -483,7 +558,8 @@ def instances() -> dict:
 
 SCENES = {f.__name__: f for f in (cornell, glass_smooth, glass_rough, furnace, conductors, plastics,
                                   dof, motion_blur, all_lights, mesh_100k, mesh_files, kitchen_sink,
-                                  environment_map, instances)}
+                                  environment_map, textured_diffuse, textured_roughness, normal_map,
+                                  instances)}
 
 
 def write(name: str, scene: dict) -> str:

@@ -143,8 +143,10 @@ struct Chi2Result {
 // land in one extra "other" cell) against N times the integral of pdf() over each cell; the
 // "other" cell expects N (1 - \int pdf). Low-expectation cells are pooled; the p-value is compared
 // with the Sidak-corrected significance 1 - (1 - alpha)^(1 / num_tests).
-inline Chi2Result chi2_test(const Material& mat, const BsdfContext& ctx, const vec3& wi,
-                            const Chi2Config& cfg) {
+// `mat`: anything answering sample() and pdf() as Material does (Material, SurfaceBsdf).
+template <typename Bsdf>
+Chi2Result chi2_test(const Bsdf& mat, const BsdfContext& ctx, const vec3& wi,
+                     const Chi2Config& cfg) {
   const int nt = cfg.theta_res, np = cfg.phi_res, ncells = nt * np + 1;
   std::vector<double> observed(ncells, 0.0), expected(ncells, 0.0);
 

@@ -1,0 +1,62 @@
+#pragma once
+// The BSDF at one surface point: one model of the closed set with its parameters (constant, or
+// looked up from textures at the hit), the two-sided handling of opaque models, and an optional
+// normal map. What the integrators evaluate and sample; conventions in bsdf.h.
+#include <optional>
+#include <variant>
+
+#include "renderer/core/frame.h"
+#include "renderer/materials/bsdf.h"
+#include "renderer/materials/conductor.h"
+#include "renderer/materials/dielectric.h"
+#include "renderer/materials/diffuse.h"
+#include "renderer/materials/plastic.h"
+
+namespace penumbra {
+
+using BsdfModel = std::variant<DiffuseBsdf, ConductorBsdf, DielectricBsdf, PlasticBsdf>;
+
+class SurfaceBsdf {
+ public:
+  explicit SurfaceBsdf(const BsdfModel& model);
+
+  // Normal mapping as Mitsuba 3.9's `normalmap` adapter with its defaults (src/bsdfs/
+  // normalmap.cpp): `n` = 2 rgb - 1 from the map, in the shading frame whose x axis follows dp/du
+  // (the integrator builds that frame for normal-mapped materials). The model is evaluated in
+  // the perturbed frame; a direction must lie on the same side of the perturbed and the
+  // unperturbed normal; a perturbed normal that faces away from wi is mirrored about the
+  // unperturbed one (flip_invalid_normals, after Schüssler et al. 2017); and the response is
+  // scaled by the shadowing term of Estevez et al. 2019 (Ray Tracing Gems ch. 12) that softens
+  // the terminator.
+  void set_mapped_normal(const vec3& n);
+  bool normal_mapped() const { return normal_mapped_; }
+
+  Spectrum eval(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
+  float pdf(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
+  // u_lobe picks a lobe, u the direction; both in [0,1).
+  std::optional<BsdfSample> sample(const BsdfContext& ctx, const vec3& wi, float u_lobe,
+                                   const vec2& u) const;
+
+  uint32_t lobes() const;  // union of BsdfLobe bits this BSDF can produce
+  // Opaque models are two-sided (the back behaves as the front); oriented ones are not.
+  bool two_sided() const { return two_sided_; }
+  // Beer-Lambert sigma_a of the interior, zero for everything that does not absorb inside.
+  Spectrum absorption() const;
+  const BsdfModel& model() const { return model_; }
+
+ private:
+  // The front-side answers (wi mirrored to the front already for two-sided models).
+  Spectrum eval_front(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
+  float pdf_front(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
+  std::optional<BsdfSample> sample_front(const BsdfContext& ctx, const vec3& wi, float u_lobe,
+                                         const vec2& u) const;
+  // The normal map's frame in shading-frame coordinates, for incident direction wi.
+  Frame perturbed_frame(const vec3& wi) const;
+
+  BsdfModel model_;
+  bool two_sided_;
+  bool normal_mapped_ = false;
+  vec3 mapped_normal_{0.f, 0.f, 1.f};
+};
+
+}  // namespace penumbra

@@ -1,0 +1,141 @@
+// Materials whose parameters are textures: factor x texture looked up per hit, clamped to the
+// parameter's range; a roughness texture that reaches 0 adds the smooth model's Dirac lobes; a
+// textured plastic shares its coating tables instead of copying them; untextured materials never
+// vary.
+#include <gtest/gtest.h>
+
+#include "renderer/materials/coating_tables.h"
+#include "renderer/materials/material.h"
+#include "renderer/materials/surface_bsdf.h"
+#include "tests/renderer/textures/texture_test_util.h"
+
+namespace penumbra::test {
+namespace {
+
+const vec3 kWi = glm::normalize(vec3(0.2f, 0.1f, 0.9f));
+const vec3 kWo = glm::normalize(vec3(-0.3f, 0.2f, 0.8f));
+
+TextureQuery at(float u, float v) { return TextureQuery{vec3(0.f), vec2(u, v), 0.f}; }
+
+// A 2 x 1 float image: left texel `l`, right texel `r` (RGB), looked up nearest.
+ImageTextureDesc two_texels(const TempFolder& dir, const std::string& name, const Spectrum& l,
+                            const Spectrum& r) {
+  const std::string path = dir.file(name);
+  write_test_image(path, 2, 1, 3, {l.x, l.y, l.z, r.x, r.y, r.z});
+  ImageTextureDesc d;
+  d.path = path;
+  d.colorspace = TextureColorspace::kLinear;
+  d.filter = TextureFilter::kNearest;
+  return d;
+}
+
+TEST(TexturedMaterial, ConstantMaterialsDoNotVary) {
+  for (const MaterialParams& p :
+       {MaterialParams(DiffuseParams{}), MaterialParams(ConductorParams{}),
+        MaterialParams(DielectricParams{}), MaterialParams(PlasticParams{})}) {
+    const Material m(p);
+    EXPECT_FALSE(m.varies());
+    EXPECT_FALSE(m.normal_mapped());
+  }
+}
+
+TEST(TexturedMaterial, DiffuseColourIsFactorTimesTexture) {
+  TempFolder dir("textured_diffuse");
+  DiffuseParams p;
+  p.color = Spectrum(0.5f);
+  p.color_texture = two_texels(dir, "c.exr", Spectrum(1.f, 0.f, 0.f), Spectrum(0.2f, 0.4f, 0.8f));
+  const Material m(p);
+  EXPECT_TRUE(m.varies());
+  EXPECT_FALSE(m.normal_mapped());
+  const float cos_o = kWo.z;
+  EXPECT_EQ(m.bsdf_at(at(0.25f, 0.5f)).eval(BsdfContext{}, kWi, kWo),
+            Spectrum(0.5f, 0.f, 0.f) * (kInvPi * cos_o));
+  EXPECT_EQ(m.bsdf_at(at(0.75f, 0.5f)).eval(BsdfContext{}, kWi, kWo),
+            Spectrum(0.1f, 0.2f, 0.4f) * (kInvPi * cos_o));
+  // bsdf() is the factor alone.
+  EXPECT_EQ(m.bsdf().eval(BsdfContext{}, kWi, kWo), Spectrum(0.5f) * (kInvPi * cos_o));
+}
+
+TEST(TexturedMaterial, ReflectanceTexelsAreClampedToOne) {
+  TempFolder dir("textured_clamp");
+  DiffuseParams p;
+  p.color = Spectrum(1.f);
+  p.color_texture = two_texels(dir, "c.exr", Spectrum(3.f, -1.f, 0.5f), Spectrum(0.f));
+  const Material m(p);
+  EXPECT_EQ(m.bsdf_at(at(0.25f, 0.5f)).eval(BsdfContext{}, kWi, kWo),
+            Spectrum(1.f, 0.f, 0.5f) * (kInvPi * kWo.z));
+}
+
+TEST(TexturedMaterial, RoughnessTextureReachingZeroIsSmoothThere) {
+  TempFolder dir("textured_rough");
+  ConductorParams p;
+  p.color = Spectrum(0.9f);
+  p.roughness = 1.f;
+  p.roughness_texture = two_texels(dir, "r.exr", Spectrum(0.f), Spectrum(0.5f));
+  const Material m(p);
+  EXPECT_EQ(m.lobes(), uint32_t(kLobeDeltaReflection | kLobeGlossyReflection));
+  const SurfaceBsdf smooth = m.bsdf_at(at(0.25f, 0.5f)), rough = m.bsdf_at(at(0.75f, 0.5f));
+  EXPECT_EQ(smooth.lobes(), uint32_t(kLobeDeltaReflection));
+  EXPECT_EQ(rough.lobes(), uint32_t(kLobeGlossyReflection));
+  // The rough half is exactly the constant material of roughness 0.5.
+  EXPECT_EQ(rough.eval(BsdfContext{}, kWi, kWo),
+            Material(ConductorParams{Spectrum(0.9f), 0.5f}).eval(BsdfContext{}, kWi, kWo));
+  // The second channel, scaled: roughness 0.4 * 0.5.
+  p.roughness = 0.4f;
+  p.roughness_texture = two_texels(dir, "g.exr", Spectrum(0.f, 0.5f, 0.f), Spectrum(0.f));
+  p.roughness_texture->channel = 1;
+  EXPECT_EQ(Material(p).bsdf_at(at(0.25f, 0.5f)).eval(BsdfContext{}, kWi, kWo),
+            Material(ConductorParams{Spectrum(0.9f), 0.2f}).eval(BsdfContext{}, kWi, kWo));
+}
+
+TEST(TexturedMaterial, TexturedPlasticPointsAtSharedTables) {
+  TempFolder dir("textured_plastic");
+  PlasticParams p;
+  p.color = Spectrum(1.f);
+  p.roughness = 0.3f;
+  p.color_texture = two_texels(dir, "c.exr", Spectrum(0.2f, 0.5f, 0.7f), Spectrum(0.f));
+  CoatingTableCache coatings;
+  const Material m(p, &coatings);
+  EXPECT_EQ(coatings.size(), 1u);
+  const SurfaceBsdf b = m.bsdf_at(at(0.25f, 0.5f));
+  EXPECT_EQ(coatings.size(), 1u);  // no table computed per hit
+  const Material constant(PlasticParams{Spectrum(0.2f, 0.5f, 0.7f), 1.5f, 0.3f}, &coatings);
+  EXPECT_EQ(b.eval(BsdfContext{}, kWi, kWo), constant.eval(BsdfContext{}, kWi, kWo));
+  EXPECT_EQ(b.pdf(BsdfContext{}, kWi, kWo), constant.pdf(BsdfContext{}, kWi, kWo));
+  // A per-hit copy is small: the ~1 KB of tables stay where they are.
+  EXPECT_LT(sizeof(PlasticBsdf), 128u);
+  EXPECT_LT(sizeof(SurfaceBsdf), 160u);
+}
+
+TEST(TexturedMaterial, NormalMapFileGivesTheDecodedNormal) {
+  TempFolder dir("textured_normal");
+  const vec3 n = glm::normalize(vec3(0.3f, -0.2f, 0.9f));
+  const vec3 rgb = 0.5f * (n + vec3(1.f));
+  DiffuseParams p;
+  p.normal_map = two_texels(dir, "n.exr", rgb, Spectrum(0.5f, 0.5f, 1.f));
+  const Material m(p);
+  EXPECT_TRUE(m.varies());
+  EXPECT_TRUE(m.normal_mapped());
+  SurfaceBsdf expected(DiffuseBsdf(p.color));
+  expected.set_mapped_normal(n);
+  const Spectrum f = m.bsdf_at(at(0.25f, 0.5f)).eval(BsdfContext{}, kWi, kWo);
+  const Spectrum g = expected.eval(BsdfContext{}, kWi, kWo);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(f[c], g[c], 1e-6f);
+  // The right texel is flat: the plain model.
+  EXPECT_EQ(m.bsdf_at(at(0.75f, 0.5f)).eval(BsdfContext{}, kWi, kWo),
+            m.bsdf().eval(BsdfContext{}, kWi, kWo));
+}
+
+TEST(TexturedMaterial, MissingImageThrowsNamingTheFile) {
+  DiffuseParams p;
+  p.color_texture = ImageTextureDesc{"/nonexistent/albedo.png"};
+  try {
+    const Material m(p);
+    ADD_FAILURE() << "no error";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/albedo.png"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace penumbra::test
