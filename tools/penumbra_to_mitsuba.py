@@ -391,14 +391,17 @@ def area_weighted_normals(positions: np.ndarray, faces: np.ndarray) -> np.ndarra
     return n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-30)
 
 
-def build_mesh(mi, name: str, positions, faces, normals, children: dict):
+def build_mesh(mi, name: str, positions, faces, normals, children: dict, uvs=None):
     """A Mitsuba mesh from numpy arrays; ``children`` are instantiated plugins (bsdf, emitter,
     interior) attached through the mesh's Properties. Without normals Mitsuba uses face normals.
+    ``uvs`` (one pair per vertex) carry over as they are: both formats put uv (0, 0) at an
+    image's top-left corner.
     """
     props = mi.Properties()
     for key, value in children.items():
         props[key] = value
-    mesh = mi.Mesh(name, len(positions), len(faces), props, has_vertex_normals=normals is not None)
+    mesh = mi.Mesh(name, len(positions), len(faces), props, has_vertex_normals=normals is not None,
+                   has_vertex_texcoords=uvs is not None)
     params = mi.traverse(mesh)
     # The buffers' own types (dynamic arrays in every variant, scalar_rgb included).
     float_buffer = type(params["vertex_positions"])
@@ -406,6 +409,8 @@ def build_mesh(mi, name: str, positions, faces, normals, children: dict):
     params["faces"] = type(params["faces"])(faces.astype(np.uint32).ravel())
     if normals is not None:
         params["vertex_normals"] = float_buffer(normals.astype(np.float32).ravel())
+    if uvs is not None:
+        params["vertex_texcoords"] = float_buffer(np.asarray(uvs, dtype=np.float32).ravel())
     params.update()
     return mesh
 
@@ -453,7 +458,8 @@ def convert_object(mi, index: int, obj: dict, materials: dict, time: float,
         return mesh_file_shape(mi, obj, matrix, offset, children)
     if kind == "mesh":
         positions, faces, normals = mesh_arrays(obj, matrix, offset)
-        return build_mesh(mi, f"mesh{index}", positions, faces, normals, instantiate(mi, children))
+        uvs = np.asarray(obj["uvs"], dtype=np.float64).reshape(-1, 2) if obj.get("uvs") else None
+        return build_mesh(mi, f"mesh{index}", positions, faces, normals, instantiate(mi, children), uvs)
     raise ValueError(f"object {index}: unknown type {kind!r}")
 
 

@@ -35,6 +35,9 @@ class Scene {
 
   // Nearest surface along the ray (t in (0, ray.t_max)), with its geometry rebuilt by its shape.
   bool intersect(const Ray& ray, SurfaceHit* hit) const;
+  // Fills hit->dpdu and dpdv (Shape::surface_derivatives) of a hit intersect() returned, on an
+  // object or on a copy (shapes/instance.h).
+  void surface_derivatives(float time, SurfaceHit* hit) const;
   // Whether anything blocks origin + t*dir for t in (0, t_max) at normalised time `time`.
   bool occluded(const vec3& origin, const vec3& dir, float t_max, float time) const;
 

@@ -105,6 +105,18 @@ void Instance::hit_geometry(const Ray& world_ray, float t, uint32_t prim, const 
   hit->uv = h.uv;
 }
 
+void Instance::surface_derivatives(float time, SurfaceHit* hit) const {
+  // The mesh reads the primitive, and the geometric normal where its uvs do not span the
+  // triangle (any tangent frame of it will do): normals map back by the transpose of linear_,
+  // up to a scale (cofactor_ = det * inverse transpose).
+  SurfaceHit local = *hit;
+  local.ng = unit_or(glm::transpose(linear_) * hit->ng, hit->ng);
+  if (glm::determinant(linear_) < 0.f) local.ng = -local.ng;
+  shape_->surface_derivatives(time, &local);
+  hit->dpdu = linear_ * local.dpdu;
+  hit->dpdv = linear_ * local.dpdv;
+}
+
 EmbreeScene make_instanced_scene(RTCDevice device, RTCGeometry geometry) {
   EmbreeScene scene(rtcNewScene(device));
   if (!scene) return scene;

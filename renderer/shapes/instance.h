@@ -39,6 +39,9 @@ class Instance {
   // Embree transforms the direction without normalising it).
   void hit_geometry(const Ray& world_ray, float t, uint32_t prim, const vec2& uv,
                     SurfaceHit* hit) const;
+  // dp/du and dp/dv of a hit hit_geometry filled: the mesh's, in its space, mapped by the
+  // linear part (tangent vectors transform as the points' differences do).
+  void surface_derivatives(float time, SurfaceHit* hit) const;
 
  private:
   const Shape* shape_;

@@ -331,6 +331,37 @@ TEST(InstanceHit, UvKeptAndNormalOfTheTransformedTriangle) {
   EXPECT_GT(checked, 1000);
 }
 
+// Normal maps follow dp/du and dp/dv (Scene::surface_derivatives): on a copy they are those of
+// the mesh written out by hand, and without uvs still tangent to the copy.
+TEST(InstanceHit, SurfaceDerivativesOfTheCopy) {
+  const auto transforms = varied_transforms();
+  for (const bool uvs : {true, false}) {
+    const Pair p = scene_pair(faceted_sphere(vec3(0.f), 1.f, uvs), transforms);
+    const auto a = Scene::build(p.instanced), b = Scene::build(p.by_hand);
+    std::mt19937 rng(13);
+    std::uniform_real_distribution<float> u01(0.f, 0.99999994f);
+    int checked = 0;
+    for (int i = 0; i < 4000; ++i) {
+      const vec3 dir = square_to_uniform_sphere({u01(rng), u01(rng)});
+      const Ray ray{random_target(rng, transforms) - 12.f * dir, dir, 0.f};
+      SurfaceHit ha, hb;
+      if (!a->intersect(ray, &ha) || !b->intersect(ray, &hb) || ha.primitive != hb.primitive) continue;
+      if (hb.object == 0) continue;  // the mesh itself
+      ASSERT_NE(ha.instance, SurfaceHit::kNotACopy);
+      a->surface_derivatives(0.f, &ha);
+      b->surface_derivatives(0.f, &hb);
+      ASSERT_LT(std::abs(glm::dot(glm::normalize(ha.dpdu), ha.ng)), 1e-3f);
+      ASSERT_LT(std::abs(glm::dot(glm::normalize(ha.dpdv), ha.ng)), 1e-3f);
+      if (uvs) {  // without uvs any tangent frame will do
+        ASSERT_LT(glm::length(ha.dpdu - hb.dpdu), 1e-4f * (1.f + glm::length(hb.dpdu))) << hb.object;
+        ASSERT_LT(glm::length(ha.dpdv - hb.dpdv), 1e-4f * (1.f + glm::length(hb.dpdv))) << hb.object;
+      }
+      ++checked;
+    }
+    EXPECT_GT(checked, 1000);
+  }
+}
+
 struct SpawnCase {
   const char* name;
   float scale;
