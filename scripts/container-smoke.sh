@@ -141,6 +141,12 @@ nice -n 10 podman build --pull=never --format docker -f docker/Dockerfile -t "$I
   >"$WORK/build.log" 2>&1 || { tail -40 "$WORK/build.log" >&2; fail "image build"; }
 ok "built in $(( $(date +%s) - t )) s, $(podman image inspect --format '{{.Size}}' "$IMAGE" | awk '{printf "%.0f MB", $1/1e6}')"
 pm run --rm "$IMAGE" --version
+# An environment map is read through the OpenImageIO plug-in (lib/penumbra/libpenumbra_oiio.so),
+# loaded only then: the image must ship it where the binary looks.
+pm run --rm --entrypoint sh "$IMAGE" -c 'cd /tmp && penumbra render \
+    /usr/share/penumbra/scenes/sun_and_sky.json -o sky.png --width 32 --height 24 --spp 2 -q' ||
+  fail "rendering a scene with an environment map in the image (the OpenImageIO plug-in)"
+ok "a scene with an environment map renders in the image (OpenImageIO plug-in loaded)"
 podman image inspect --format '{{json .Config.Healthcheck}}' "$IMAGE" | grep -q healthz ||
   fail "the image has no HEALTHCHECK on /healthz (was it built with --format docker?)"
 ok "HEALTHCHECK on /healthz in the image config"

@@ -10,7 +10,7 @@ PKGS=(
   build-essential cmake ninja-build pkg-config git ca-certificates curl
   libembree-dev libopenimageio-dev openimageio-tools libglm-dev
   libcpp-httplib-dev nlohmann-json3-dev libtbb-dev libsqlite3-dev
-  libgtest-dev libgmock-dev libbenchmark-dev libtinyobjloader-dev
+  libgtest-dev libgmock-dev libbenchmark-dev libtinyobjloader-dev libpng-dev libopenexr-dev
 )
 if [ "${1:-}" = "--fuzz" ]; then PKGS+=(clang libclang-rt-14-dev); fi
 missing=()

@@ -1,8 +1,5 @@
 #include "renderer/io/image_io.h"
 
-#include <OpenImageIO/filesystem.h>
-#include <OpenImageIO/imageio.h>
-
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -10,6 +7,10 @@
 #include <fstream>
 #include <random>
 #include <unistd.h>
+
+#include "renderer/io/exr_writer.h"
+#include "renderer/io/oiio_module.h"
+#include "renderer/io/png_writer.h"
 
 namespace penumbra {
 namespace {
@@ -43,37 +44,16 @@ ImageFormat image_format_from_path(const std::string& path) {
 
 std::vector<uint8_t> encode_image(const Image& image, ImageFormat format,
                                   const ImageMetadata& metadata) {
-  std::vector<unsigned char> buffer;
-  OIIO::Filesystem::IOVecOutput proxy(buffer);
-  const char* name = format == ImageFormat::kPng ? "image.png" : "image.exr";
-  auto out = OIIO::ImageOutput::create(name);
-  if (!out) throw ImageIoError("OpenImageIO has no writer for " + std::string(name));
   const size_t n = size_t(image.width) * image.height * 3;
-  OIIO::ImageSpec spec;
-  std::vector<float> linear;
-  std::vector<uint8_t> bytes;
-  const void* data;
   if (format == ImageFormat::kPng) {
-    spec = OIIO::ImageSpec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
-    bytes.resize(n);
+    std::vector<uint8_t> bytes(n);
     for (size_t i = 0; i < n; ++i)
       bytes[i] = uint8_t(std::lround(linear_to_srgb(image.rgb[i]) * 255.f));
-    data = bytes.data();
-  } else {
-    spec = OIIO::ImageSpec(image.width, image.height, 3, OIIO::TypeDesc::FLOAT);
-    spec.attribute("compression", "zip");
-    linear.resize(n);
-    for (size_t i = 0; i < n; ++i) linear[i] = std::isfinite(image.rgb[i]) ? image.rgb[i] : 0.f;
-    data = linear.data();
+    return encode_png(bytes.data(), image.width, image.height, metadata);
   }
-  for (const auto& [key, value] : metadata) spec.attribute(key, value);
-  void* proxy_ptr = &proxy;
-  spec.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy_ptr);
-  if (!out->open(name, spec)) throw ImageIoError("cannot encode image: " + out->geterror());
-  const OIIO::TypeDesc type = format == ImageFormat::kPng ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT;
-  if (!out->write_image(type, data)) throw ImageIoError("cannot encode image: " + out->geterror());
-  if (!out->close()) throw ImageIoError("cannot encode image: " + out->geterror());
-  return std::vector<uint8_t>(buffer.begin(), buffer.end());
+  std::vector<float> linear(n);
+  for (size_t i = 0; i < n; ++i) linear[i] = std::isfinite(image.rgb[i]) ? image.rgb[i] : 0.f;
+  return encode_exr(linear.data(), image.width, image.height, metadata);
 }
 
 void write_image_file(const std::string& path, const Image& image, const ImageMetadata& metadata) {
@@ -98,21 +78,20 @@ void write_image_file(const std::string& path, const Image& image, const ImageMe
 }
 
 Image read_image_file(const std::string& path) {
-  auto in = OIIO::ImageInput::open(path);
-  if (!in) throw ImageIoError("cannot read " + path + ": " + OIIO::geterror());
-  const OIIO::ImageSpec& spec = in->spec();
+  const auto in = open_plugin_image(path);
+  const PenumbraImageSpec& spec = in->spec();
+  if (spec.width <= 0 || spec.height <= 0 || spec.channels <= 0)
+    throw ImageIoError(path + ": the image has no pixels");
   Image img(spec.width, spec.height);
-  const int nc = spec.nchannels;
+  const int nc = spec.channels;
   std::vector<float> data(size_t(spec.width) * spec.height * nc);
-  if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, data.data()))
-    throw ImageIoError("cannot read " + path + ": " + in->geterror());
-  const bool srgb = spec.format.basetype == OIIO::TypeDesc::UINT8;
+  in->read(nc, data.data());
+  const bool srgb = spec.is_uint8 != 0;
   for (size_t i = 0; i < size_t(spec.width) * spec.height; ++i)
     for (int c = 0; c < 3; ++c) {
       const float v = data[i * nc + std::min(c, nc - 1)];
       img.rgb[3 * i + c] = srgb ? srgb_to_linear(v) : v;
     }
-  in->close();
   return img;
 }
 

@@ -1,8 +1,9 @@
 #include "renderer/io/image_reader.h"
 
-#include <OpenImageIO/imageio.h>
-
+#include <algorithm>
 #include <cmath>
+
+#include "renderer/io/oiio_module.h"
 
 namespace penumbra {
 namespace {
@@ -13,9 +14,9 @@ namespace {
 
 
 // The header of an open image, checked against the limits.
-AssetImageInfo check_header(const std::string& path, const OIIO::ImageSpec& spec,
+AssetImageInfo check_header(const std::string& path, const PenumbraImageSpec& spec,
                             const ImageReadLimits& limits) {
-  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
+  if (spec.width <= 0 || spec.height <= 0 || spec.channels <= 0)
     fail(path, "the image has no pixels");
   if (spec.width > limits.max_dimension || spec.height > limits.max_dimension)
     fail(path, "the image is " + std::to_string(spec.width) + " x " + std::to_string(spec.height) +
@@ -28,17 +29,14 @@ AssetImageInfo check_header(const std::string& path, const OIIO::ImageSpec& spec
   AssetImageInfo info;
   info.width = spec.width;
   info.height = spec.height;
-  info.channels = std::min(spec.nchannels, limits.max_channels);
-  info.is_float = spec.format.is_floating_point();
-  info.is_8bit = spec.format == OIIO::TypeDesc::UINT8;
+  info.channels = std::min(spec.channels, limits.max_channels);
+  info.is_float = spec.is_float != 0;
+  info.is_8bit = spec.is_uint8 != 0;
   return info;
 }
 
-std::unique_ptr<OIIO::ImageInput> open_image(const std::string& path) {
-  auto in = OIIO::ImageInput::open(path);
-  if (!in) fail(path, "cannot read the image: " + OIIO::geterror());
-  return in;
-}
+// Through the OpenImageIO plug-in, loaded on first use (oiio_module.h); its errors name the path.
+std::unique_ptr<PluginImage> open_image(const std::string& path) { return open_plugin_image(path); }
 
 }  // namespace
 
@@ -55,9 +53,7 @@ AssetImage read_asset_image(const std::string& path, const ImageReadLimits& limi
   img.channels = info.channels;
   img.is_float = info.is_float;
   img.pixels.resize(size_t(img.width) * size_t(img.height) * size_t(img.channels));
-  if (!in->read_image(0, 0, 0, img.channels, OIIO::TypeDesc::FLOAT, img.pixels.data()))
-    fail(path, "cannot decode the image: " + in->geterror());
-  in->close();
+  in->read(img.channels, img.pixels.data());
   for (float& v : img.pixels)
     if (!std::isfinite(v)) v = 0.f;
   return img;
@@ -72,9 +68,7 @@ AssetImage8 read_asset_image_8bit(const std::string& path, const ImageReadLimits
   img.height = info.height;
   img.channels = info.channels;
   img.pixels.resize(size_t(img.width) * size_t(img.height) * size_t(img.channels));
-  if (!in->read_image(0, 0, 0, img.channels, OIIO::TypeDesc::UINT8, img.pixels.data()))
-    fail(path, "cannot decode the image: " + in->geterror());
-  in->close();
+  in->read(img.channels, img.pixels.data());
   return img;
 }
 

@@ -5,7 +5,9 @@
 #include <memory>
 #include <string>
 
-#include <OpenImageIO/imageio.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfInputFile.h>
+#include <OpenEXR/ImfStringAttribute.h>
 #include <nlohmann/json.hpp>
 
 #include "api/embedded_documents.h"
@@ -18,9 +20,13 @@ namespace {
 const std::string kProjectVersion = PENUMBRA_PROJECT_VERSION;
 
 std::string software_attribute(const std::string& path) {
-  const auto input = OIIO::ImageInput::open(path);
-  if (!input) return "cannot open " + path;
-  return input->spec().get_string_attribute("Software");
+  try {
+    const Imf::InputFile input(path.c_str());
+    const auto* software = input.header().findTypedAttribute<Imf::StringAttribute>("Software");
+    return software ? software->value() : "no Software attribute in " + path;
+  } catch (const std::exception& e) {
+    return "cannot open " + path + ": " + e.what();
+  }
 }
 
 TEST(Version, GeneratedHeaderIsTheProjects) {
