@@ -16,8 +16,8 @@ constexpr int64_t kBvhBuildExtraPerTriangle = 52;
 // A copy placed by an instances object: the renderer's Instance (shapes/instance.h) plus
 // Embree's instance geometry, its transforms and its share of the top-level BVH. Measured
 // (docs/instancing.md): 520-540 resident bytes per copy after the build
-// (InstanceMemory.CopiesCostBytesNotTheMesh), about 790 at the peak of a render
-// (bench/instancing_benchmark.sh); the estimate takes the peak.
+// (InstanceMemory.CopiesCostBytesNotTheMesh), 580-800 at the peak of a render
+// (bench/instancing_benchmark.sh); the estimate takes the larger.
 constexpr int64_t kBytesPerInstance = 800;
 // Film::Pixel (2 x 3 doubles + a count, padded to 56) plus the float RGB image and its variance.
 constexpr int64_t kFilmBytesPerPixel = 56 + 12 + 12;
