@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "api/instances_parser.h"
 #include "api/mesh_parser.h"
 #include "api/texture_parser.h"
 #include "api/transform.h"
@@ -93,6 +94,8 @@ ParsedObjects parse_objects(const Json* objects, const std::string& pointer,
                           diag))
     return parsed;
 
+  std::vector<PendingInstances> pending_instances;  // resolved once every object is read
+  std::vector<int64_t> desc_index(objects->size(), -1);
   for (std::size_t i = 0; i < objects->size(); ++i) {
     ObjectReader reader((*objects)[i], child_pointer(pointer, i), diag);
     if (!reader.valid()) continue;
@@ -100,6 +103,13 @@ ParsedObjects parse_objects(const Json* objects, const std::string& pointer,
     ObjectDesc object;
 
     const auto type = reader.string("type", Presence::kRequired);
+    if (type && *type == kInstancesType) {  // api/instances_parser.h
+      if (auto p = parse_instances(reader, limits, parsed.instance_count)) {
+        parsed.instance_count += int64_t(p->transforms.size());
+        pending_instances.push_back(std::move(*p));
+      }
+      continue;
+    }
     if (const auto name = reader.string("material", Presence::kRequired)) {
       const auto it = materials.index.find(*name);
       if (it != materials.index.end()) {
@@ -165,15 +175,18 @@ ParsedObjects parse_objects(const Json* objects, const std::string& pointer,
       }
     } else {
       reader.error("type", "unknown object type " + quote_user_string(*type) +
-                               did_you_mean(*type, {"sphere", "quad", "mesh"}) +
-                               "; expected sphere, quad or mesh");
+                               did_you_mean(*type, {"sphere", "quad", "mesh", "instances"}) +
+                               "; expected sphere, quad, mesh or instances");
       continue;  // the shape's keys cannot be judged without a type
     }
     reader.report_unknown_keys();
     if (diag.error_count() != errors_before) continue;
     if (!is_black(object.emission)) parsed.any_emission = true;
+    desc_index[i] = int64_t(parsed.objects.size());
     parsed.objects.push_back(std::move(object));
   }
+  resolve_instances(pending_instances, *objects, desc_index, parsed.objects, origin,
+                    parsed.instances, diag);
   return parsed;
 }
 

@@ -25,6 +25,8 @@ struct ParsedObjects {
   std::vector<AssetUse> assets;      // mesh files read
   std::vector<bool> material_used;   // per material handle
   bool any_emission = false;
+  std::vector<InstancesDesc> instances;  // "instances" objects (api/instances_parser.h)
+  int64_t instance_count = 0;            // copies they place
 };
 
 // `shutter_extent` = max(|open|, |close|): motion must not carry objects out of range by then.

@@ -230,6 +230,7 @@ std::optional<SceneRequest> parse_scene(const Json& document, const Limits& limi
   request.world_origin = origin;
   request.scene.materials = std::move(materials.params);
   request.scene.objects = std::move(objects.objects);
+  request.scene.instances = std::move(objects.instances);
   request.assets = std::move(objects.assets);
   request.scene.texture_limits = textures.renderer_limits();
   return request;
