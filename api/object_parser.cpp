@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "api/gltf_parser.h"
+#include "api/instances_parser.h"
 #include "api/mesh_parser.h"
 #include "api/texture_parser.h"
 #include "api/transform.h"
@@ -94,6 +95,8 @@ ParsedObjects parse_objects(const Json* objects, const std::string& pointer,
                           diag))
     return parsed;
 
+  std::vector<PendingInstances> pending_instances;  // resolved once every object is read
+  std::vector<int64_t> desc_index(objects->size(), -1);
   for (std::size_t i = 0; i < objects->size(); ++i) {
     ObjectReader reader((*objects)[i], child_pointer(pointer, i), diag);
     if (!reader.valid()) continue;
@@ -101,6 +104,13 @@ ParsedObjects parse_objects(const Json* objects, const std::string& pointer,
     ObjectDesc object;
 
     const auto type = reader.string("type", Presence::kRequired);
+    if (type && *type == kInstancesType) {  // api/instances_parser.h
+      if (auto p = parse_instances(reader, limits, parsed.instance_count)) {
+        parsed.instance_count += int64_t(p->transforms.size());
+        pending_instances.push_back(std::move(*p));
+      }
+      continue;
+    }
     // A glTF asset brings its own materials and emission.
     const bool is_gltf = type && *type == "gltf";
     if (is_gltf) {
@@ -206,15 +216,18 @@ ParsedObjects parse_objects(const Json* objects, const std::string& pointer,
       continue;
     } else {
       reader.error("type", "unknown object type " + quote_user_string(*type) +
-                               did_you_mean(*type, {"sphere", "quad", "mesh", "gltf"}) +
-                               "; expected sphere, quad, mesh or gltf");
+                               did_you_mean(*type, {"sphere", "quad", "mesh", "instances", "gltf"}) +
+                               "; expected sphere, quad, mesh, instances or gltf");
       continue;  // the shape's keys cannot be judged without a type
     }
     reader.report_unknown_keys();
     if (diag.error_count() != errors_before) continue;
     if (!is_black(object.emission)) parsed.any_emission = true;
+    desc_index[i] = int64_t(parsed.objects.size());
     parsed.objects.push_back(std::move(object));
   }
+  resolve_instances(pending_instances, *objects, desc_index, parsed.objects, origin,
+                    parsed.instances, diag);
   return parsed;
 }
 

@@ -29,6 +29,8 @@ struct ParsedObjects {
   // this order) and their KHR_lights_punctual lights.
   std::vector<MaterialParams> extra_materials;
   std::vector<LightDesc> lights;
+  std::vector<InstancesDesc> instances;  // "instances" objects (api/instances_parser.h)
+  int64_t instance_count = 0;            // copies they place
 };
 
 // `shutter_extent` = max(|open|, |close|): motion must not carry objects out of range by then.

@@ -35,6 +35,7 @@ struct Limits {
   int64_t max_vertices = 12'000'000;              // mesh vertices, whole scene
   int64_t max_mesh_file_bytes = int64_t(1) << 30;  // any one mesh file
   int max_objects = 100'000;
+  int64_t max_instances = 100'000;  // copies placed by "instances" objects, whole scene
   int max_materials = 10'000;
   int max_lights = 10'000;
   int max_json_depth = 64;

@@ -245,6 +245,7 @@ std::optional<SceneRequest> parse_scene(const Json& document, const Limits& limi
   request.scene.materials.insert(request.scene.materials.end(), objects.extra_materials.begin(),
                                  objects.extra_materials.end());
   request.scene.objects = std::move(objects.objects);
+  request.scene.instances = std::move(objects.instances);
   request.assets = std::move(objects.assets);
   request.scene.texture_limits = textures.renderer_limits();
   return request;

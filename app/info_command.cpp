@@ -6,6 +6,7 @@
 #include <cstring>
 #include <filesystem>
 #include <limits>
+#include <set>
 #include <string>
 #include <variant>
 #include <vector>
@@ -98,6 +99,15 @@ int print_scene(const std::string& file) {
       vertices += int64_t(mesh->positions.size());
     }
   }
+  // Copies placed by instances objects, and the triangles they draw (not stored again).
+  int64_t copies = 0, drawn = triangles;
+  std::set<uint32_t> copied;
+  for (const InstancesDesc& set : scene.instances) {
+    copied.insert(set.object);
+    copies += int64_t(set.transforms.size());
+    if (const auto* mesh = std::get_if<MeshDesc>(&scene.objects[set.object].shape))
+      drawn += int64_t(set.transforms.size()) * int64_t(mesh->indices.size() / 3);
+  }
   int64_t points = 0, directionals = 0;
   for (const LightDesc& light : scene.lights)
     (std::holds_alternative<PointLightDesc>(light) ? points : directionals)++;
@@ -106,12 +116,19 @@ int print_scene(const std::string& file) {
               is_gltf(file) ? "glTF asset, rendered at" : "scene,", settings.width, settings.height,
               settings.spp);
   std::printf(
-      "  objects     %zu: %s; %lld emitting\n", scene.objects.size(),
-      list_counts(
-          {{"sphere", "spheres", spheres}, {"quad", "quads", quads}, {"mesh", "meshes", meshes}})
+      "  objects     %zu: %s; %lld emitting\n", scene.objects.size() + scene.instances.size(),
+      list_counts({{"sphere", "spheres", spheres},
+                   {"quad", "quads", quads},
+                   {"mesh", "meshes", meshes},
+                   {"instances object", "instances objects", int64_t(scene.instances.size())}})
           .c_str(),
       static_cast<long long>(emitting));
   std::printf("  triangles   %lld\n", static_cast<long long>(triangles));
+  if (!scene.instances.empty())
+    std::printf("  instances   %lld %s of %zu %s, %lld triangles drawn in all\n",
+                static_cast<long long>(copies), copies == 1 ? "copy" : "copies",
+                copied.size(), copied.size() == 1 ? "mesh" : "meshes",
+                static_cast<long long>(drawn));
   std::printf("  vertices    %lld\n", static_cast<long long>(vertices));
   std::printf("  lights      %s; environment %s\n",
               list_counts({{"point light", "point lights", points},

@@ -51,9 +51,14 @@ int run_validate(int argc, char** argv) {
     const SceneInput& scene = result.request->scene;
     const auto emitters = std::count_if(scene.objects.begin(), scene.objects.end(),
                                         [](const ObjectDesc& o) { return !is_black(o.emission); });
-    std::printf("%s: OK (%zu objects, %lld triangles, %zu lights, %lld emitting objects)\n",
-                file.c_str(), scene.objects.size(), static_cast<long long>(count_triangles(scene)),
-                scene.lights.size(), static_cast<long long>(emitters));
+    size_t copies = 0;  // placed by instances objects, which are objects too
+    for (const InstancesDesc& set : scene.instances) copies += set.transforms.size();
+    const std::string instanced =
+        scene.instances.empty() ? "" : ", " + std::to_string(copies) + " instanced copies";
+    std::printf("%s: OK (%zu objects, %lld triangles, %zu lights, %lld emitting objects%s)\n",
+                file.c_str(), scene.objects.size() + scene.instances.size(),
+                static_cast<long long>(count_triangles(scene)), scene.lights.size(),
+                static_cast<long long>(emitters), instanced.c_str());
   }
   return all_valid ? 0 : 1;
 }

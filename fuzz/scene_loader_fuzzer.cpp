@@ -25,6 +25,7 @@ penumbra::api::Limits fuzz_limits() {
   l.max_depth = 16;
   l.max_triangles = 20'000;
   l.max_objects = 200;
+  l.max_instances = 200;
   l.max_materials = 64;
   l.max_lights = 64;
   l.max_json_depth = 32;

@@ -3,6 +3,9 @@
 # Idempotent; needs root (or sudo). Used by the README, .ci/run and docker/Dockerfile.
 #   scripts/install-deps.sh           build, test and run
 #   scripts/install-deps.sh --fuzz    also clang and its sanitizer/libFuzzer runtime (scripts/fuzz.sh)
+#   scripts/install-deps.sh --schemathesis  also the Python venv with schemathesis, the HTTP API
+#                                     fuzzer of the ctest label "schemathesis" (PyPI, pinned;
+#                                     scripts/setup-schemathesis-venv.sh)
 set -euo pipefail
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
@@ -23,3 +26,4 @@ if [ ${#missing[@]} -gt 0 ]; then
   $SUDO apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
+if [ "${1:-}" = "--schemathesis" ]; then "$(dirname "$0")/setup-schemathesis-venv.sh"; fi

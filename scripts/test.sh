@@ -2,7 +2,8 @@
 # The test command: installs the dependencies, builds, and runs the whole test suite (ctest).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-./scripts/install-deps.sh
+# --schemathesis: also the pinned Python venv (.venv-schemathesis) of the "schemathesis" label.
+./scripts/install-deps.sh --schemathesis
 ./scripts/build.sh
 BUILD_DIR=${BUILD_DIR:-build}
 ctest --test-dir "$BUILD_DIR" --output-on-failure -j"$(nproc)" --timeout 300 "$@"

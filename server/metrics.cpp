@@ -14,6 +14,16 @@ void Metrics::count_rejected(const std::string& reason) {
   ++rejected_[reason];
 }
 
+void Metrics::count_stopped_early(const std::string& reason) {
+  std::lock_guard lock(mutex_);
+  ++stopped_early_[reason];
+}
+
+void Metrics::count_connection_refused(const std::string& reason) {
+  std::lock_guard lock(mutex_);
+  ++connections_refused_[reason];
+}
+
 void Metrics::observe_render(const std::string& final_state, double seconds, uint64_t rays) {
   std::lock_guard lock(mutex_);
   ++finished_[final_state];
@@ -57,6 +67,16 @@ std::string Metrics::render_text(const Gauges& g) const {
        "# TYPE penumbra_jobs_finished_total counter\n";
   for (const auto& [state, n] : finished_)
     o << "penumbra_jobs_finished_total{state=\"" << state << "\"} " << n << "\n";
+  o << "# HELP penumbra_jobs_stopped_early_total Renders that ended before their planned "
+       "samples, by reason.\n# TYPE penumbra_jobs_stopped_early_total counter\n"
+    << "penumbra_jobs_stopped_early_total{reason=\"time_limit\"} "
+    << (stopped_early_.count("time_limit") ? stopped_early_.at("time_limit") : 0) << "\n";
+  o << "# HELP penumbra_http_connections_refused_total Connections answered by a head or rate "
+       "limit (limit) or refused for want of a connection thread (overload).\n"
+       "# TYPE penumbra_http_connections_refused_total counter\n";
+  for (const char* reason : {"limit", "overload"})
+    o << "penumbra_http_connections_refused_total{reason=\"" << reason << "\"} "
+      << (connections_refused_.count(reason) ? connections_refused_.at(reason) : 0) << "\n";
   o << "# HELP penumbra_render_seconds Wall-clock time of a render (scene build excluded).\n"
        "# TYPE penumbra_render_seconds histogram\n";
   for (std::size_t i = 0; i < kRenderSecondsBuckets.size(); ++i)

@@ -21,6 +21,11 @@ class Metrics {
   void count_submitted() { submitted_.fetch_add(1); }
   void count_rejected(const std::string& reason);
   void observe_render(const std::string& final_state, double seconds, uint64_t rays);
+  // A render that ended before its planned samples ("time_limit").
+  void count_stopped_early(const std::string& reason);
+  // Connections answered by a ConnectionLimits limit ("limit") or refused for want of a
+  // connection thread ("overload").
+  void count_connection_refused(const std::string& reason);
 
   struct Gauges {
     std::map<std::string, int64_t> jobs_by_state;
@@ -36,6 +41,8 @@ class Metrics {
   std::map<std::tuple<std::string, std::string, int>, uint64_t> requests_;
   std::map<std::string, uint64_t> rejected_;
   std::map<std::string, uint64_t> finished_;
+  std::map<std::string, uint64_t> stopped_early_;
+  std::map<std::string, uint64_t> connections_refused_;
   std::array<uint64_t, kRenderSecondsBuckets.size()> render_buckets_{};
   uint64_t render_count_ = 0;
   double render_seconds_sum_ = 0;

@@ -6,11 +6,13 @@
 #include <cstdlib>
 #include <filesystem>
 #include <pthread.h>
+#include <sys/resource.h>
 #include <thread>
 #include <unistd.h>
 
 #include "server/http/http_server.h"
 #include "server/jobs/job_service.h"
+#include "server/loopback.h"
 #include "server/metrics.h"
 #include "server/server_config.h"
 #include "server/storage/file_result_store.h"
@@ -40,13 +42,24 @@ int run_serve(int argc, char** argv) {
     return 2;
   }
   const ServerConfig config = *parsed.config;
-  if (!is_loopback_host(config.host) && config.token.empty() && !config.insecure) {
+  // Decided on the addresses the host resolves to, and once more on the address actually bound.
+  const bool open_without_token = config.token.empty() && !config.insecure;
+  const auto refuse_open = [&config] {
     std::fprintf(stderr,
-                 "penumbra serve: refusing to listen on %s without a token: anyone who can reach "
-                 "it could use it.\nSet --token (or PENUMBRA_TOKEN), or pass --insecure if a "
+                 "penumbra serve: refusing to listen on %s without a token: it is not a loopback "
+                 "address (decided on the addresses it resolves to), so anyone who can reach it "
+                 "could use it.\nSet --token (or PENUMBRA_TOKEN), or pass --insecure if a "
                  "proxy in front authenticates.\n",
                  config.host.c_str());
     return 2;
+  };
+  if (open_without_token && !is_loopback_host(config.host)) return refuse_open();
+
+  // One descriptor per connection: --http-threads connections need more than the usual soft
+  // limit of 1024, so the soft limit is raised to the hard one.
+  if (rlimit nofile{}; ::getrlimit(RLIMIT_NOFILE, &nofile) == 0 && nofile.rlim_cur < nofile.rlim_max) {
+    nofile.rlim_cur = nofile.rlim_max;
+    ::setrlimit(RLIMIT_NOFILE, &nofile);
   }
 
   // Signals are taken by one thread with sigwait; every other thread (created after this)
@@ -68,6 +81,7 @@ int run_serve(int argc, char** argv) {
     std::fprintf(stderr, "penumbra serve: cannot listen on %s:%d\n", config.host.c_str(), config.port);
     return 1;
   }
+  if (open_without_token && !http.bound_to_loopback()) return refuse_open();
   jobs.start();
 
   std::atomic<bool> shutting_down{false};

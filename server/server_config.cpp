@@ -89,6 +89,13 @@ std::vector<Setting> settings() {
                   &ServerConfig::max_triangles),
       duration_setting("--max-render-time", "PENUMBRA_MAX_RENDER_TIME", 0.001,
                        &ServerConfig::max_render_seconds),
+      {"--min-free-space", "PENUMBRA_MIN_FREE_SPACE", true,
+       [](ServerConfig& c, const std::string& v) -> std::string {
+         const auto b = parse_byte_size(v);
+         if (!b) return bad("--min-free-space", v, "a size such as 64M");
+         c.min_free_bytes = *b;
+         return "";
+       }},
       duration_setting("--retention", "PENUMBRA_RETENTION", 0.001, &ServerConfig::retention_seconds),
       {"--token", "PENUMBRA_TOKEN", true,
        [](ServerConfig& c, const std::string& v) -> std::string {
@@ -100,7 +107,25 @@ std::vector<Setting> settings() {
          c.insecure = parse_bool(v);
          return "";
        }},
-      int_setting("--http-threads", "PENUMBRA_HTTP_THREADS", 2, 1024, &ServerConfig::http_threads),
+      int_setting("--http-threads", "PENUMBRA_HTTP_THREADS", 2, 16384, &ServerConfig::http_threads),
+      duration_setting("--header-timeout", "PENUMBRA_HEADER_TIMEOUT", 0.001,
+                       &ServerConfig::header_timeout_seconds),
+      {"--min-transfer-rate", "PENUMBRA_MIN_TRANSFER_RATE", true,
+       [](ServerConfig& c, const std::string& v) -> std::string {
+         const auto b = parse_byte_size(v);
+         if (!b || *b == 0) return bad("--min-transfer-rate", v, "bytes per second such as 8k");
+         c.min_transfer_rate = *b;
+         return "";
+       }},
+      int_setting("--max-headers", "PENUMBRA_MAX_HEADERS", 8, 10000, &ServerConfig::max_headers),
+      {"--max-header-bytes", "PENUMBRA_MAX_HEADER_BYTES", true,
+       [](ServerConfig& c, const std::string& v) -> std::string {
+         const auto b = parse_byte_size(v);
+         if (!b || *b < 1024 || *b > (64u << 20))
+           return bad("--max-header-bytes", v, "a size from 1k to 64M such as 64k");
+         c.max_header_bytes = *b;
+         return "";
+       }},
       duration_setting("--read-timeout", "PENUMBRA_READ_TIMEOUT", 0.001,
                        &ServerConfig::read_timeout_seconds),
       duration_setting("--write-timeout", "PENUMBRA_WRITE_TIMEOUT", 0.001,
@@ -173,10 +198,6 @@ std::optional<std::size_t> parse_byte_size(const std::string& text) {
   return std::size_t(*v) * unit;
 }
 
-bool is_loopback_host(const std::string& host) {
-  if (host == "localhost" || host == "::1" || host == "[::1]") return true;
-  return host.rfind("127.", 0) == 0;
-}
 
 ConfigParse parse_server_config(const std::vector<std::string>& args,
                                 const std::function<const char*(const char*)>& getenv) {
@@ -249,14 +270,28 @@ const char* serve_usage() {
          "  --max-triangles N        triangles per scene (default 2000000) [PENUMBRA_MAX_TRIANGLES]\n"
          "  --max-render-time DUR    render time per job; longer renders stop there and keep\n"
          "                           their image (default 10m) [PENUMBRA_MAX_RENDER_TIME]\n"
+         "  --min-free-space SIZE    kept free on the data directory's file system beyond the\n"
+         "                           worst case of accepted jobs; below it POST is 507 and\n"
+         "                           /readyz 503 (default 64M) [PENUMBRA_MIN_FREE_SPACE]\n"
          "  --retention DUR          finished jobs and results are deleted after this\n"
          "                           (default 24h) [PENUMBRA_RETENTION]\n"
          "  --token TOKEN            require 'Authorization: Bearer TOKEN' on every route but\n"
          "                           /healthz (default: none) [PENUMBRA_TOKEN]\n"
          "  --insecure               allow a non-loopback --host without a token [PENUMBRA_INSECURE=1]\n"
-         "  --http-threads N         HTTP connection threads (default 8) [PENUMBRA_HTTP_THREADS]\n"
-         "  --read-timeout DUR       socket read timeout (default 10s) [PENUMBRA_READ_TIMEOUT]\n"
-         "  --write-timeout DUR      socket write timeout (default 30s) [PENUMBRA_WRITE_TIMEOUT]\n"
+         "  --http-threads N         connections served at once, a thread each started on demand;\n"
+         "                           more are answered 503 (default 1024) [PENUMBRA_HTTP_THREADS]\n"
+         "  --header-timeout DUR     the whole request head must arrive within this (default 10s)\n"
+         "                           [PENUMBRA_HEADER_TIMEOUT]\n"
+         "  --read-timeout DUR       a body may take this plus its size at the minimum rate\n"
+         "                           (default 10s) [PENUMBRA_READ_TIMEOUT]\n"
+         "  --write-timeout DUR      a response may take this plus its size at the minimum rate\n"
+         "                           (default 30s) [PENUMBRA_WRITE_TIMEOUT]\n"
+         "  --min-transfer-rate SIZE bytes per second a body or response averages after its\n"
+         "                           grace time (default 8k) [PENUMBRA_MIN_TRANSFER_RATE]\n"
+         "  --max-headers N          header lines per request, more -> 431 (default 100)\n"
+         "                           [PENUMBRA_MAX_HEADERS]\n"
+         "  --max-header-bytes SIZE  request line and headers, more -> 431 (default 64k)\n"
+         "                           [PENUMBRA_MAX_HEADER_BYTES]\n"
          "  --keep-alive SECONDS     idle keep-alive connection timeout (default 5)\n"
          "                           [PENUMBRA_KEEP_ALIVE]\n"
          "  --keep-alive-requests N  requests per connection (default 100)\n"

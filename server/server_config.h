@@ -25,11 +25,20 @@ struct ServerConfig {
   int64_t max_triangles = 2'000'000;
   double max_render_seconds = 600.0;  // wall-clock budget per job; renders stop there, image kept
   double retention_seconds = 24 * 3600.0;
+  // Kept free on the data directory's file system beyond every accepted job's worst case:
+  // below it POST answers 507 and /readyz is not ready.
+  std::size_t min_free_bytes = std::size_t(64) << 20;
   std::string token;  // empty = no authentication
   bool insecure = false;
-  int http_threads = 8;
-  double read_timeout_seconds = 10.0;
-  double write_timeout_seconds = 30.0;
+  // Connections served at once, one thread each, started on demand and gone after 10 s idle;
+  // beyond this a connection is answered 503 at once (docs/design-notes.md, slow clients).
+  int http_threads = 1024;
+  double header_timeout_seconds = 10.0;  // the whole request head, however slowly it comes
+  double read_timeout_seconds = 10.0;    // grace for a body before the minimum rate applies
+  double write_timeout_seconds = 30.0;   // grace for a response before the minimum rate applies
+  std::size_t min_transfer_rate = 8192;  // bytes/s a body or response must average after grace
+  int max_headers = 100;                 // header lines per request; more -> 431
+  std::size_t max_header_bytes = 65536;  // request line + headers; more -> 431
   int keep_alive_seconds = 5;
   int keep_alive_max_requests = 100;
   double drain_seconds = 1.0;  // after SIGTERM: /readyz answers 503 this long before the port closes
@@ -56,8 +65,6 @@ ConfigParse parse_server_config(const std::vector<std::string>& args,
 std::optional<double> parse_duration(const std::string& text);
 // "16777216" / "512k" / "16M" / "1G" (binary units) -> bytes.
 std::optional<std::size_t> parse_byte_size(const std::string& text);
-// True for 127.0.0.0/8, ::1 and "localhost": addresses other machines cannot reach.
-bool is_loopback_host(const std::string& host);
 
 const char* serve_usage();
 

@@ -23,6 +23,11 @@ The conversion keeps every semantic of the format (issue 2, docs/accuracy.md has
   by Mitsuba's own Bitmap), ``raw``, with the same ``filter_type`` and ``wrap_mode``; a normal
   map wraps the BSDF in ``normalmap`` inside ``twosided`` (see :class:`TextureBaker`).
 
+* an ``instances`` object becomes a ``shapegroup`` holding the mesh it names (converted as that
+  object is, its own ``transform`` included) and one ``instance`` per transform, whose
+  ``to_world`` is that transform: both apply the copy's transform after the mesh's own
+  (:func:`convert_instances`). The mesh is also converted where it stands, as penumbra draws it.
+
 Mitsuba 3.9 has no moving shapes. :func:`to_mitsuba` therefore builds the scene at one instant
 ``time``; a motion-blurred reference is the average of renders at many instants spread over the
 shutter (see :func:`shutter_instants` and tools/make_references.py).
@@ -386,14 +391,17 @@ def area_weighted_normals(positions: np.ndarray, faces: np.ndarray) -> np.ndarra
     return n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-30)
 
 
-def build_mesh(mi, name: str, positions, faces, normals, children: dict):
+def build_mesh(mi, name: str, positions, faces, normals, children: dict, uvs=None):
     """A Mitsuba mesh from numpy arrays; ``children`` are instantiated plugins (bsdf, emitter,
     interior) attached through the mesh's Properties. Without normals Mitsuba uses face normals.
+    ``uvs`` (one pair per vertex) carry over as they are: both formats put uv (0, 0) at an
+    image's top-left corner.
     """
     props = mi.Properties()
     for key, value in children.items():
         props[key] = value
-    mesh = mi.Mesh(name, len(positions), len(faces), props, has_vertex_normals=normals is not None)
+    mesh = mi.Mesh(name, len(positions), len(faces), props, has_vertex_normals=normals is not None,
+                   has_vertex_texcoords=uvs is not None)
     params = mi.traverse(mesh)
     # The buffers' own types (dynamic arrays in every variant, scalar_rgb included).
     float_buffer = type(params["vertex_positions"])
@@ -401,6 +409,8 @@ def build_mesh(mi, name: str, positions, faces, normals, children: dict):
     params["faces"] = type(params["faces"])(faces.astype(np.uint32).ravel())
     if normals is not None:
         params["vertex_normals"] = float_buffer(normals.astype(np.float32).ravel())
+    if uvs is not None:
+        params["vertex_texcoords"] = float_buffer(np.asarray(uvs, dtype=np.float32).ravel())
     params.update()
     return mesh
 
@@ -448,7 +458,8 @@ def convert_object(mi, index: int, obj: dict, materials: dict, time: float,
         return mesh_file_shape(mi, obj, matrix, offset, children)
     if kind == "mesh":
         positions, faces, normals = mesh_arrays(obj, matrix, offset)
-        return build_mesh(mi, f"mesh{index}", positions, faces, normals, instantiate(mi, children))
+        uvs = np.asarray(obj["uvs"], dtype=np.float64).reshape(-1, 2) if obj.get("uvs") else None
+        return build_mesh(mi, f"mesh{index}", positions, faces, normals, instantiate(mi, children), uvs)
     raise ValueError(f"object {index}: unknown type {kind!r}")
 
 
@@ -502,6 +513,26 @@ def resolve_mesh_files(scene: dict, folder: str) -> dict:
         if obj.get("type") == "mesh" and "file" in obj:
             obj["file"] = os.path.join(folder, obj["file"])
     return scene
+
+
+def convert_instances(mi, index: int, obj: dict, objects: list, materials: dict, time: float,
+                      textures, out: dict) -> None:
+    """Add a penumbra ``instances`` object to the scene dictionary ``out``: the shape group of the
+    mesh it names (once per mesh) and an ``instance`` of it per transform.
+
+    Penumbra refuses copies of emitting meshes, and Mitsuba's shape groups cannot hold emitters,
+    so the group's shape has none. The group holds a second conversion of the mesh (the first is
+    drawn where it stands): one Mitsuba shape cannot belong to two parents.
+    """
+    mesh_index = int(obj["mesh"])
+    group = f"group{mesh_index}"
+    if group not in out:
+        out[group] = {"type": "shapegroup",
+                      "shape": convert_object(mi, mesh_index, objects[mesh_index], materials, time,
+                                              textures)}
+    for k, transform in enumerate(obj["transforms"]):
+        out[f"object{index}_{k}"] = {"type": "instance", "shapegroup": {"type": "ref", "id": group},
+                                     "to_world": mi.ScalarTransform4f(object_matrix(transform))}
 
 
 def instantiate(mi, children: dict) -> dict:
@@ -605,8 +636,12 @@ def to_mitsuba(mi, scene: dict, time: float = 0.0, spp: int | None = None,
     }
     materials = scene.get("materials", {})
     textures = TextureBaker(mi, assets)
-    for i, obj in enumerate(scene.get("objects", [])):
-        out[f"object{i}"] = convert_object(mi, i, obj, materials, time, textures)
+    objects = scene.get("objects", [])
+    for i, obj in enumerate(objects):
+        if obj.get("type") == "instances":
+            convert_instances(mi, i, obj, objects, materials, time, textures, out)
+        else:
+            out[f"object{i}"] = convert_object(mi, i, obj, materials, time, textures)
     for i, light in enumerate(scene.get("lights", [])):
         out[f"light{i}"] = convert_light(light)
     environment = convert_environment(mi, scene.get("environment"))

@@ -73,6 +73,9 @@ struct SurfaceHit {
   vec3 dpdu{0.f}, dpdv{0.f};
   uint32_t object = 0;
   uint32_t primitive = 0;
+  // The copy hit (Scene::instance), or kNotACopy: a copy's hit reports its mesh's object.
+  static constexpr uint32_t kNotACopy = ~0u;
+  uint32_t instance = kNotACopy;
 };
 
 }  // namespace penumbra

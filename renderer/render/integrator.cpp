@@ -26,8 +26,8 @@ bool geometry_agrees(const vec3& wi_world, const vec3& wo_world, const vec3& ng,
 // The shading frame with its tangent along dp/du, which a normal map's x axis follows
 // (Mitsuba 3's SurfaceInteraction::initialize_sh_frame: Gram-Schmidt of dp/du against the
 // shading normal). Any frame of the normal where the parametrisation degenerates.
-Frame tangent_frame(const Shape& shape, float time, SurfaceHit* hit) {
-  shape.surface_derivatives(time, hit);
+Frame tangent_frame(const Scene& scene, float time, SurfaceHit* hit) {
+  scene.surface_derivatives(time, hit);
   const vec3 n = hit->ns;
   const vec3 s = hit->dpdu - n * glm::dot(n, hit->dpdu);
   const float len = glm::length(s);
@@ -104,7 +104,7 @@ Spectrum integrate(const Scene& scene, const IntegratorSettings& settings, Ray r
     std::optional<SurfaceBsdf> textured;
     const SurfaceBsdf* bsdf = &material.bsdf();
     if (material.varies()) bsdf = &textured.emplace(material.bsdf_at(TextureQuery{hit.p, hit.uv, ray.time}));
-    const Frame frame = material.normal_mapped() ? tangent_frame(*obj.shape, ray.time, &hit) : Frame(hit.ns);
+    const Frame frame = material.normal_mapped() ? tangent_frame(scene, ray.time, &hit) : Frame(hit.ns);
     const vec3 wi_world = -ray.direction;
     const vec3 wi = frame.to_local(wi_world);
     const uint32_t lobes = bsdf->lobes();

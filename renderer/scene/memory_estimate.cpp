@@ -1,6 +1,8 @@
 #include "renderer/scene/memory_estimate.h"
 
+#include <algorithm>
 #include <variant>
+#include <vector>
 
 namespace penumbra {
 namespace {
@@ -11,6 +13,12 @@ namespace {
 // (docs/mesh-files.md).
 constexpr int64_t kBvhBytesPerTriangle = 64;
 constexpr int64_t kBvhBuildExtraPerTriangle = 52;
+// A copy placed by an instances object: the renderer's Instance (shapes/instance.h) plus
+// Embree's instance geometry, its transforms and its share of the top-level BVH. Measured
+// (docs/instancing.md): 520-540 resident bytes per copy after the build
+// (InstanceMemory.CopiesCostBytesNotTheMesh), 580-800 at the peak of a render
+// (bench/instancing_benchmark.sh); the estimate takes the larger.
+constexpr int64_t kBytesPerInstance = 800;
 // Film::Pixel (2 x 3 doubles + a count, padded to 56) plus the float RGB image and its variance.
 constexpr int64_t kFilmBytesPerPixel = 56 + 12 + 12;
 
@@ -44,6 +52,18 @@ MemoryEstimate estimate_memory(const SceneInput& scene, const RenderSettings& se
     if (const auto* mesh = std::get_if<MeshDesc>(&object.shape))
       add_mesh(*mesh, !is_black(object.emission),
                object.velocity != vec3(0.f) || object.acceleration != vec3(0.f), e);
+  // Each instanced mesh gets a second BVH (its child scene), sharing its vertex buffers.
+  std::vector<bool> copied(scene.objects.size(), false);
+  for (const InstancesDesc& set : scene.instances) {
+    e.embree += int64_t(set.transforms.size()) * kBytesPerInstance;
+    if (set.object >= scene.objects.size() || copied[set.object]) continue;
+    copied[set.object] = true;
+    if (const auto* mesh = std::get_if<MeshDesc>(&scene.objects[set.object].shape)) {
+      const int64_t triangles = int64_t(mesh->indices.size() / 3);
+      e.embree += triangles * kBvhBytesPerTriangle;
+      e.embree_build_peak = std::max(e.embree_build_peak, triangles * kBvhBuildExtraPerTriangle);
+    }
+  }
   e.film = int64_t(settings.width) * settings.height * kFilmBytesPerPixel;
   return e;
 }

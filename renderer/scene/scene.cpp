@@ -35,11 +35,26 @@ bool Scene::intersect(const Ray& ray, SurfaceHit* hit) const {
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
 
   hit->t = rh.ray.tfar;
-  hit->object = rh.hit.geomID;
   hit->primitive = rh.hit.primID;
+  if (rh.hit.instID[0] != RTC_INVALID_GEOMETRY_ID) {  // a copy: geomID is the mesh's id in it
+    const Instance& copy = instances_[rh.hit.instID[0] - objects_.size()];
+    hit->object = copy.object();
+    hit->instance = rh.hit.instID[0] - uint32_t(objects_.size());
+    copy.hit_geometry(ray, hit->t, rh.hit.primID, vec2(rh.hit.u, rh.hit.v), hit);
+    return true;
+  }
+  hit->object = rh.hit.geomID;
+  hit->instance = SurfaceHit::kNotACopy;
   objects_[rh.hit.geomID].shape->hit_geometry(ray, hit->t, rh.hit.primID, vec2(rh.hit.u, rh.hit.v),
                                               hit);
   return true;
+}
+
+void Scene::surface_derivatives(float time, SurfaceHit* hit) const {
+  if (hit->instance != SurfaceHit::kNotACopy)
+    instances_[hit->instance].surface_derivatives(time, hit);
+  else
+    objects_[hit->object].shape->surface_derivatives(time, hit);
 }
 
 bool Scene::occluded(const vec3& origin, const vec3& dir, float t_max, float time) const {

@@ -14,6 +14,7 @@
 #include "renderer/scene/scene_features.h"
 #include "renderer/scene/scene_input.h"
 #include "renderer/scene/scene_object.h"
+#include "renderer/shapes/instance.h"
 
 struct RTCSceneTy;  // Embree's scene handle
 
@@ -34,6 +35,9 @@ class Scene {
 
   // Nearest surface along the ray (t in (0, ray.t_max)), with its geometry rebuilt by its shape.
   bool intersect(const Ray& ray, SurfaceHit* hit) const;
+  // Fills hit->dpdu and dpdv (Shape::surface_derivatives) of a hit intersect() returned, on an
+  // object or on a copy (shapes/instance.h).
+  void surface_derivatives(float time, SurfaceHit* hit) const;
   // Whether anything blocks origin + t*dir for t in (0, t_max) at normalised time `time`.
   bool occluded(const vec3& origin, const vec3& dir, float t_max, float time) const;
 
@@ -43,6 +47,10 @@ class Scene {
   const Bounds3& bounds() const { return bounds_; }
 
   size_t object_count() const { return objects_.size(); }
+  // Placed copies of mesh objects (SceneInput::instances, flattened); a hit on one reports its
+  // mesh's object index.
+  size_t instance_count() const { return instances_.size(); }
+  const Instance& instance(size_t index) const { return instances_[index]; }
   const SceneObject& object(uint32_t id) const { return objects_[id]; }
   const Material& material(uint32_t index) const { return materials_[index]; }
 
@@ -70,6 +78,10 @@ class Scene {
   std::vector<std::unique_ptr<FloatTexture>> alpha_textures_;  // cutouts, pointed to by shapes
   std::vector<std::unique_ptr<Shape>> shapes_;
   std::vector<SceneObject> objects_;  // index = Embree geometry id
+  // Embree geometry id = objects_.size() + index. The child scenes they instance (one per
+  // instanced mesh) are owned here and released after rtc_scene_.
+  std::vector<Instance> instances_;
+  std::vector<EmbreeScene> instanced_scenes_;
   std::vector<std::unique_ptr<Light>> lights_;
   LightSampler light_sampler_;
   const EnvironmentLight* environment_ = nullptr;

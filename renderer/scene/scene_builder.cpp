@@ -90,9 +90,30 @@ class SceneBuilder {
     }
   }
 
+  // Copies of meshes (shapes/instance.h). Only a mesh that does not emit can be copied: an
+  // area light samples its own shape, and a copy has none (the api reports this on the field).
+  void instances() {
+    size_t copies = 0;
+    for (const InstancesDesc& desc : in_.instances) copies += desc.transforms.size();
+    s_.instances_.reserve(copies);
+    for (const InstancesDesc& desc : in_.instances) {
+      if (desc.object >= s_.objects_.size())
+        throw SceneBuildError("instances of object " + std::to_string(desc.object) +
+                              ": no such object");
+      const Shape& shape = *s_.objects_[desc.object].shape;
+      if (!std::holds_alternative<MeshDesc>(in_.objects[desc.object].shape) ||
+          !is_black(in_.objects[desc.object].emission))
+        throw SceneBuildError("instances of object " + std::to_string(desc.object) +
+                              ": only a mesh that does not emit can be instanced");
+      for (const InstanceTransform& t : desc.transforms)
+        s_.instances_.emplace_back(shape, desc.object, t);
+    }
+  }
+
   void bounds() {
     Bounds3 b;
     for (const auto& shape : s_.shapes_) b.extend(shape->bounds());
+    for (const Instance& copy : s_.instances_) b.extend(copy.bounds());
     if (s_.shapes_.empty()) b = Bounds3{vec3(0.f), vec3(0.f)};
     s_.bounds_ = b;
   }
@@ -136,6 +157,28 @@ class SceneBuilder {
     s_.features_.environment = true;
   }
 
+  // One child scene per instanced mesh, holding the mesh's own geometry; then one Embree
+  // instance per copy, with ids after the objects'.
+  void attach_instances(RTCDevice device, RTCScene scene, const std::vector<EmbreeGeometry>& geometries,
+                        EmbreeErrorScope& errors) {
+    std::vector<RTCScene> child_of(s_.objects_.size(), nullptr);
+    for (size_t k = 0; k < s_.instances_.size(); ++k) {
+      const Instance& copy = s_.instances_[k];
+      RTCScene& child = child_of[copy.object()];
+      if (!child) {
+        EmbreeScene made = make_instanced_scene(device, geometries[copy.object()].get());
+        if (!made) throw SceneBuildError("Embree could not create a scene: " + errors.first_error());
+        child = made.get();
+        s_.instanced_scenes_.push_back(std::move(made));
+      }
+      const EmbreeGeometry geom = copy.make_geometry(device, child);
+      if (!geom)
+        throw SceneBuildError("Embree could not create instance " + std::to_string(k) + ": " +
+                              errors.first_error());
+      rtcAttachGeometryByID(scene, geom.get(), unsigned(s_.objects_.size() + k));
+    }
+  }
+
   void embree_scene() {
     RTCDevice device = embree_device();
     EmbreeErrorScope errors;
@@ -146,13 +189,15 @@ class SceneBuilder {
     // re-hit the surface they leave). The Embree-only benchmark traces this same scene, so it
     // pays for both too.
     rtcSetSceneFlags(scene.get(), RTC_SCENE_FLAG_ROBUST);
+    std::vector<EmbreeGeometry> geometries(s_.shapes_.size());  // kept for the instances
     for (size_t i = 0; i < s_.shapes_.size(); ++i) {
-      const EmbreeGeometry geom = s_.shapes_[i]->make_geometry(device);
-      if (!geom)
+      geometries[i] = s_.shapes_[i]->make_geometry(device);
+      if (!geometries[i])
         throw SceneBuildError("Embree could not create the geometry of object " + std::to_string(i) +
                               ": " + errors.first_error());
-      rtcAttachGeometryByID(scene.get(), geom.get(), unsigned(i));
+      rtcAttachGeometryByID(scene.get(), geometries[i].get(), unsigned(i));
     }
+    attach_instances(device, scene.get(), geometries, errors);
     rtcCommitScene(scene.get());
     const std::string error = errors.first_error();
     if (!error.empty()) throw SceneBuildError(error);
@@ -171,6 +216,7 @@ std::unique_ptr<Scene> Scene::build(const SceneInput& input) {
   b.camera_and_shutter();
   b.materials();
   b.shapes();
+  b.instances();
   b.bounds();
   b.lights();
   b.embree_scene();

@@ -10,6 +10,7 @@
 
 #include "renderer/materials/material_params.h"
 #include "renderer/core/math.h"
+#include "renderer/scene/instance_input.h"
 #include "renderer/textures/texture_desc.h"
 
 namespace penumbra {
@@ -92,6 +93,7 @@ struct SceneInput {
   std::vector<MaterialParams> materials;
   std::vector<ObjectDesc> objects;
   std::vector<LightDesc> lights;
+  std::vector<InstancesDesc> instances;  // copies of mesh objects (instance_input.h)
   TextureLimits texture_limits;  // applied again as the build decodes the textures' images
 };
 

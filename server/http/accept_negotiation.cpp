@@ -49,7 +49,10 @@ std::variant<ImageFormat, Problem> negotiate_image_format(
   if (!accept_header) return ImageFormat::kPng;
   const std::string accept = ascii_lower(*accept_header);
   std::string_view rest = accept;
-  while (!rest.empty()) {
+  // Bounded as well as linear: only the first kMaxMediaRanges ranges are read (the header line
+  // itself is capped at 8 KiB by ConnectionStream).
+  std::size_t ranges = 0;
+  while (!rest.empty() && ranges++ < kMaxMediaRanges) {
     const std::size_t comma = std::min(rest.find(','), rest.size());
     std::string_view range = rest.substr(0, comma);
     rest.remove_prefix(std::min(comma + 1, rest.size()));
@@ -62,7 +65,8 @@ std::variant<ImageFormat, Problem> negotiate_image_format(
     if (const auto format = format_for_range(trim_ows(range))) return *format;
   }
   return make_problem(406, "not-acceptable", "Not Acceptable",
-                      "results are image/png or image/x-exr (or use ?format=png|exr)");
+                      "results are image/png or image/x-exr (or use ?format=png|exr); only the "
+                      "first " + std::to_string(kMaxMediaRanges) + " media ranges of Accept are read");
 }
 
 const char* mime_type(ImageFormat f) {

@@ -12,6 +12,9 @@
 
 namespace penumbra::server {
 
+// Media ranges of Accept looked at; later ones are ignored.
+inline constexpr std::size_t kMaxMediaRanges = 64;
+
 // format_param: the ?format= value if present; accept: the Accept header if present.
 // A Problem is 400 (bad format value) or 406 (Accept names nothing the service makes).
 std::variant<ImageFormat, Problem> negotiate_image_format(

@@ -4,25 +4,62 @@
 
 #include <cstdio>
 
+#include "server/http/connection_pool.h"
 #include "server/http/problem.h"
 #include "server/http/request_guard.h"
 #include "server/http/route_table.h"
+#include "server/loopback.h"
 
 namespace penumbra::server {
+namespace {
+
+// A burst of connects beyond the listen queue waits for SYN retries (1 s, 3 s ...).
+constexpr int kListenBacklog = 1024;
+
+ConnectionLimits connection_limits(const ServerConfig& c) {
+  ConnectionLimits l;
+  l.max_header_count = std::size_t(c.max_headers);
+  l.max_header_bytes = c.max_header_bytes;
+  l.header_seconds = c.header_timeout_seconds;
+  l.body_grace_seconds = c.read_timeout_seconds;
+  l.write_grace_seconds = c.write_timeout_seconds;
+  l.min_bytes_per_second = double(c.min_transfer_rate);
+  return l;
+}
+
+// The library answers these itself, before any handler; say what they mean.
+std::string library_error_detail(int status) {
+  switch (status) {
+    case 400:
+      return "the request line or a header could not be parsed";
+    case 413:
+      return "the body is larger than the server accepts (--max-body)";
+    case 414:
+      return "the request target is too long";
+    case 416:
+      return "the Range header is not a byte range 'bytes=first-last', 'bytes=first-' or "
+             "'bytes=-suffix'";
+    default:
+      return "";
+  }
+}
+
+}  // namespace
 
 HttpServer::HttpServer(const ServerConfig& config, JobService& jobs, Metrics& metrics)
     : config_(config),
       metrics_(metrics),
       auth_(config.token),
       context_{config_, jobs, metrics, ready_},
-      server_(std::make_unique<httplib::Server>()) {
+      server_(std::make_unique<GuardedServer>(connection_limits(config), kListenBacklog, metrics)) {
   httplib::Server& s = *server_;
-  // cpp-httplib's defaults are unsafe for a public service: every limit is set here.
+  // cpp-httplib's defaults are unsafe for a public service: every limit is set here, and the
+  // per-connection ones (deadlines, head caps) in GuardedServer / ConnectionStream.
   const int threads = config_.http_threads;
-  s.new_task_queue = [threads] { return new httplib::ThreadPool(std::size_t(threads)); };
+  s.new_task_queue = [threads] {
+    return new ConnectionPool(std::size_t(threads), std::chrono::seconds(10));
+  };
   s.set_payload_max_length(config_.max_body_bytes);
-  s.set_read_timeout(std::chrono::duration<double>(config_.read_timeout_seconds));
-  s.set_write_timeout(std::chrono::duration<double>(config_.write_timeout_seconds));
   s.set_keep_alive_timeout(config_.keep_alive_seconds);
   s.set_keep_alive_max_count(std::size_t(config_.keep_alive_max_requests));
   s.set_tcp_nodelay(true);  // small JSON answers to polls go out without Nagle's delay
@@ -53,6 +90,11 @@ void HttpServer::install_handlers() {
         if (!res.body.empty() || res.content_length_ > 0)
           return httplib::Server::HandlerResponse::Unhandled;
         const std::string route = route_template(req.path);
+        // Methods the library parses but cannot route (TRACE, CONNECT) come back as 400: on a
+        // known path they are 405 like any other method it does not answer.
+        const bool unroutable_method =
+            res.status == 400 && (req.method == "TRACE" || req.method == "CONNECT");
+        if (unroutable_method) res.status = 404;  // then 405 with Allow on a known path
         if (res.status == 404 && route != "other") {
           std::string allow;
           for (const auto& m : allowed_methods(route)) allow += (allow.empty() ? "" : ", ") + m;
@@ -62,7 +104,7 @@ void HttpServer::install_handlers() {
         } else if (res.status == 404) {
           send_problem(res, req, status_problem(404, "no such resource"));
         } else {
-          send_problem(res, req, status_problem(res.status, ""));
+          send_problem(res, req, status_problem(res.status, library_error_detail(res.status)));
         }
         return httplib::Server::HandlerResponse::Handled;
       }));
@@ -91,8 +133,14 @@ void HttpServer::install_handlers() {
 }
 
 int HttpServer::bind() {
-  if (config_.port == 0) return server_->bind_to_any_port(config_.host);
-  return server_->bind_to_port(config_.host, config_.port) ? config_.port : -1;
+  const int port = config_.port == 0 ? server_->bind_to_any_port(config_.host)
+                                     : (server_->bind_to_port(config_.host, config_.port) ? config_.port : -1);
+  if (port > 0) server_->widen_backlog();
+  return port;
+}
+
+bool HttpServer::bound_to_loopback() const {
+  return is_loopback_socket(int(server_->listening_socket()));
 }
 
 bool HttpServer::listen() { return server_->listen_after_bind(); }

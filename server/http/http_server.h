@@ -7,14 +7,11 @@
 #include <memory>
 
 #include "server/http/auth.h"
+#include "server/http/guarded_server.h"
 #include "server/http/route_context.h"
 #include "server/jobs/job_service.h"
 #include "server/metrics.h"
 #include "server/server_config.h"
-
-namespace httplib {
-class Server;
-}
 
 namespace penumbra::server {
 
@@ -24,6 +21,8 @@ class HttpServer {
   ~HttpServer();
   // Binds host:port (port 0 = ephemeral); returns the bound port, or -1.
   int bind();
+  // After bind(): whether the address actually bound is a loopback address.
+  bool bound_to_loopback() const;
   // Serves until stop(); blocks.
   bool listen();
   void stop();
@@ -37,7 +36,7 @@ class HttpServer {
   BearerAuth auth_;
   std::atomic<bool> ready_{true};
   RouteContext context_;
-  std::unique_ptr<httplib::Server> server_;
+  std::unique_ptr<GuardedServer> server_;
 };
 
 }  // namespace penumbra::server

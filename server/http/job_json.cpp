@@ -64,6 +64,12 @@ nlohmann::ordered_json job_json(const JobView& v) {
   j["finished_at"] = time_or_null(r.finished_at);
   j["attempts"] = r.attempts;
   j["render"] = {{"width", r.width}, {"height", r.height}, {"spp", r.spp}};
+  // A render cut by its time limit says so at the top, with the samples per pixel it reached,
+  // so a client need not read the stats to learn that the image is less converged than asked.
+  if (stats.is_object() && stats.value("stopped_by_time_limit", false)) {
+    j["stopped_early"] = "time_limit";
+    j["spp_reached"] = stats.value("spp_mean", 0.0);
+  }
   j["stats"] = stats;
   if (!r.error_json.empty()) j["error"] = json::parse(r.error_json);
   j["warnings"] = r.warnings_json.empty() ? json::array() : json::parse(r.warnings_json);

@@ -2,6 +2,7 @@
 #include <httplib.h>
 
 #include <cmath>
+#include <cstdio>
 
 #include "server/http/idempotency_key.h"
 #include "server/http/job_json.h"
@@ -11,6 +12,7 @@
 #include "server/http/route_context.h"
 #include "server/http/route_table.h"
 #include "server/http/submission_problem.h"
+#include "server/storage/store_error.h"
 
 namespace penumbra::server {
 namespace {
@@ -59,7 +61,21 @@ void get(const RouteContext& c, const httplib::Request& req, httplib::Response& 
 
 void cancel_or_delete(const RouteContext& c, const httplib::Request& req, httplib::Response& res) {
   const std::string id = req.matches[1];
-  switch (c.jobs.cancel_or_delete(id, std::chrono::milliseconds(3000))) {
+  DeleteOutcome outcome;
+  try {
+    outcome = c.jobs.cancel_or_delete(id, std::chrono::milliseconds(3000));
+  } catch (const StoreError& e) {
+    // A full disk can fail the commit of the tombstone. The job is gone from memory and its
+    // files are removed (space freed), so a repeated DELETE answers 204; this one says the
+    // record could not be made durable yet, never 500.
+    std::fprintf(stderr, "penumbra serve: DELETE %s: %s\n", id.c_str(), e.what());
+    Problem p = make_problem(503, "storage-error", "Storage error",
+                             "the deletion of job " + id +
+                                 " could not be recorded on disk (is it full?); retry");
+    p.retry_after_seconds = 5;
+    return send_problem(res, req, p);
+  }
+  switch (outcome) {
     case DeleteOutcome::kNotFound:
       return send_problem(res, req, status_problem(404, "no job " + id));
     case DeleteOutcome::kDeleted:

@@ -20,6 +20,8 @@ const char* status_reason(int status) {
       return "Method Not Allowed";
     case 406:
       return "Not Acceptable";
+    case 408:
+      return "Request Timeout";
     case 409:
       return "Conflict";
     case 411:
@@ -34,6 +36,10 @@ const char* status_reason(int status) {
       return "Range Not Satisfiable";
     case 422:
       return "Unprocessable Content";
+    case 431:
+      return "Request Header Fields Too Large";
+    case 507:
+      return "Insufficient Storage";
     case 429:
       return "Too Many Requests";
     case 500:
@@ -55,13 +61,36 @@ Problem make_problem(int status, const std::string& slug, const std::string& tit
   return p;
 }
 
+const char* status_slug(int status) {
+  switch (status) {
+    case 400:
+      return "bad-request";
+    case 404:
+      return "not-found";
+    case 405:
+      return "method-not-allowed";
+    case 408:
+      return "request-timeout";
+    case 413:
+      return "body-too-large";
+    case 414:
+      return "uri-too-long";
+    case 416:
+      return "range-not-satisfiable";
+    case 431:
+      return "headers-too-large";
+    case 500:
+      return "internal-error";
+    case 503:
+      return "unavailable";
+    default:
+      return status >= 500 ? "server-error" : "client-error";
+  }
+}
+
 Problem status_problem(int status, const std::string& detail) {
-  Problem p;
-  p.status = status;
-  p.type = "about:blank";
-  p.title = status_reason(status);  // RFC 9457 4.2.1: about:blank's title is the reason phrase
-  p.detail = detail;
-  return p;
+  // A type of our own even for plain statuses: clients switch on `type` alone (issue 15).
+  return make_problem(status, status_slug(status), status_reason(status), detail);
 }
 
 Problem invalid_parameter(const std::string& parameter, const std::string& what) {

@@ -13,7 +13,7 @@ namespace penumbra::server {
 
 struct Problem {
   int status = 500;
-  std::string type;    // a stable URN naming the kind of problem; "about:blank" for plain statuses
+  std::string type;    // a stable URN naming the kind of problem, never about:blank
   std::string title;   // short, the same for every occurrence of the type
   std::string detail;  // this occurrence, meant for people
   nlohmann::ordered_json extensions =
@@ -24,8 +24,10 @@ struct Problem {
 // A problem of one of the service's own types, "urn:penumbra:problem:<slug>".
 Problem make_problem(int status, const std::string& slug, const std::string& title,
                      const std::string& detail);
-// For statuses that need no type of their own (404, 405, ...): type about:blank.
+// For statuses with one meaning (404, 405, ...): type urn:penumbra:problem:<status_slug(status)>.
 Problem status_problem(int status, const std::string& detail);
+// "not-found", "method-not-allowed" ...: the slug of a plain status.
+const char* status_slug(int status);
 // 400 invalid-parameter naming the query parameter: detail "<parameter> <what>" and
 // errors: [{parameter, detail: what}].
 Problem invalid_parameter(const std::string& parameter, const std::string& what);

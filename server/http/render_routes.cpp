@@ -45,7 +45,7 @@ void render(const RouteContext& c, std::atomic<int>& waiters, const httplib::Req
   const auto done = c.jobs.wait_finished(id, std::chrono::steady_clock::now() + kMaxWait);
   if (!done) return send_problem(res, req, status_problem(404, "job " + id + " was deleted"));
   const ImageFormat f = std::get<ImageFormat>(format);
-  if (done->state == JobState::kSucceeded && send_result(res, c.jobs, id, f)) return;
+  if (done->state == JobState::kSucceeded && send_result(res, c.jobs, id, f, header_value(req, "Range"))) return;
   Problem p;
   if (done->state == JobState::kFailed) {
     p = make_problem(500, "render-failed", "Render failed", "the render of job " + id + " failed");

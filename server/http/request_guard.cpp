@@ -21,6 +21,12 @@ bool is_digits(const std::string& s) {
 
 std::optional<Problem> guard_request(const httplib::Request& req, const GuardSettings& settings,
                                      const BearerAuth& auth) {
+  // The library's parsed ranges are dropped: it would cut any answer, problem documents
+  // included, and it does not check a range against the size of the body (issue 15: 206 with
+  // Content-Length 18446744073609554395). Result routes read the header themselves
+  // (byte_range.h); elsewhere Range is ignored, as RFC 9110 section 14.2 allows.
+  // (The Request object is not const in the library; only the handler's view of it is.)
+  const_cast<httplib::Request&>(req).ranges.clear();
   // Liveness must answer whatever the token: orchestrators probe it without credentials.
   if (auth.enabled() && req.path != "/healthz" &&
       !auth.allows(req.get_header_value("Authorization"))) {
@@ -63,10 +69,7 @@ std::optional<Problem> guard_request(const httplib::Request& req, const GuardSet
     }
   }
   if (req.has_header("Range") && req.get_header_value("Range").find(',') != std::string::npos) {
-    // One range at most: a many-range request multiplies the response size. The parsed ranges
-    // are dropped too, or the library would cut this very answer into a multipart response.
-    // (The Request object is not const in the library; only the handler's view of it is.)
-    const_cast<httplib::Request&>(req).ranges.clear();
+    // One range at most: a many-range request multiplies the response size.
     return make_problem(416, "multiple-ranges", "Range Not Satisfiable",
                         "only a single byte range is served");
   }
@@ -78,11 +81,20 @@ std::optional<Problem> guard_request(const httplib::Request& req, const GuardSet
         type == "application/json" || (type.rfind("application/", 0) == 0 && type.size() > 5 &&
                                        type.compare(type.size() - 5, 5, "+json") == 0);
     // curl --data-binary sends application/x-www-form-urlencoded unless told otherwise; it is
-    // read as JSON too so the one-line curl of the README works.
-    if (!json_like && type != "application/x-www-form-urlencoded")
-      return make_problem(
-          415, "unsupported-media-type", "Unsupported Media Type",
-          "the body must be a JSON scene (Content-Type: application/json), not " + type);
+    // read as JSON too so a curl line without -H works. The library would parse such a body as a
+    // form and refuse it above 8192 bytes (CPPHTTPLIB_FORM_URL_ENCODED_PAYLOAD_MAX_LENGTH) before
+    // any handler runs, so the header is rewritten here, before the body is read.
+    if (type == "application/x-www-form-urlencoded") {
+      auto& headers = const_cast<httplib::Request&>(req).headers;
+      headers.erase("Content-Type");
+      headers.emplace("Content-Type", "application/json");
+    } else if (!json_like) {
+      Problem p = make_problem(415, "unsupported-media-type", "Unsupported Media Type",
+                               "the body must be a JSON scene: send the header "
+                               "'Content-Type: application/json' (got '" + type + "')");
+      p.extensions["header"] = "Content-Type";
+      return p;
+    }
   }
   return std::nullopt;
 }

@@ -1,5 +1,6 @@
 #pragma once
 // Streams a stored result image as the answer (GET /v1/jobs/{id}/result, POST /v1/render).
+#include <optional>
 #include <string>
 
 #include "renderer/io/image_io.h"
@@ -12,9 +13,10 @@ struct Response;
 namespace penumbra::server {
 
 // False when the job has no stored result in that format. The stream stays open, so a
-// concurrent DELETE of the job does not cut the answer short. The status is left unset: the
-// library answers 206 for a (single) Range request, else 200.
+// concurrent DELETE of the job does not cut the answer short. `range` is the Range header:
+// answered 206 with Content-Range, or 416 outside the file (byte_range.h); the library's own
+// range handling is off (request_guard clears the parsed ranges).
 bool send_result(httplib::Response& res, const JobService& jobs, const std::string& id,
-                 ImageFormat format);
+                 ImageFormat format, const std::optional<std::string>& range);
 
 }  // namespace penumbra::server

@@ -23,7 +23,7 @@ void get_result(const RouteContext& c, const httplib::Request& req, httplib::Res
   if (!v) return send_problem(res, req, status_problem(404, "no job " + id));
   const JobState state = v->record.state;
   if (state == JobState::kSucceeded) {
-    if (send_result(res, c.jobs, id, f)) return;
+    if (send_result(res, c.jobs, id, f, header_value(req, "Range"))) return;
     return send_problem(res, req, status_problem(404, "the result of job " + id + " is gone"));
   }
   const std::string preview = ascii_lower(req.get_param_value("preview"));

@@ -13,10 +13,18 @@ void add_service_routes(httplib::Server& s, const RouteContext& c) {
     send_json(res, 200, {{"status", "ok"}});
   });
   s.Get("/readyz", [&c](const httplib::Request& req, httplib::Response& res) {
-    if (c.ready && c.jobs.accepting()) return send_json(res, 200, {{"status", "ready"}});
-    Problem p = make_problem(503, "shutting-down", "Shutting down", "not accepting new jobs");
-    p.retry_after_seconds = 5;
-    send_problem(res, req, p);
+    if (!c.ready || !c.jobs.accepting()) {
+      Problem p = make_problem(503, "shutting-down", "Shutting down", "not accepting new jobs");
+      p.retry_after_seconds = 5;
+      return send_problem(res, req, p);
+    }
+    if (!c.jobs.storage_ok()) {
+      Problem p = make_problem(503, "storage-low", "Storage nearly full",
+                               "the data directory has less than --min-free-space available");
+      p.retry_after_seconds = 30;
+      return send_problem(res, req, p);
+    }
+    send_json(res, 200, {{"status", "ready"}});
   });
   s.Get("/metrics", [&c](const httplib::Request&, httplib::Response& res) {
     Metrics::Gauges g = c.jobs.gauges();

@@ -45,6 +45,23 @@ std::optional<Problem> submission_problem(const SubmitOutcome& o) {
       p.retry_after_seconds = o.retry_after_seconds;
       return p;
     }
+    case K::kStoreFailed: {
+      Problem p = make_problem(503, "storage-error", "Storage error",
+                               "the job could not be stored; nothing was accepted, retry");
+      p.retry_after_seconds = o.retry_after_seconds;
+      return p;
+    }
+    case K::kNoSpace: {
+      Problem p = make_problem(
+          507, "insufficient-storage", "Insufficient Storage",
+          "the data directory has " + std::to_string(o.bytes_available) +
+              " bytes available; this job needs up to " + std::to_string(o.bytes_needed) +
+              " (its images at worst, the images of jobs already accepted, and --min-free-space)");
+      p.extensions["bytes_available"] = o.bytes_available;
+      p.extensions["bytes_needed"] = o.bytes_needed;
+      p.retry_after_seconds = 60;
+      return p;
+    }
   }
   return status_problem(500, "");
 }

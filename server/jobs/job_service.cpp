@@ -5,7 +5,9 @@
 #include <nlohmann/json.hpp>
 #include <random>
 
+#include "server/jobs/retry_estimate.h"
 #include "server/jobs/unix_time.h"
+#include "server/storage/disk_space.h"
 
 namespace penumbra::server {
 namespace {
@@ -59,10 +61,26 @@ void JobService::start() {
 }
 
 double JobService::retry_after_for_queue() const {
-  const double average = workers_.average_job_seconds();
-  const double per_job = average > 0 ? average : 5.0;
-  const double wait = per_job * double(queue_.size()) / std::max(1, config_.workers);
-  return std::clamp(wait, 1.0, 3600.0);
+  std::vector<RunningJobEstimate> running;
+  for (const auto& runtime : table_.runtimes()) {
+    const RenderProgress p = runtime->progress();
+    running.push_back({p.fraction, p.eta_seconds});
+  }
+  return queue_retry_after_seconds(running, workers_.average_job_seconds(), config_.workers);
+}
+
+std::uint64_t JobService::reserved_bytes() const {
+  std::uint64_t total = 0;
+  const int limit = config_.max_queue + config_.workers + 1;
+  for (const JobState state : {JobState::kQueued, JobState::kRunning})
+    for (const JobEntry& e : table_.list(state, 0, limit))
+      total += worst_case_result_bytes(e.record.width, e.record.height);
+  return total;
+}
+
+bool JobService::storage_ok() const {
+  const auto available = available_bytes(config_.data_dir);
+  return !available || *available >= config_.min_free_bytes;
 }
 
 SubmitOutcome JobService::submit(std::string_view body, const std::string& idempotency_key) {
@@ -100,6 +118,19 @@ SubmitOutcome JobService::submit(std::string_view body, const std::string& idemp
     return out;
   }
   const RenderSettings& s = loaded.request->settings;
+  // Room for this job's images, the scene, the images promised to jobs already accepted, and the
+  // margin; checked before anything is written (under submit_mutex_, so two submissions cannot
+  // both take the last room).
+  if (const auto available = available_bytes(config_.data_dir)) {
+    const std::uint64_t needed = worst_case_result_bytes(s.width, s.height) + body.size() +
+                                 reserved_bytes() + config_.min_free_bytes;
+    if (*available < needed) {
+      out.kind = SubmitOutcome::Kind::kNoSpace;
+      out.bytes_needed = needed;
+      out.bytes_available = *available;
+      return out;
+    }
+  }
   JobRecord r;
   r.id = new_job_id();
   r.seq = last_seq_ + 1;
@@ -112,7 +143,22 @@ SubmitOutcome JobService::submit(std::string_view body, const std::string& idemp
   if (!out.warnings.empty()) r.warnings_json = diagnostics_json(out.warnings).dump();
   // Committed (fsync'd) before anyone hears 202. Nobody knows the id yet, so no other change
   // of this job can be queued before its insert.
-  writer_.wait_durable(writer_.enqueue(InsertJob{r, scene_json}));
+  try {
+    writer_.wait_durable(writer_.enqueue(InsertJob{r, scene_json}));
+  } catch (const StoreError& e) {
+    // Nothing was accepted: the job is in neither the table nor the queue. A full disk is the
+    // usual cause (507); anything else is a storage failure worth retrying (503), never a 500.
+    std::fprintf(stderr, "penumbra serve: storing a new job failed: %s\n", e.what());
+    const auto available = available_bytes(config_.data_dir);
+    out.kind = available && *available < config_.min_free_bytes
+                   ? SubmitOutcome::Kind::kNoSpace
+                   : SubmitOutcome::Kind::kStoreFailed;
+    out.bytes_available = available.value_or(0);
+    out.bytes_needed = worst_case_result_bytes(s.width, s.height) + body.size() +
+                       config_.min_free_bytes;
+    out.retry_after_seconds = 5;
+    return out;
+  }
   last_seq_ = r.seq;
   table_.add(r);
   queue_.push(r.id, /*force=*/true);  // capacity was checked under submit_mutex_

@@ -43,12 +43,16 @@ struct SubmitOutcome {
     kKeyReused,     // idempotency key used for another scene (422)
     kQueueFull,     // 429
     kNotAccepting,  // shutting down (503)
+    kNoSpace,       // the data directory cannot hold the job's worst case (507)
+    kStoreFailed,   // the job could not be stored for another reason (503)
   };
   Kind kind = Kind::kAccepted;
   JobRecord record;
   std::vector<api::Diagnostic> errors;
   std::vector<api::Diagnostic> warnings;
   double retry_after_seconds = 0;
+  std::uint64_t bytes_needed = 0;     // kNoSpace
+  std::uint64_t bytes_available = 0;  // kNoSpace
 };
 
 struct JobView {
@@ -87,6 +91,8 @@ class JobService {
                                          std::chrono::steady_clock::time_point deadline) const;
 
   bool accepting() const { return accepting_.load(); }
+  // False while the data directory has less than --min-free-space available (/readyz).
+  bool storage_ok() const;
   // Stops taking jobs; running renders are put back in the queue, except one that will be done
   // within a few seconds, which is finished.
   void begin_shutdown();
@@ -98,6 +104,8 @@ class JobService {
 
   Metrics::Gauges gauges() const;
   double retry_after_for_queue() const;
+  // The worst case of every queued and running job's images: space already promised.
+  std::uint64_t reserved_bytes() const;
 
  private:
   void reaper_loop();

@@ -3,7 +3,18 @@
 #include <algorithm>
 #include <chrono>
 
+namespace {
+// What follows the sampling, per pixel: resolving the film and its variance, encoding the EXR and
+// the PNG, writing both with fsync. Measured 4.5e-8 s (0.76 s for 4096 x 4096: 0.53 s resolve,
+// 0.23 s encode and write) on the 2-core machine, about doubled for a loaded machine.
+constexpr double kFinishSecondsPerPixel = 1.0e-7;
+}  // namespace
+
 namespace penumbra::server {
+
+double finish_seconds_estimate(std::uint64_t pixels) {
+  return 0.05 + double(pixels) * kFinishSecondsPerPixel;
+}
 
 RenderOutcome run_render_job(const std::string& scene_json, const RenderJobOptions& options,
                              JobRuntime& runtime) {
@@ -34,6 +45,16 @@ RenderOutcome run_render_job(const std::string& scene_json, const RenderJobOptio
   }
   out.build_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - build_start).count();
+  if (settings.time_limit > 0) {
+    // What is left for sampling: the limit less the time spent so far (queue to running, scene
+    // read and built) and the time the images will take to encode and store. The render loop
+    // then stops within one tile of its own limit (renderer/render/render.cpp).
+    const double spent =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - options.started).count();
+    const double finish =
+        finish_seconds_estimate(std::uint64_t(settings.width) * std::uint64_t(settings.height));
+    settings.time_limit = std::max(1e-3, settings.time_limit - spent - finish);
+  }
   if (runtime.cancel_flag()->load()) {
     out.kind = RenderOutcome::Kind::kStopped;
     return out;

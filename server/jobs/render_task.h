@@ -1,6 +1,7 @@
 #pragma once
 // Renders one job: scene JSON -> validated request -> Embree scene -> progressive render.
 // Called on the service's own worker threads, never on HTTP threads.
+#include <chrono>
 #include <string>
 
 #include "api/scene_loader.h"
@@ -14,7 +15,14 @@ struct RenderJobOptions {
   api::Limits limits;
   int threads = 0;                // render threads for this job
   double max_render_seconds = 0;  // the server's budget per job; 0 = none
+  // When the job started (marked running): a time limit counts from here, so reading the scene,
+  // building it and writing the images fit in it too, not only the sampling.
+  std::chrono::steady_clock::time_point started = std::chrono::steady_clock::now();
 };
+
+// Seconds to encode and store a job's EXR and PNG of this many pixels, as measured here
+// (docs/http-api.md, time limits) with a margin: kept back from the sampling budget.
+double finish_seconds_estimate(std::uint64_t pixels);
 
 struct RenderOutcome {
   enum class Kind { kSucceeded, kFailed, kStopped };

@@ -118,6 +118,7 @@ void RenderWorkers::loop() {
 void RenderWorkers::run_job(const std::string& id) {
   auto runtime = std::make_shared<JobRuntime>();
   const double started = unix_now();
+  const auto started_steady = std::chrono::steady_clock::now();
   int exhausted_attempts = 0;
   const auto ticket = table_.modify(id, [&](JobEntry& e) {
     // Cancelled meanwhile, or shutdown began after the pop: it stays queued for the restart.
@@ -149,6 +150,7 @@ void RenderWorkers::run_job(const std::string& id) {
   options.limits = config_.scene_limits();
   options.threads = config_.threads_per_job();
   options.max_render_seconds = config_.max_render_seconds;
+  options.started = started_steady;
   const RenderOutcome outcome = run_render_job(*scene, options, *runtime);
   if (outcome.kind == RenderOutcome::Kind::kStopped &&
       runtime->stop_reason() == JobRuntime::StopReason::kShutdown) {
@@ -183,6 +185,7 @@ void RenderWorkers::finish_job(const std::string& id, const RenderOutcome& outco
       results_.write(id, "png", encode_image(outcome.image, ImageFormat::kPng, meta));
       table_.modify(id, settle(JobState::kSucceeded, now, stats_json(outcome, threads), ""));
       metrics_.observe_render("succeeded", outcome.stats.seconds, outcome.stats.rays);
+      if (outcome.stats.stopped_by_time_limit) metrics_.count_stopped_early("time_limit");
       const double total = outcome.stats.seconds + outcome.build_seconds;
       const double average = average_job_seconds_.load();
       average_job_seconds_ = average > 0 ? 0.8 * average + 0.2 * total : total;

@@ -1,6 +1,15 @@
 #include "server/storage/sqlite_job_store.h"
 
+#include <fcntl.h>
 #include <sqlite3.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
 
 namespace penumbra::server {
 namespace {
@@ -74,7 +83,11 @@ JobRecord read_record(const Statement& s) {
 
 }  // namespace
 
-SqliteJobStore::SqliteJobStore(const std::string& path) {
+SqliteJobStore::SqliteJobStore(const std::string& path)
+    : scenes_dir_((std::filesystem::path(path).parent_path() / "scenes").string()) {
+  std::error_code ec;
+  std::filesystem::create_directories(scenes_dir_, ec);
+  if (ec) throw StoreError("cannot create " + scenes_dir_ + ": " + ec.message());
   if (sqlite3_open_v2(path.c_str(), &db_,
                       SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_NOMUTEX,
                       nullptr) != SQLITE_OK) {
@@ -127,34 +140,93 @@ StoredJobs SqliteJobStore::load() {
                  "SELECT MAX(n) FROM (SELECT seq AS n FROM sqlite_sequence WHERE name = 'jobs' "
                  "UNION ALL SELECT MAX(seq) FROM jobs)");
   if (last.step()) out.last_seq = last.integer(0);
+  remove_orphan_scenes(out.records);
   return out;
 }
 
+std::string SqliteJobStore::scene_path(const std::string& id) const {
+  return (std::filesystem::path(scenes_dir_) / (id + ".json")).string();
+}
+
+void SqliteJobStore::write_scene(const std::string& id, const std::string& scene_json) const {
+  // Whole or not at all, and on disk before the row that names it commits.
+  const std::string final_path = scene_path(id);
+  const std::string tmp = final_path + ".tmp";
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) throw StoreError("cannot create " + tmp + ": " + std::strerror(errno));
+  std::size_t done = 0;
+  while (done < scene_json.size()) {
+    const ssize_t n = ::write(fd, scene_json.data() + done, scene_json.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      const std::string err = std::strerror(errno);
+      ::close(fd);
+      ::unlink(tmp.c_str());
+      throw StoreError("cannot write " + tmp + ": " + err);
+    }
+    done += std::size_t(n);
+  }
+  if (::fsync(fd) != 0 || ::close(fd) != 0 || ::rename(tmp.c_str(), final_path.c_str()) != 0) {
+    const std::string err = std::strerror(errno);
+    ::unlink(tmp.c_str());
+    throw StoreError("cannot store " + final_path + ": " + err);
+  }
+  const int dir = ::open(scenes_dir_.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dir >= 0) {
+    ::fsync(dir);
+    ::close(dir);
+  }
+}
+
+void SqliteJobStore::remove_orphan_scenes(const std::vector<JobRecord>& records) const {
+  std::set<std::string> live;
+  for (const JobRecord& r : records)
+    if (r.state != JobState::kDeleted) live.insert(r.id + ".json");
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(scenes_dir_, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (!live.count(name)) std::filesystem::remove(entry.path(), ec);
+  }
+}
+
 std::optional<std::string> SqliteJobStore::scene(const std::string& id) {
-  std::lock_guard lock(mutex_);
-  Statement q(db_, "SELECT scene FROM jobs WHERE id = ? AND state != 'deleted'");
-  q.bind(1, id);
-  if (!q.step()) return std::nullopt;
-  return q.text(0);
+  {
+    std::lock_guard lock(mutex_);
+    Statement q(db_, "SELECT scene FROM jobs WHERE id = ? AND state != 'deleted'");
+    q.bind(1, id);
+    if (!q.step()) return std::nullopt;
+    std::string in_row = q.text(0);
+    if (!in_row.empty()) return in_row;  // a row written by an earlier version
+  }
+  std::ifstream in(scene_path(id), std::ios::binary);
+  if (!in) throw StoreError("the scene file of job " + id + " is missing");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
 }
 
 void SqliteJobStore::apply(const std::vector<JobChange>& changes) {
   if (changes.empty()) return;
   std::lock_guard lock(mutex_);
   // One transaction, so one fsync for the whole batch (group commit).
+  std::vector<std::string> remove_after_commit;
   exec("BEGIN IMMEDIATE");
   try {
-    for (const JobChange& c : changes) apply_one(c);
+    for (const JobChange& c : changes) apply_one(c, remove_after_commit);
     exec("COMMIT");
   } catch (...) {
     sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);  // the error being thrown says why
     throw;
   }
+  std::error_code ec;
+  for (const std::string& file : remove_after_commit) std::filesystem::remove(file, ec);
 }
 
-void SqliteJobStore::apply_one(const JobChange& change) {
+void SqliteJobStore::apply_one(const JobChange& change,
+                               std::vector<std::string>& remove_after_commit) {
   if (const auto* insert = std::get_if<InsertJob>(&change)) {
     const JobRecord& r = insert->record;
+    write_scene(r.id, insert->scene_json);  // the row keeps '' in its scene column
     Statement s(db_,
                 "INSERT INTO jobs (seq, id, state, scene, idempotency_key, created_at, started_at, "
                 "finished_at, attempts, width, height, spp, samples_total, stats, error, warnings) "
@@ -162,7 +234,7 @@ void SqliteJobStore::apply_one(const JobChange& change) {
     s.bind(1, r.seq)
         .bind(2, r.id)
         .bind(3, std::string(to_string(r.state)))
-        .bind(4, insert->scene_json);
+        .bind(4, std::string());
     s.bind_or_null(5, r.idempotency_key)
         .bind(6, r.created_at)
         .bind(7, r.started_at)
@@ -185,10 +257,13 @@ void SqliteJobStore::apply_one(const JobChange& change) {
     s.bind(4, r.finished_at).bind(5, int64_t(r.attempts)).bind(6, int64_t(r.samples_total));
     s.bind(7, r.stats_json).bind(8, r.error_json).bind(9, r.warnings_json).bind(10, r.id);
     s.step();
+    if (r.state == JobState::kDeleted) remove_after_commit.push_back(scene_path(r.id));
   } else {
+    const std::string& id = std::get<EraseJob>(change).id;
     Statement s(db_, "DELETE FROM jobs WHERE id = ?");
-    s.bind(1, std::get<EraseJob>(change).id);
+    s.bind(1, id);
     s.step();
+    remove_after_commit.push_back(scene_path(id));
   }
 }
 

@@ -23,7 +23,8 @@ TEST(ExampleScenes, AllLoadCleanly) {
     EXPECT_LE(s.spp, 64) << entry.path();
   }
   for (const char* required : {"cornell_box.json", "glass.json", "metals.json",
-                               "depth_of_field.json", "motion_blur.json", "mesh.json", "textures.json"})
+                               "depth_of_field.json", "motion_blur.json", "mesh.json", "textures.json",
+                               "instances.json"})
     EXPECT_TRUE(std::filesystem::exists(dir / required)) << required;
   EXPECT_GE(count, 7);
 }

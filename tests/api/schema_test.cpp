@@ -59,7 +59,7 @@ TEST(Schema, DocumentsEveryField) {
   expect_documented(defs["object"]["properties"],
                     {"type", "material", "emission", "velocity", "acceleration", "transform",
                      "center", "radius", "origin", "u", "v", "positions", "indices", "normals",
-                     "uvs", "file"},
+                     "uvs", "file", "mesh", "transforms"},
                     "object");
   const Json& materials = defs["material"]["oneOf"];
   expect_documented(materials[0]["properties"], {"type", "color", "normal_map"}, "diffuse");

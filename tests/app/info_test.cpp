@@ -45,6 +45,28 @@ TEST(Info, SceneWithAMeshFile) {
   EXPECT_TRUE(contains(r.output, "film 390.6 KiB")) << r.output;  // 5000 pixels x 80 bytes
 }
 
+TEST(Info, SceneWithInstances) {
+  SceneFolder folder;
+  write_file(folder, "copies.json", R"({"version": 1,
+      "camera": {"position": [0, 0, 5], "look_at": [0, 0, 0]},
+      "environment": {"radiance": [1, 1, 1]},
+      "materials": {"white": {"type": "diffuse"}},
+      "objects": [{"type": "mesh", "material": "white", "positions": [0, 0, 0, 1, 0, 0, 0, 1, 0],
+                   "indices": [0, 1, 2]},
+                  {"type": "instances", "mesh": 0, "transforms": [{"translate": [2, 0, 0]}, {}]},
+                  {"type": "instances", "mesh": 0, "transforms": [{"scale": 2}]}]})");
+  const CommandResult r = run_penumbra(folder, "info copies.json");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "  objects     3: 1 mesh, 2 instances objects; 0 emitting\n"))
+      << r.output;
+  EXPECT_TRUE(contains(r.output, "  triangles   1\n")) << r.output;
+  EXPECT_TRUE(contains(r.output, "  instances   3 copies of 1 mesh, 4 triangles drawn in all\n"))
+      << r.output;
+  const CommandResult v = run_penumbra(folder, "validate copies.json");
+  EXPECT_TRUE(contains(v.output, "3 objects, 1 triangles, 0 lights, 0 emitting objects, 3 instanced copies"))
+      << v.output;
+}
+
 TEST(Info, MeshFiles) {
   SceneFolder folder;
   PolygonMesh m = sample_polygon_mesh();

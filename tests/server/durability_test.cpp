@@ -80,8 +80,12 @@ TEST(Durability, FinishedJobsExpireAfterTheRetention) {
     status = c->Get(("/v1/jobs/" + id).c_str())->status;
   }
   EXPECT_EQ(status, 404);
+  // The record goes first (the 404), the files once its erase is committed.
+  for (int i = 0; i < 100 && std::filesystem::exists(dir.path() + "/results/" + id + ".png"); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
   EXPECT_FALSE(std::filesystem::exists(dir.path() + "/results/" + id + ".png"));
   EXPECT_FALSE(std::filesystem::exists(dir.path() + "/results/" + id + ".exr"));
+  EXPECT_FALSE(std::filesystem::exists(dir.path() + "/scenes/" + id + ".json"));
 }
 
 }  // namespace

@@ -1,6 +1,8 @@
 // Flags and environment variables of `penumbra serve`, durations and sizes, loopback detection.
 #include "server/server_config.h"
 
+#include "server/loopback.h"
+
 #include <gtest/gtest.h>
 
 #include <map>
@@ -106,6 +108,13 @@ TEST(ServerConfig, Loopback) {
   EXPECT_FALSE(is_loopback_host("0.0.0.0"));
   EXPECT_FALSE(is_loopback_host("::"));
   EXPECT_FALSE(is_loopback_host("192.168.1.5"));
+  // Decided on resolved addresses, not on the text: a name that starts like a loopback address
+  // but does not resolve to one (.test never resolves, RFC 6761) is not loopback.
+  EXPECT_FALSE(is_loopback_host("127.example.test"));
+  EXPECT_FALSE(is_loopback_host("127.0.0.1.example.test"));
+  EXPECT_FALSE(is_loopback_host(""));
+  EXPECT_TRUE(is_loopback_host("[::1]"));
+  EXPECT_TRUE(is_loopback_host("::ffff:127.0.0.1"));
 }
 
 }  // namespace

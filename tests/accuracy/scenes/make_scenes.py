@@ -30,6 +30,9 @@ textured_roughness  rough conductors with roughness maps (nearest), textured con
                     textured plastic base, rough glass with a roughness map
 normal_map          normal maps on a diffuse floor, a rough plastic wall, a conductor and a
                     textured diffuse sphere (quad and sphere tangent frames)
+instances           a smooth-shaded, checker-textured lumpy mesh and copies of it placed by an
+                    ``instances`` object (rotated, non-uniformly scaled and sheared, mirrored),
+                    and a cube copied by a second one; Mitsuba: ``shapegroup`` + ``instance``
 ==================  ==============================================================================
 
 The textured scenes read the images in ``textures/`` (tools/make_textures.py writes them).
@@ -505,9 +508,41 @@ def environment_map() -> dict:
     }
 
 
+def instances() -> dict:
+    """Copies of two meshes by ``instances`` objects. The blob has vertex normals, so the copies'
+    shading normals (inverse transpose under shear and non-uniform scale) reach the image, and a
+    checker texture on its uvs, so the copies' uvs do; one copy is mirrored (negative determinant: its front side turns inside out, which opaque,
+    two-sided materials do not see, so Mitsuba's instance, which keeps it, agrees)."""
+    unit, tris = icosphere(3)
+    x, y, z = unit[:, 0], unit[:, 1], unit[:, 2]
+    positions = unit * (1 + 0.15 * np.sin(3 * x + 1) * np.cos(2 * y) + 0.1 * np.sin(4 * z))[:, None]
+    # Spherical uvs, so the checker texture shows that copies keep the mesh's uv.
+    uvs = np.stack([np.arctan2(z, x) / (2 * math.pi) + 0.5, np.arccos(np.clip(y, -1, 1)) / math.pi], axis=1)
+    cube_p, cube_i = cube_mesh()
+    shear = [[1.1, 0.5, 0, -1.31], [0, 0.8, 0, 0.044], [0, 0, 0.9, 0.125], [0, 0, 0, 1]]
+    mirror = [[-0.9, 0, 0, 1.2], [0, 0.9, 0, 0.03], [0, 0, 0.9, 0.1], [0, 0, 0, 1]]
+    return floor_scene(
+        [mesh(positions, tris, "coat", normals=vertex_normals(positions, tris), digits=5,
+              transform=transform([0.3, 0.3, 0.3], [0, 1, 0], 30, [0, 0.32, 0.25]), uvs=rounded(uvs, 5)),
+         {"type": "instances", "mesh": 3, "transforms": [
+             {"translate": [-0.6, 0.0, -0.55]},
+             {"rotate": {"axis": [1, 1, 0], "degrees": 50}, "translate": [0.457, 0.293, -0.684]},
+             {"matrix": [v for row in shear for v in row]},
+             {"matrix": [v for row in mirror for v in row]}]},
+         mesh(cube_p, cube_i, "metal", transform=transform([0.25, 0.25, 0.25], [0, 1, 0], 20, [-0.3, 0.125, 0.9])),
+         {"type": "instances", "mesh": 5, "transforms": [
+             {"rotate": {"axis": [0, 1, 0], "degrees": 25}, "translate": [0.14, 0, -0.02]},
+             {"scale": [1, 2.2, 1], "translate": [1.05, 0, -0.1]}]}],
+        {"coat": {"type": "plastic", "color": texture("checker.png", scale=[0.9, 0.45, 0.2]), "ior": 1.5,
+                  "roughness": 0.3},
+         "metal": {"type": "conductor", "color": [0.85, 0.85, 0.9], "roughness": 0.3}},
+        width=96, height=72, max_depth=6, cam_pos=(0, 1.3, 3.8), look=(0, 0.45, 0), fov=38)
+
+
 SCENES = {f.__name__: f for f in (cornell, glass_smooth, glass_rough, furnace, conductors, plastics,
                                   dof, motion_blur, all_lights, mesh_100k, mesh_files, kitchen_sink,
-                                  environment_map, textured_diffuse, textured_roughness, normal_map)}
+                                  environment_map, textured_diffuse, textured_roughness, normal_map,
+                                  instances)}
 
 
 def write(name: str, scene: dict) -> str:
@@ -523,7 +558,10 @@ def write(name: str, scene: dict) -> str:
 
 
 def main() -> None:
-    for name, make in SCENES.items():
+    import sys
+    names = sys.argv[1:] or list(SCENES)  # e.g. ``make_scenes.py instances``: only that one
+    for name in names:
+        make = SCENES[name]
         path = write(name, make())
         print(f"{path}: {os.path.getsize(path) / 1e3:.0f} kB")
 

@@ -57,3 +57,33 @@ TEST(MemoryEstimate, SceneAddsEmittersMotionAndFilm) {
 
 }  // namespace
 }  // namespace penumbra::test
+
+namespace penumbra::test {
+namespace {
+
+// Copies cost a fixed amount each, and each copied mesh one more BVH (its child scene), however
+// many copies and instances objects name it; no vertex buffers are added.
+TEST(MemoryEstimate, InstancesAddPerCopyAndOneBvhPerMesh) {
+  SceneInput scene;
+  ObjectDesc mesh;
+  mesh.shape = grid_mesh(500, false, false);  // 1000 triangles
+  scene.objects.push_back(mesh);
+  const RenderSettings settings;
+  const MemoryEstimate base = estimate_memory(scene, settings);
+  scene.instances.push_back(InstancesDesc{0, std::vector<InstanceTransform>(10)});
+  const MemoryEstimate ten = estimate_memory(scene, settings);
+  scene.instances.push_back(InstancesDesc{0, std::vector<InstanceTransform>(990)});
+  const MemoryEstimate thousand = estimate_memory(scene, settings);
+  EXPECT_EQ(ten.scene_input, base.scene_input);
+  EXPECT_EQ(ten.shapes, base.shapes);
+  const int64_t per_copy = (thousand.embree - ten.embree) / 990;
+  EXPECT_GT(per_copy, 64);
+  EXPECT_LT(per_copy, 2048);
+  // The second BVH: the measured 61-80 bytes per triangle, once.
+  const int64_t bvh = ten.embree - base.embree - 10 * per_copy;
+  EXPECT_GE(bvh, 1000 * 61);
+  EXPECT_LE(bvh, 1000 * 80);
+}
+
+}  // namespace
+}  // namespace penumbra::test

@@ -1,0 +1,42 @@
+#pragma once
+// The "instances" object: copies of one mesh object placed by transforms,
+//   {"type": "instances", "mesh": 0, "transforms": [{"translate": [2, 0, 0]}, {"matrix": [...]}]}
+// Each transform applies after the mesh's own (to the mesh where it stands); the copies share the
+// mesh's material. The mesh it names may come later in /objects, so an instances object is read
+// in two steps: parse_instances while reading /objects, resolve_instances once all are read.
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "api/json_reader.h"
+#include "api/scene_loader.h"
+#include "api/transform.h"
+#include "renderer/scene/scene_input.h"
+
+namespace penumbra::api {
+
+inline constexpr std::string_view kInstancesType = "instances";
+
+// An instances object as written, its mesh not yet looked up.
+struct PendingInstances {
+  std::string pointer;                       // "/objects/5"
+  int64_t mesh = 0;                          // index into /objects as written
+  std::vector<AffineTransform> transforms;   // scene space, before the camera rebasing
+};
+
+// Reads the fields of an instances object (its "type" already read). `used` = copies taken by
+// earlier instances objects, against Limits::max_instances. Reports unknown keys.
+std::optional<PendingInstances> parse_instances(ObjectReader& reader, const Limits& limits,
+                                                int64_t used);
+
+// Checks what each pending object's "mesh" names and converts it. `objects` is the /objects
+// array; `desc_index[i]` is the index in `descs` of the object /objects/i became, or -1 (an
+// instances object, or one with errors, already reported). `origin` is the camera position
+// subtracted from every position (object_parser.h). Errors name /objects/i/mesh or
+// /objects/i/transforms/k.
+void resolve_instances(const std::vector<PendingInstances>& pending, const Json& objects,
+                       const std::vector<int64_t>& desc_index, const std::vector<ObjectDesc>& descs,
+                       const glm::dvec3& origin, std::vector<InstancesDesc>& out, Diagnostics& diag);
+
+}  // namespace penumbra::api
