@@ -22,16 +22,21 @@ std::size_t ConnectionPool::threads() const {
 void ConnectionPool::enqueue(std::function<void()> fn) {
   std::unique_lock<std::mutex> lock(mutex_);
   if (shutdown_) return;
-  if (jobs_.size() < idle_) {
-    jobs_.push_back(std::move(fn));
+  const auto now = std::chrono::steady_clock::now();
+  if (jobs_.size() < threads_ - busy_) {  // a free thread takes it
+    jobs_.push_back({std::move(fn), now});
     wake_.notify_one();
     return;
   }
   if (threads_ < max_threads_) {
-    jobs_.push_back(std::move(fn));
+    jobs_.push_back({std::move(fn), now});
     ++threads_;
     // Detached: an idle thread leaves on its own; shutdown() waits for the count to reach 0.
     std::thread([this] { work(); }).detach();
+    return;
+  }
+  if (jobs_.size() < max_threads_) {  // the next thread to finish takes it (see the header)
+    jobs_.push_back({std::move(fn), now});
     return;
   }
   lock.unlock();
@@ -44,18 +49,21 @@ void ConnectionPool::work() {
   std::unique_lock<std::mutex> lock(mutex_);
   for (;;) {
     if (jobs_.empty()) {
-      ++idle_;
       const bool woke =
           wake_.wait_for(lock, idle_exit_, [this] { return !jobs_.empty() || shutdown_; });
-      --idle_;
       if (!woke || (jobs_.empty() && shutdown_)) break;
     }
     if (jobs_.empty()) continue;
-    auto fn = std::move(jobs_.front());
+    Pending job = std::move(jobs_.front());
     jobs_.pop_front();
+    ++busy_;
     lock.unlock();
-    fn();
+    const bool late = std::chrono::steady_clock::now() - job.queued > kShedAfter;
+    t_shedding = late;
+    job.fn();
+    t_shedding = false;
     lock.lock();
+    --busy_;
   }
   --threads_;
   all_exited_.notify_all();
