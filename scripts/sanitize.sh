@@ -15,6 +15,8 @@ cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPENUMB
 ninja -C "$build" -j "$jobs" renderer_tests api_tests stress_tests
 
 export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1:${ASAN_OPTIONS:-}"
+# Leaks inside third-party libraries (scripts/lsan.supp says which and why) are not ours to fix.
+export LSAN_OPTIONS="suppressions=$root/scripts/lsan.supp:${LSAN_OPTIONS:-}"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:${UBSAN_OPTIONS:-}"
 status=0
 for t in renderer_tests api_tests stress_tests; do
