@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <algorithm>
 #include <map>
 #include <new>
 
@@ -55,6 +56,14 @@ AffineTransform compose(const AffineTransform& outer, const AffineTransform& inn
   t.linear = outer.linear * inner.linear;
   t.translation = outer.linear * inner.translation + outer.translation;
   return t;
+}
+
+// x = A y + b  <=>  y = A^-1 x - A^-1 b (A invertible: nodes with a zero determinant are skipped).
+AffineTransform inverse(const AffineTransform& t) {
+  AffineTransform inv;
+  inv.linear = glm::inverse(t.linear);
+  inv.translation = -(inv.linear * t.translation);
+  return inv;
 }
 
 // The glTF images a scene's materials use, each probed once (header only) as a texture.
@@ -221,7 +230,8 @@ std::optional<GltfAsset> read_gltf_asset(const std::string& file, const std::str
 
 std::optional<ParsedGltf> parse_gltf_object(ObjectReader& reader, const AffineTransform& transform,
                                             const MeshBudget& budget, const Limits& limits,
-                                            const AssetFolder& assets, TextureSet& textures) {
+                                            const AssetFolder& assets, TextureSet& textures,
+                                            bool copies_allowed) {
   Diagnostics& diag = reader.diagnostics();
   const auto file = reader.string("file", Presence::kRequired);
   if (!file) return std::nullopt;
@@ -246,7 +256,16 @@ std::optional<ParsedGltf> parse_gltf_object(ObjectReader& reader, const AffineTr
   converted.emplace_back();
   if (diag.error_count() != errors_before) return std::nullopt;
 
-  int64_t skipped_nodes = 0, hidden_parts = 0;
+  // The first node to place a mesh (with a given handedness: a mirroring node's triangles are
+  // re-wound, so it cannot copy an unmirrored placement) is its base; later nodes copy the
+  // base's objects by M_node * M_base^-1 where they can.
+  struct Base {
+    AffineTransform to_world;
+    AffineTransform from_world;                 // its inverse
+    std::vector<std::ptrdiff_t> copies_index;   // per primitive: index in out.copies, or -1
+  };
+  std::map<std::pair<int, bool>, Base> bases;
+  int64_t skipped_nodes = 0, hidden_parts = 0, instanced = 0;
   for (const GltfMeshInstance& instance : asset->instances) {
     const AffineTransform to_world = compose(transform, affine(instance.to_world));
     const double det = glm::determinant(to_world.linear);
@@ -255,12 +274,25 @@ std::optional<ParsedGltf> parse_gltf_object(ObjectReader& reader, const AffineTr
       continue;
     }
     const GltfMesh& mesh = asset->meshes[size_t(instance.mesh)];
+    const auto key = std::make_pair(instance.mesh, det < 0);
+    auto base = bases.find(key);
+    const bool is_base = base == bases.end();
+    if (is_base) {
+      Base b{to_world, inverse(to_world), std::vector<std::ptrdiff_t>(mesh.primitives.size(), -1)};
+      base = bases.emplace(key, std::move(b)).first;
+    }
     for (size_t p = 0; p < mesh.primitives.size(); ++p) {
       const GltfPrimitive& prim = mesh.primitives[p];
       const MaterialAndEmission& mat =
           converted[prim.material < 0 ? default_material : size_t(prim.material)];
       if (mat.hidden) {
         ++hidden_parts;  // alpha MASK with a factor below the cutoff: nothing is left
+        continue;
+      }
+      if (!is_base && base->second.copies_index[p] >= 0) {
+        out.copies[size_t(base->second.copies_index[p])].transforms.push_back(
+            compose(to_world, base->second.from_world));
+        ++instanced;
         continue;
       }
       const int64_t tris = int64_t(prim.indices.size() / 3);
@@ -297,10 +329,19 @@ std::optional<ParsedGltf> parse_gltf_object(ObjectReader& reader, const AffineTr
       if (!is_black(object.emission)) out.any_emission = true;
       out.triangles += int64_t(placed->indices.size() / 3);
       out.vertices += int64_t(placed->positions.size());
+      const bool copyable = copies_allowed && is_black(object.emission) && !object.emission_texture;
       object.shape = std::move(*placed);
+      if (is_base && copyable) {
+        base->second.copies_index[p] = std::ptrdiff_t(out.copies.size());
+        out.copies.push_back(GltfCopies{out.objects.size(), {}});
+      }
       out.objects.push_back(std::move(object));
     }
   }
+  // Primitives no other node uses need no instances.
+  out.copies.erase(std::remove_if(out.copies.begin(), out.copies.end(),
+                                  [](const GltfCopies& c) { return c.transforms.empty(); }),
+                   out.copies.end());
   if (hidden_parts > 0)
     diag.warning(pointer, quote_user_string(*file) + ": " + plural(hidden_parts, "primitive", "primitives") +
                               " left out: alphaMode MASK with an alpha factor below the cutoff");
@@ -338,7 +379,8 @@ std::optional<ParsedGltf> parse_gltf_object(ObjectReader& reader, const AffineTr
   out.use.path = *file;
   out.use.summary = "glTF: " + plural(int64_t(asset->meshes.size()), "mesh", "meshes") + " at " +
                     plural(int64_t(asset->instances.size()), "node", "nodes") + " -> " +
-                    plural(out.triangles, "triangle", "triangles") + ", " +
+                    plural(out.triangles, "triangle", "triangles") +
+                    (instanced > 0 ? " (+ " + plural(instanced, "instanced copy", "instanced copies") + ")" : "") + ", " +
                     plural(materials_used, "material", "materials") + ", " +
                     plural(int64_t(asset->images.size()), "image", "images") + ", " +
                     plural(int64_t(asset->lights.size()), "light", "lights") + ", " +

@@ -20,8 +20,18 @@
 
 namespace penumbra::api {
 
+// A primitive of a glTF mesh that several nodes use, placed once (objects[object], at the first
+// of those nodes) and copied to the others by `transforms` (from where that object stands to
+// where each other node puts it, in the same camera-rebased space): Embree instances, not copies
+// of the vertices (renderer/scene/instance_input.h).
+struct GltfCopies {
+  std::size_t object = 0;
+  std::vector<AffineTransform> transforms;
+};
+
 struct ParsedGltf {
   std::vector<ObjectDesc> objects;        // `material` indexes `materials` below
+  std::vector<GltfCopies> copies;         // of some of `objects`
   std::vector<MaterialParams> materials;  // one per glTF material, then the default material
   std::vector<LightDesc> lights;          // world space, relative to the scene's origin
   int64_t triangles = 0, vertices = 0;
@@ -31,9 +41,14 @@ struct ParsedGltf {
 
 // Reads the object at `reader` (type "gltf"): "file" and the "transform" already parsed into
 // `transform` (which includes the shift to the scene's origin). nullopt with errors reported.
+// A mesh that several nodes use becomes one object and instances of it (`copies`) unless
+// `copies_allowed` is false (a moving object: its copies must move by its velocity, not by the
+// velocity mapped through each copy's transform) or the primitive emits (an area light samples
+// its own triangles).
 std::optional<ParsedGltf> parse_gltf_object(ObjectReader& reader, const AffineTransform& transform,
                                             const MeshBudget& budget, const Limits& limits,
-                                            const AssetFolder& assets, TextureSet& textures);
+                                            const AssetFolder& assets, TextureSet& textures,
+                                            bool copies_allowed = true);
 
 // Reads a glTF asset from the asset folder with the confinement and limits of a scene: for
 // `penumbra render/info model.glb`, which need its cameras, lights and bounds before building

@@ -160,4 +160,26 @@ void resolve_instances(const std::vector<PendingInstances>& pending, const Json&
   }
 }
 
+std::optional<InstancesDesc> rebased_instances(uint32_t object, const MeshDesc& mesh,
+                                               const std::vector<AffineTransform>& transforms,
+                                               const glm::dvec3& origin, const std::string& pointer,
+                                               Diagnostics& diag) {
+  const Box bounds = mesh_bounds(mesh);
+  InstancesDesc desc;
+  desc.object = object;
+  desc.transforms.reserve(transforms.size());
+  for (const AffineTransform& t : transforms) {
+    InstanceTransform copy;
+    copy.linear = glm::mat3(t.linear);
+    copy.translation = vec3(t.translation);
+    if (!usable(copy, bounds, origin)) {
+      diag.error(pointer, "a copy of a shared mesh lands beyond world-space coordinates +-" +
+                              format_number(kMaxCoordinate) + " or scales it beyond single precision");
+      return std::nullopt;
+    }
+    desc.transforms.push_back(copy);
+  }
+  return desc;
+}
+
 }  // namespace penumbra::api

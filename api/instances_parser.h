@@ -39,4 +39,12 @@ void resolve_instances(const std::vector<PendingInstances>& pending, const Json&
                        const std::vector<int64_t>& desc_index, const std::vector<ObjectDesc>& descs,
                        const glm::dvec3& origin, std::vector<InstancesDesc>& out, Diagnostics& diag);
 
+// Copies of descs[object] (a mesh that does not emit) by transforms already in the renderer's
+// camera-rebased space (a glTF mesh shared by several nodes, api/gltf_parser.h). nullopt with an
+// error on `pointer` if a copy leaves the coordinate range or single precision.
+std::optional<InstancesDesc> rebased_instances(uint32_t object, const MeshDesc& mesh,
+                                               const std::vector<AffineTransform>& transforms,
+                                               const glm::dvec3& origin, const std::string& pointer,
+                                               Diagnostics& diag);
+
 }  // namespace penumbra::api

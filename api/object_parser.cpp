@@ -191,7 +191,8 @@ ParsedObjects parse_objects(const Json* objects, const std::string& pointer,
       }
       const MeshBudget budget{limits.max_triangles - parsed.triangles,
                               limits.max_vertices - parsed.vertices};
-      auto gltf = parse_gltf_object(reader, transform, budget, limits, assets, textures);
+      const bool moving = object.velocity != vec3(0.f) || object.acceleration != vec3(0.f);
+      auto gltf = parse_gltf_object(reader, transform, budget, limits, assets, textures, !moving);
       reader.report_unknown_keys();
       if (!gltf || diag.error_count() != errors_before) continue;
       if (parsed.objects.size() + gltf->objects.size() > std::size_t(limits.max_objects)) {
@@ -199,6 +200,28 @@ ParsedObjects parse_objects(const Json* objects, const std::string& pointer,
                                  std::to_string(limits.max_objects) + " (max_objects)");
         continue;
       }
+      int64_t copies = 0;
+      for (const GltfCopies& c : gltf->copies) copies += int64_t(c.transforms.size());
+      if (parsed.instance_count + copies > limits.max_instances) {
+        reader.error("file", "its meshes shared by several nodes make " + std::to_string(copies) +
+                                 " copies, beyond the scene's limit of " +
+                                 std::to_string(limits.max_instances) + " (max_instances)");
+        continue;
+      }
+      const std::size_t first_object = parsed.objects.size();
+      bool copies_ok = true;
+      for (const GltfCopies& c : gltf->copies) {
+        auto desc = rebased_instances(uint32_t(first_object + c.object),
+                                      std::get<MeshDesc>(gltf->objects[c.object].shape), c.transforms,
+                                      origin, reader.pointer_of("file"), diag);
+        if (!desc) {
+          copies_ok = false;
+          break;
+        }
+        parsed.instances.push_back(std::move(*desc));
+      }
+      if (!copies_ok) continue;
+      parsed.instance_count += copies;
       const uint32_t offset = uint32_t(materials.names.size() + parsed.extra_materials.size());
       for (ObjectDesc& part : gltf->objects) {
         part.material += offset;
