@@ -68,6 +68,7 @@ HttpServer::HttpServer(const ServerConfig& config, JobService& jobs, Metrics& me
   add_job_routes(s, context_);
   add_result_routes(s, context_);
   add_render_routes(s, context_);
+  add_dashboard_routes(s, context_);
 }
 
 HttpServer::~HttpServer() = default;
