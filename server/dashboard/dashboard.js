@@ -61,8 +61,14 @@ function fmtEta(job) {
   return eta < 90 ? `${Math.round(eta)} s` : `${Math.round(eta / 60)} min`;
 }
 
-function fmtTime(t) {
-  return typeof t === "number" ? new Date(t * 1000).toLocaleTimeString() : "";
+function fmtTime(t) {  // RFC 3339 from the server
+  const d = t ? new Date(t) : null;
+  return d && !isNaN(d) ? d.toLocaleTimeString() : "";
+}
+
+function created(job) {
+  const d = job.created_at ? Date.parse(job.created_at) : 0;
+  return isNaN(d) ? 0 : d;
 }
 
 async function blobUrl(path, accept) {
@@ -125,7 +131,7 @@ function actionsFor(job) {
 
 function renderRows() {
   const rows = $("job-rows");
-  const jobs = [...state.jobs.values()].sort((a, b) => (b.created_at || 0) - (a.created_at || 0));
+  const jobs = [...state.jobs.values()].sort((a, b) => created(b) - created(a));
   $("empty").hidden = jobs.length > 0;
   const existing = new Map([...rows.children].map((tr) => [tr.dataset.id, tr]));
   let before = rows.firstChild;
@@ -136,7 +142,7 @@ function renderRows() {
       tr.dataset.id = job.id;
       tr.innerHTML = '<td><img class="thumb" alt=""></td><td class="id"></td><td class="state"></td>' +
         '<td><progress max="1" value="0"></progress></td><td class="eta"></td><td class="size"></td>' +
-        '<td class="when"></td><td class="actions"></td>';
+        '<td class="when"></td><td class="act"></td>';
       tr.addEventListener("click", () => select(job.id));
     }
     existing.delete(job.id);
@@ -225,6 +231,10 @@ function select(id) {
   state.follow = null;
   state.selected = id;
   state.detailKey = "";
+  const img = $("detail-image");
+  if (img.src.startsWith("blob:")) URL.revokeObjectURL(img.src);
+  img.removeAttribute("src");
+  img.dataset.key = "";
   renderRows();
   const job = state.jobs.get(id);
   if (job) showDetail(job);

@@ -138,8 +138,11 @@ class Dashboard(unittest.TestCase):
         self.assertGreaterEqual(len(progress), 3, f"the progress bar did not move: {progress}")
         self.assertGreaterEqual(len(previews), 2, f"the preview did not change: {previews}")
         if os.environ.get("PENUMBRA_SCREENSHOT"):
-            self.submit_through_page(scene(spp=1 << 16, time_limit=20, seed=2), "second.json")
+            second = self.submitted_id(self.submit_through_page(
+                scene(spp=1 << 16, time_limit=20, seed=2), "second.json"))
             self.submit_through_page(scene(spp=4, seed=3), "third.json")
+            self.wait.until(lambda d: self.row_state(second) == "running")
+            self.row(second).click()
             time.sleep(3)
             self.driver.save_screenshot(os.environ["PENUMBRA_SCREENSHOT"])
         # Download the PNG through the page: the same bytes as the API's.
