@@ -66,7 +66,7 @@ class Dashboard(unittest.TestCase):
         options = webdriver.ChromeOptions()
         options.binary_location = os.environ.get("CHROMIUM", "/usr/bin/chromium")
         for arg in ("--headless=new", "--no-sandbox", "--disable-dev-shm-usage",
-                    "--disable-gpu", "--window-size=1200,900"):
+                    "--disable-gpu", "--window-size=1320,760"):
             options.add_argument(arg)
         options.add_experimental_option("prefs", {"download.default_directory": cls.downloads,
                                                   "download.prompt_for_download": False})
