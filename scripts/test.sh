@@ -7,4 +7,6 @@ cd "$(dirname "$0")/.."
 ./scripts/install-deps.sh --schemathesis --browser
 ./scripts/build.sh
 BUILD_DIR=${BUILD_DIR:-build}
+# Open Image Denoise beside the binary (the pinned PyPI wheel's libraries; denoising tests).
+BUILD_DIR="$BUILD_DIR" ./scripts/install-oidn.sh
 ctest --test-dir "$BUILD_DIR" --output-on-failure -j"$(nproc)" --timeout 300 "$@"
