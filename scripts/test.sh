@@ -9,4 +9,5 @@ cd "$(dirname "$0")/.."
 BUILD_DIR=${BUILD_DIR:-build}
 # Open Image Denoise beside the binary (the pinned PyPI wheel's libraries; denoising tests).
 BUILD_DIR="$BUILD_DIR" ./scripts/install-oidn.sh
+export PENUMBRA_REQUIRE_OIDN=1
 ctest --test-dir "$BUILD_DIR" --output-on-failure -j"$(nproc)" --timeout 300 "$@"
