@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
 #include <variant>
 
 #include "server/http/problem.h"
@@ -22,10 +23,14 @@ struct ListQuery {
   int limit = kDefaultPageSize;
   std::optional<JobState> state;
   int64_t before_seq = 0;  // 0 = from the newest
+  // ?state=queued lists in run order (priority, then seq); its tokens name the run key of the
+  // last job of the page ("p<priority + 1000, hex>-<seq, hex>").
+  std::optional<std::pair<int, int64_t>> run_after;
 };
 
 // A 400 problem names the first bad parameter.
 std::variant<ListQuery, Problem> parse_list_query(const ListParams& params);
 std::string page_token(int64_t last_seq_of_page);
+std::string run_order_page_token(int priority, int64_t seq);
 
 }  // namespace penumbra::server
