@@ -43,10 +43,13 @@ void list(const RouteContext& c, const httplib::Request& req, httplib::Response&
   // Queued jobs are listed in the order they will run; the others newest first.
   const bool run_order = q.state == JobState::kQueued;
   std::vector<JobView> jobs =
-      run_order ? c.jobs.list_queued(q.run_after ? std::optional<JobService::RunKey>(
-                                                       {q.run_after->first, q.run_after->second})
-                                                 : std::nullopt,
-                                     q.limit + 1)
+      run_order ? c.jobs.list_queued(
+                      q.before_seq > 0
+                          ? std::optional<JobService::RunKey>(
+                                {run_order_from_token(q.before_seq).first,
+                                 run_order_from_token(q.before_seq).second})
+                          : std::nullopt,
+                      q.limit + 1)
                 : c.jobs.list(q.state, q.before_seq, q.limit + 1);
   json out = {{"jobs", json::array()}, {"next_page_token", nullptr}};
   if (int(jobs.size()) > q.limit) {

@@ -32,18 +32,6 @@ std::variant<ListQuery, Problem> parse_list_query(const ListParams& params) {
       return invalid_parameter("state",
                                "must be one of queued, running, succeeded, failed, cancelled");
   }
-  if (params.page_token && !params.page_token->empty() && (*params.page_token)[0] == 'p') {
-    // A run-order token (state=queued): p<priority + 1000>-<seq>, both hex.
-    const std::string& t = *params.page_token;
-    const auto dash = t.find('-');
-    const std::string p = t.substr(1, dash == std::string::npos ? 0 : dash - 1);
-    const std::string s = dash == std::string::npos ? "" : t.substr(dash + 1);
-    const bool ok = q.state == JobState::kQueued && !p.empty() && p.size() <= 4 &&
-                    all_of(p, ::isxdigit) && !s.empty() && s.size() <= 15 && all_of(s, ::isxdigit);
-    if (!ok) return invalid_parameter("page_token", "is not a token this server issued");
-    q.run_after = std::make_pair(int(std::stol(p, nullptr, 16)) - 1000, int64_t(std::stoll(s, nullptr, 16)));
-    return q;
-  }
   if (params.page_token) {
     const std::string& t = *params.page_token;
     // 15 hex digits at most: the value fits an int64_t.
@@ -60,11 +48,14 @@ std::string page_token(int64_t last_seq_of_page) {
   return token;
 }
 
+constexpr int kSeqBits = 48;
+
 std::string run_order_page_token(int priority, int64_t seq) {
-  char token[48];
-  std::snprintf(token, sizeof token, "p%x-%llx", unsigned(priority + 1000),
-                static_cast<unsigned long long>(seq));
-  return token;
+  return page_token((int64_t(priority + 1000) << kSeqBits) | (seq & ((int64_t(1) << kSeqBits) - 1)));
+}
+
+std::pair<int, int64_t> run_order_from_token(int64_t token) {
+  return {int(token >> kSeqBits) - 1000, token & ((int64_t(1) << kSeqBits) - 1)};
 }
 
 }  // namespace penumbra::server

@@ -23,14 +23,15 @@ struct ListQuery {
   int limit = kDefaultPageSize;
   std::optional<JobState> state;
   int64_t before_seq = 0;  // 0 = from the newest
-  // ?state=queued lists in run order (priority, then seq); its tokens name the run key of the
-  // last job of the page ("p<priority + 1000, hex>-<seq, hex>").
-  std::optional<std::pair<int, int64_t>> run_after;
 };
 
 // A 400 problem names the first bad parameter.
 std::variant<ListQuery, Problem> parse_list_query(const ListParams& params);
 std::string page_token(int64_t last_seq_of_page);
+// ?state=queued lists in run order (priority, then seq): its token packs the run key of the last
+// job of the page into the same hex form, (priority + 1000) << 48 | seq.
 std::string run_order_page_token(int priority, int64_t seq);
+// The run key (priority, seq) a token of run_order_page_token names.
+std::pair<int, int64_t> run_order_from_token(int64_t token);
 
 }  // namespace penumbra::server
