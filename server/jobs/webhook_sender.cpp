@@ -41,6 +41,21 @@ std::string resolve(const std::string& host, std::string& error) {
   return text;
 }
 
+// What failed, in words (cpp-httplib's own names are terse: "Connection", "Read").
+std::string describe(httplib::Error e) {
+  switch (e) {
+    case httplib::Error::Connection: return "could not connect";
+    case httplib::Error::ConnectionTimeout: return "connecting timed out";
+    case httplib::Error::Read: return "no answer in time (or the connection was reset)";
+    case httplib::Error::Write: return "the request could not be sent";
+    case httplib::Error::SSLConnection: return "TLS handshake failed";
+    case httplib::Error::SSLLoadingCerts: return "the system's CA certificates could not be loaded";
+    case httplib::Error::SSLServerVerification:
+      return "the server's TLS certificate did not verify";
+    default: return httplib::to_string(e);
+  }
+}
+
 double uniform01() {
   static thread_local std::mt19937_64 rng{std::random_device{}()};
   return std::uniform_real_distribution<double>(0.0, 1.0)(rng);
@@ -191,8 +206,7 @@ void WebhookSender::deliver(const std::string& id) {
         error = "HTTP " + std::to_string(status) +
                 (status >= 300 && status < 400 ? " (redirects are not followed)" : "");
       } else {
-        error = std::string("no answer: ") + httplib::to_string(ok ? httplib::Error::Unknown
-                                                                   : result);
+        error = describe(ok ? httplib::Error::Unknown : result);
       }
     }
   }
