@@ -77,7 +77,7 @@ bool GuardedServer::process_and_close_socket(socket_t sock) {
     explicit SocketScope(int s) { t_connection_socket = s; }
     ~SocketScope() { t_connection_socket = -1; }
   };
-  const SocketScope socket_scope(int(sock));
+  const SocketScope socket_scope{int(sock)};
   const auto serving = [this] { return svr_sock_ != INVALID_SOCKET; };
   const auto first_wait = std::chrono::duration_cast<std::chrono::milliseconds>(
       std::chrono::duration<double>(limits_.header_seconds));
