@@ -174,5 +174,29 @@ TEST(Webhook, GivenUpAfterTheRetryTimeIsVisible) {
             "penumbra_webhook_attempts_total{result=\"gave_up\"} 1");
 }
 
+// https:// goes through cpp-httplib's OpenSSL client: against a receiver that speaks plain HTTP
+// the TLS handshake fails, and the job says so (the https path is wired; a certificate check
+// against the system's CAs needs a real host, not available to the tests).
+TEST(Webhook, HttpsUrlsUseTlsAndAFailedHandshakeIsReported) {
+  TempDir dir;
+  WebhookReceiver receiver(0);
+  ServerProcess server(dir.path(), {"--webhook-allow-hosts",
+                                    "127.0.0.1:" + std::to_string(receiver.port()),
+                                    "--webhook-retry-for", "0s"});
+  auto c = server.client();
+  const std::string url = "https://127.0.0.1:" + std::to_string(receiver.port()) + "/hook";
+  const std::string id = submit(*c, with_notify(tiny_scene(), url));
+  Json job;
+  for (int i = 0; i < 500; ++i) {
+    job = get_job(*c, id);
+    if (job["notify"]["delivery"] == "failed") break;
+    std::this_thread::sleep_for(20ms);
+  }
+  EXPECT_EQ(job["notify"]["delivery"], "failed") << job.dump();
+  EXPECT_EQ(job["notify"]["attempts"], 1);
+  EXPECT_EQ(job["notify"]["last_error"], "TLS handshake failed");
+  EXPECT_TRUE(receiver.hits().empty()) << "nothing reached the handler in clear text";
+}
+
 }  // namespace
 }  // namespace penumbra::test
