@@ -24,6 +24,11 @@ void Metrics::count_connection_refused(const std::string& reason) {
   ++connections_refused_[reason];
 }
 
+void Metrics::count_webhook(const std::string& result) {
+  std::lock_guard lock(mutex_);
+  ++webhooks_[result];
+}
+
 void Metrics::observe_render(const std::string& final_state, double seconds, uint64_t rays) {
   std::lock_guard lock(mutex_);
   ++finished_[final_state];
@@ -77,6 +82,18 @@ std::string Metrics::render_text(const Gauges& g) const {
   for (const char* reason : {"limit", "overload"})
     o << "penumbra_http_connections_refused_total{reason=\"" << reason << "\"} "
       << (connections_refused_.count(reason) ? connections_refused_.at(reason) : 0) << "\n";
+  o << "# HELP penumbra_webhook_attempts_total Webhook POSTs by outcome: delivered (2xx), "
+       "failed_attempt (retried later), gave_up (retries exhausted or host no longer allowed).\n"
+       "# TYPE penumbra_webhook_attempts_total counter\n";
+  for (const char* result : {"delivered", "failed_attempt", "gave_up"})
+    o << "penumbra_webhook_attempts_total{result=\"" << result << "\"} "
+      << (webhooks_.count(result) ? webhooks_.at(result) : 0) << "\n";
+  o << "# HELP penumbra_webhooks_pending Webhook deliveries scheduled or under way.\n"
+       "# TYPE penumbra_webhooks_pending gauge\npenumbra_webhooks_pending "
+    << g.webhooks_pending << "\n";
+  o << "# HELP penumbra_event_streams Server-Sent Events streams open.\n"
+       "# TYPE penumbra_event_streams gauge\npenumbra_event_streams "
+    << g.event_streams << "\n";
   o << "# HELP penumbra_render_seconds Wall-clock time of a render (scene build excluded).\n"
        "# TYPE penumbra_render_seconds histogram\n";
   for (std::size_t i = 0; i < kRenderSecondsBuckets.size(); ++i)

@@ -26,6 +26,8 @@ class Metrics {
   // Connections answered by a ConnectionLimits limit ("limit") or refused for want of a
   // connection thread ("overload").
   void count_connection_refused(const std::string& reason);
+  // A webhook attempt's outcome: "delivered", "failed_attempt" (retried), "gave_up".
+  void count_webhook(const std::string& result);
 
   struct Gauges {
     std::map<std::string, int64_t> jobs_by_state;
@@ -33,6 +35,8 @@ class Metrics {
     int64_t queue_capacity = 0;
     int64_t running = 0;
     bool ready = false;
+    int64_t webhooks_pending = 0;  // deliveries scheduled or under way
+    int64_t event_streams = 0;     // GET /v1/jobs/{id}/events streams open
   };
   std::string render_text(const Gauges& gauges) const;
 
@@ -43,6 +47,7 @@ class Metrics {
   std::map<std::string, uint64_t> finished_;
   std::map<std::string, uint64_t> stopped_early_;
   std::map<std::string, uint64_t> connections_refused_;
+  std::map<std::string, uint64_t> webhooks_;
   std::array<uint64_t, kRenderSecondsBuckets.size()> render_buckets_{};
   uint64_t render_count_ = 0;
   double render_seconds_sum_ = 0;

@@ -139,6 +139,20 @@ std::vector<Setting> settings() {
          c.access_log = parse_bool(v);
          return "";
        }},
+      {"--webhook-allow-hosts", "PENUMBRA_WEBHOOK_ALLOW_HOSTS", true,
+       [](ServerConfig& c, const std::string& v) -> std::string {
+         std::string error;
+         if (!parse_allowed_hosts(v, error))
+           return bad("--webhook-allow-hosts", v, ("HOST[:PORT],...; " + error).c_str());
+         c.webhook_allow_hosts = v;
+         return "";
+       }},
+      duration_setting("--webhook-timeout", "PENUMBRA_WEBHOOK_TIMEOUT", 0.001,
+                       &ServerConfig::webhook_timeout_seconds),
+      duration_setting("--webhook-retry-for", "PENUMBRA_WEBHOOK_RETRY_FOR", 0.0,
+                       &ServerConfig::webhook_retry_seconds),
+      int_setting("--max-event-streams", "PENUMBRA_MAX_EVENT_STREAMS", 1, 16384,
+                  &ServerConfig::max_event_streams),
   };
 }
 
@@ -157,6 +171,11 @@ int ServerConfig::threads_per_job() const {
   if (render_threads > 0) return render_threads;
   const int cores = int(std::max(1u, std::thread::hardware_concurrency()));
   return std::max(1, cores / std::max(1, workers));
+}
+
+std::vector<AllowedHost> ServerConfig::webhook_hosts() const {
+  std::string error;
+  return parse_allowed_hosts(webhook_allow_hosts, error).value_or(std::vector<AllowedHost>{});
 }
 
 std::optional<double> parse_duration(const std::string& text) {
@@ -299,6 +318,16 @@ const char* serve_usage() {
          "  --drain DUR              after SIGTERM, /readyz answers 503 this long before the port\n"
          "                           closes (default 1s) [PENUMBRA_DRAIN]\n"
          "  --access-log             one line per request on stderr [PENUMBRA_ACCESS_LOG=1]\n"
+         "  --webhook-allow-hosts H  HOST[:PORT],... webhooks may reach; HOST alone = port 80/443\n"
+         "                           by scheme (default: none, webhooks off)\n"
+         "                           [PENUMBRA_WEBHOOK_ALLOW_HOSTS]\n"
+         "  --webhook-timeout DUR    one webhook POST, connect to answer (default 10s)\n"
+         "                           [PENUMBRA_WEBHOOK_TIMEOUT]\n"
+         "  --webhook-retry-for DUR  a failing delivery is retried (backoff 1s, 2s, 4s ... 5m)\n"
+         "                           this long after the job ended (default 1h)\n"
+         "                           [PENUMBRA_WEBHOOK_RETRY_FOR]\n"
+         "  --max-event-streams N    GET /v1/jobs/{id}/events streams open at once, more -> 503\n"
+         "                           (default 256) [PENUMBRA_MAX_EVENT_STREAMS]\n"
          "\n"
          "Durations: 90, 90s, 15m, 24h, 7d, 250ms.\n";
 }

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "api/scene_loader.h"
+#include "server/jobs/webhook_url.h"
 
 namespace penumbra::server {
 
@@ -43,11 +44,20 @@ struct ServerConfig {
   int keep_alive_max_requests = 100;
   double drain_seconds = 1.0;  // after SIGTERM: /readyz answers 503 this long before the port closes
   bool access_log = false;
+  // Webhooks (docs/http-api.md, "Notifications"): the hosts they may reach (none = off), how
+  // long one POST may take, and how long a delivery is retried before it is given up.
+  std::string webhook_allow_hosts;  // "host[:port],..."
+  double webhook_timeout_seconds = 10.0;
+  double webhook_retry_seconds = 3600.0;
+  // GET /v1/jobs/{id}/events streams open at once; each holds a connection thread.
+  int max_event_streams = 256;
 
   // The per-scene caps handed to the scene loader.
   api::Limits scene_limits() const;
   // Threads one job renders with (render_threads resolved against the core count).
   int threads_per_job() const;
+  // webhook_allow_hosts parsed (checked when the flags are read, so never malformed here).
+  std::vector<AllowedHost> webhook_hosts() const;
 };
 
 struct ConfigParse {

@@ -13,6 +13,8 @@
 namespace penumbra::server {
 namespace {
 
+thread_local int t_connection_socket = -1;
+
 // Closes after the answer has had a chance to reach the client: closing a socket with unread
 // input resets the connection, and the client may lose the answer with it (a rejected request
 // usually has more head or body on the way). Reads and drops input for up to 1 s or 1 MB.
@@ -36,6 +38,8 @@ void lingering_close(socket_t sock) {
 }
 
 }  // namespace
+
+int current_connection_socket() { return t_connection_socket; }
 
 GuardedServer::GuardedServer(const ConnectionLimits& limits, int listen_backlog, Metrics& metrics)
     : limits_(limits), listen_backlog_(listen_backlog), metrics_(metrics) {}
@@ -68,6 +72,12 @@ bool GuardedServer::process_and_close_socket(socket_t sock) {
     return false;
   }
   ConnectionStream stream(sock, limits_);  // the first request's head deadline runs from accept
+  // current_connection_socket() while this connection is served.
+  struct SocketScope {
+    explicit SocketScope(int s) { t_connection_socket = s; }
+    ~SocketScope() { t_connection_socket = -1; }
+  };
+  const SocketScope socket_scope{int(sock)};
   const auto serving = [this] { return svr_sock_ != INVALID_SOCKET; };
   const auto first_wait = std::chrono::duration_cast<std::chrono::milliseconds>(
       std::chrono::duration<double>(limits_.header_seconds));

@@ -14,6 +14,10 @@
 
 namespace penumbra::server {
 
+// The socket of the connection the calling thread serves (-1 outside one): a long response
+// (an event stream) polls it to notice that its client has gone.
+int current_connection_socket();
+
 class GuardedServer : public httplib::Server {
  public:
   GuardedServer(const ConnectionLimits& limits, int listen_backlog, Metrics& metrics);
@@ -21,6 +25,8 @@ class GuardedServer : public httplib::Server {
   void widen_backlog();
   // The listening socket (after a bind), e.g. to check the address it is bound to.
   socket_t listening_socket() const { return svr_sock_; }
+  // False once stop() has begun: long responses end.
+  bool serving() const { return svr_sock_ != INVALID_SOCKET; }
 
  private:
   bool process_and_close_socket(socket_t sock) override;

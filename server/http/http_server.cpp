@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "server/http/connection_pool.h"
+#include "server/http/job_json.h"
 #include "server/http/problem.h"
 #include "server/http/request_guard.h"
 #include "server/http/route_table.h"
@@ -69,6 +70,8 @@ HttpServer::HttpServer(const ServerConfig& config, JobService& jobs, Metrics& me
   add_result_routes(s, context_);
   add_render_routes(s, context_);
   add_dashboard_routes(s, context_);
+  add_event_routes(s, context_);
+  jobs.set_webhook_body(webhook_body);
 }
 
 HttpServer::~HttpServer() = default;

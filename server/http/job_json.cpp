@@ -24,6 +24,35 @@ std::string rfc3339(double t) {
   return buf;
 }
 
+nlohmann::ordered_json notify_json(const JobRecord::Notify& n) {
+  using json = nlohmann::ordered_json;
+  auto time_or_null = [](double t) { return t > 0 ? json(rfc3339(t)) : json(nullptr); };
+  // Never the secret.
+  const char* state = n.delivered_at > 0 ? "delivered"
+                      : n.gave_up_at > 0 ? "failed"
+                      : n.attempts > 0   ? "retrying"
+                                         : "waiting";
+  return {{"url", n.url},
+          {"delivery", state},
+          {"attempts", n.attempts},
+          {"last_status", n.last_status > 0 ? json(n.last_status) : json(nullptr)},
+          {"last_error", n.last_error.empty() ? json(nullptr) : json(n.last_error)},
+          {"last_attempt_at", time_or_null(n.last_attempt_at)},
+          {"next_attempt_at", time_or_null(n.next_attempt_at)},
+          {"delivered_at", time_or_null(n.delivered_at)}};
+}
+
+std::string webhook_body(const JobRecord& r) {
+  // What GET /v1/jobs/{id} answers for the finished job, with notify reduced to its url: the
+  // body (and so its signature) is the same on every retry and after a restart.
+  JobRecord copy = r;
+  const std::string url = copy.notify.url;
+  copy.notify = {};
+  nlohmann::ordered_json j = job_json(JobView{copy, std::nullopt, std::nullopt, false});
+  j["notify"] = {{"url", url}};
+  return j.dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace);
+}
+
 nlohmann::ordered_json job_json(const JobView& v) {
   using json = nlohmann::ordered_json;
   const JobRecord& r = v.record;
@@ -58,6 +87,7 @@ nlohmann::ordered_json job_json(const JobView& v) {
   j["samples_total"] = samples_total;
   j["eta_seconds"] = eta;
   j["queue_position"] = v.queue_position ? json(*v.queue_position) : json(nullptr);
+  j["priority"] = r.priority;
   if (v.stop_requested) j["cancel_requested"] = true;
   j["created_at"] = time_or_null(r.created_at);
   j["started_at"] = time_or_null(r.started_at);
@@ -73,6 +103,7 @@ nlohmann::ordered_json job_json(const JobView& v) {
   j["stats"] = stats;
   if (!r.error_json.empty()) j["error"] = json::parse(r.error_json);
   j["warnings"] = r.warnings_json.empty() ? json::array() : json::parse(r.warnings_json);
+  if (!r.notify.url.empty()) j["notify"] = notify_json(r.notify);
   const std::string self = job_path(r.id);
   j["links"] = {{"self", self},
                 {"result", self + "/result"},

@@ -8,6 +8,10 @@
 namespace penumbra::server {
 
 nlohmann::ordered_json job_json(const JobView& job);
+// The "notify" member: the webhook's URL and delivery status (never its secret).
+nlohmann::ordered_json notify_json(const JobRecord::Notify& notify);
+// The body a webhook POSTs: the finished job's document, stable across retries.
+std::string webhook_body(const JobRecord& record);
 std::string job_path(const std::string& id);
 // Retry-After for an unfinished job: about when something will have changed.
 double retry_after_seconds(const JobView& job);

@@ -40,11 +40,23 @@ void list(const RouteContext& c, const httplib::Request& req, httplib::Response&
       {param_value(req, "limit"), param_value(req, "state"), param_value(req, "page_token")});
   if (const auto* p = std::get_if<Problem>(&query)) return send_problem(res, req, *p);
   const ListQuery& q = std::get<ListQuery>(query);
-  std::vector<JobView> jobs = c.jobs.list(q.state, q.before_seq, q.limit + 1);
+  // Queued jobs are listed in the order they will run; the others newest first.
+  const bool run_order = q.state == JobState::kQueued;
+  std::vector<JobView> jobs =
+      run_order ? c.jobs.list_queued(
+                      q.before_seq > 0
+                          ? std::optional<JobService::RunKey>(
+                                {run_order_from_token(q.before_seq).first,
+                                 run_order_from_token(q.before_seq).second})
+                          : std::nullopt,
+                      q.limit + 1)
+                : c.jobs.list(q.state, q.before_seq, q.limit + 1);
   json out = {{"jobs", json::array()}, {"next_page_token", nullptr}};
   if (int(jobs.size()) > q.limit) {
     jobs.resize(std::size_t(q.limit));
-    out["next_page_token"] = page_token(jobs.back().record.seq);
+    const JobRecord& last = jobs.back().record;
+    out["next_page_token"] =
+        run_order ? run_order_page_token(last.priority, last.seq) : page_token(last.seq);
   }
   for (const JobView& v : jobs) out["jobs"].push_back(job_json(v));
   send_json(res, 200, out);

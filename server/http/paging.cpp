@@ -48,4 +48,14 @@ std::string page_token(int64_t last_seq_of_page) {
   return token;
 }
 
+constexpr int kSeqBits = 48;
+
+std::string run_order_page_token(int priority, int64_t seq) {
+  return page_token((int64_t(priority + 1000) << kSeqBits) | (seq & ((int64_t(1) << kSeqBits) - 1)));
+}
+
+std::pair<int, int64_t> run_order_from_token(int64_t token) {
+  return {int(token >> kSeqBits) - 1000, token & ((int64_t(1) << kSeqBits) - 1)};
+}
+
 }  // namespace penumbra::server

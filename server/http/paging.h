@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
 #include <variant>
 
 #include "server/http/problem.h"
@@ -27,5 +28,10 @@ struct ListQuery {
 // A 400 problem names the first bad parameter.
 std::variant<ListQuery, Problem> parse_list_query(const ListParams& params);
 std::string page_token(int64_t last_seq_of_page);
+// ?state=queued lists in run order (priority, then seq): its token packs the run key of the last
+// job of the page into the same hex form, (priority + 1000) << 48 | seq.
+std::string run_order_page_token(int priority, int64_t seq);
+// The run key (priority, seq) a token of run_order_page_token names.
+std::pair<int, int64_t> run_order_from_token(int64_t token);
 
 }  // namespace penumbra::server

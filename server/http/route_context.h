@@ -29,5 +29,7 @@ void add_result_routes(httplib::Server& server,
 void add_render_routes(httplib::Server& server, const RouteContext& context);  // /v1/render
 void add_dashboard_routes(httplib::Server& server,
                           const RouteContext& context);  // /, /dashboard/{file}
+void add_event_routes(httplib::Server& server,
+                      const RouteContext& context);  // /v1/jobs/{id}/events
 
 }  // namespace penumbra::server

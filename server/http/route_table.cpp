@@ -38,6 +38,7 @@ std::string route_template(const std::string& path) {
   const std::string_view rest = std::string_view(path).substr(kJobs.size() + kIdLength);
   if (rest.empty()) return "/v1/jobs/{id}";
   if (rest == kResult) return "/v1/jobs/{id}/result";
+  if (rest == "/events") return "/v1/jobs/{id}/events";
   return "other";
 }
 

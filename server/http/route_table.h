@@ -11,6 +11,7 @@ namespace penumbra::server {
 // (compiled once, at registration).
 inline const std::string kJobRoute = "/v1/jobs/([0-9a-f]{24})";
 inline const std::string kResultRoute = kJobRoute + "/result";
+inline const std::string kEventsRoute = kJobRoute + "/events";
 
 // A dashboard file's name as /dashboard/{file} serves it: letters, digits, '_', '-', then one
 // dot and a lowercase extension (the pattern of kDashboardRoute).

@@ -4,12 +4,16 @@
 
 namespace penumbra::server {
 
-JobQueue::PushResult JobQueue::push(const std::string& id, bool force) {
+JobQueue::PushResult JobQueue::push(const std::string& id, int priority, int64_t seq, bool force) {
   {
     std::lock_guard lock(mutex_);
     if (closed_) return PushResult::kClosed;
-    if (!force && ids_.size() >= capacity_) return PushResult::kFull;
-    ids_.push_back(id);
+    if (!force && entries_.size() >= capacity_) return PushResult::kFull;
+    // After every entry that runs before it: higher priority, or equal priority and older.
+    const auto at = std::find_if(entries_.begin(), entries_.end(), [&](const Entry& e) {
+      return e.priority < priority || (e.priority == priority && e.seq > seq);
+    });
+    entries_.insert(at, Entry{priority, seq, id});
   }
   cv_.notify_one();
   return PushResult::kPushed;
@@ -17,36 +21,38 @@ JobQueue::PushResult JobQueue::push(const std::string& id, bool force) {
 
 std::optional<std::string> JobQueue::pop() {
   std::unique_lock lock(mutex_);
-  cv_.wait(lock, [&] { return closed_ || !ids_.empty(); });
+  cv_.wait(lock, [&] { return closed_ || !entries_.empty(); });
   if (closed_) return std::nullopt;
-  std::string id = std::move(ids_.front());
-  ids_.pop_front();
+  std::string id = std::move(entries_.front().id);
+  entries_.pop_front();
   return id;
 }
 
 bool JobQueue::remove(const std::string& id) {
   std::lock_guard lock(mutex_);
-  const auto it = std::find(ids_.begin(), ids_.end(), id);
-  if (it == ids_.end()) return false;
-  ids_.erase(it);
+  const auto it =
+      std::find_if(entries_.begin(), entries_.end(), [&](const Entry& e) { return e.id == id; });
+  if (it == entries_.end()) return false;
+  entries_.erase(it);
   return true;
 }
 
 std::optional<std::size_t> JobQueue::position(const std::string& id) const {
   std::lock_guard lock(mutex_);
-  const auto it = std::find(ids_.begin(), ids_.end(), id);
-  if (it == ids_.end()) return std::nullopt;
-  return std::size_t(it - ids_.begin());
+  const auto it =
+      std::find_if(entries_.begin(), entries_.end(), [&](const Entry& e) { return e.id == id; });
+  if (it == entries_.end()) return std::nullopt;
+  return std::size_t(it - entries_.begin());
 }
 
 std::size_t JobQueue::size() const {
   std::lock_guard lock(mutex_);
-  return ids_.size();
+  return entries_.size();
 }
 
 bool JobQueue::full() const {
   std::lock_guard lock(mutex_);
-  return ids_.size() >= capacity_;
+  return entries_.size() >= capacity_;
 }
 
 void JobQueue::close() {

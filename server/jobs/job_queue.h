@@ -1,7 +1,11 @@
 #pragma once
-// The FIFO of queued job ids with a capacity. Thread-safe; workers block in pop().
+// The queued job ids in run order, with a capacity: higher priority first, submission order
+// (seq) within a priority (render-farm convention: Flamenco, OpenCue and Deadline all run the
+// highest priority first and first-come-first-served among equals). Thread-safe; workers block
+// in pop().
 #include <chrono>
 #include <condition_variable>
+#include <cstdint>
 #include <deque>
 #include <mutex>
 #include <optional>
@@ -15,8 +19,9 @@ class JobQueue {
 
   enum class PushResult { kPushed, kFull, kClosed };
   // `force` ignores the capacity: jobs recovered at startup were already accepted.
-  PushResult push(const std::string& id, bool force = false);
-  // Blocks until a job is queued (returns it) or the queue is closed (returns nullopt).
+  PushResult push(const std::string& id, int priority, int64_t seq, bool force = false);
+  // Blocks until a job is queued (returns the first in run order) or the queue is closed
+  // (returns nullopt).
   std::optional<std::string> pop();
   // Removes a queued job (cancel); false if it is not queued (already popped, or unknown).
   bool remove(const std::string& id);
@@ -29,10 +34,15 @@ class JobQueue {
   void close();
 
  private:
+  struct Entry {
+    int priority;
+    int64_t seq;
+    std::string id;
+  };
   const std::size_t capacity_;
   mutable std::mutex mutex_;
   std::condition_variable cv_;
-  std::deque<std::string> ids_;
+  std::deque<Entry> entries_;  // in run order
   bool closed_ = false;
 };
 

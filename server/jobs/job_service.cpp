@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <cstdio>
 #include <nlohmann/json.hpp>
+#include <limits>
 #include <random>
 
+#include "server/jobs/job_options.h"
 #include "server/jobs/retry_estimate.h"
 #include "server/jobs/unix_time.h"
 #include "server/storage/disk_space.h"
@@ -40,7 +42,22 @@ JobService::JobService(const ServerConfig& config, JobStore& store, ResultStore&
       writer_(store),
       table_(writer_),
       queue_(std::size_t(config.max_queue)),
-      workers_(config_, queue_, table_, writer_, store, results, metrics) {}
+      workers_(config_, queue_, table_, writer_, store, results, metrics),
+      webhooks_(WebhookSettings{config_.webhook_hosts(), config_.webhook_timeout_seconds,
+                                config_.webhook_retry_seconds, 2},
+                metrics) {
+  table_.set_observer([this](const JobEntry& e) { observe(e); });
+}
+
+void JobService::observe(const JobEntry& e) {
+  const JobRecord& r = e.record;
+  std::optional<std::size_t> position;
+  if (r.state == JobState::kQueued) position = queue_.position(r.id);  // queue_: a leaf lock
+  events_.record_change(r, position);
+  // The job has just ended (no attempt yet): its webhook is due now. Later attempts are
+  // scheduled by the sender itself.
+  if (WebhookSender::pending(r) && r.notify.attempts == 0) webhooks_.schedule(r.id, 0);
+}
 
 JobService::~JobService() {
   begin_shutdown();
@@ -53,9 +70,33 @@ void JobService::start() {
   // A crash between a tombstone's commit and the removal of its files leaves the files.
   for (const JobRecord& r : stored.records)
     if (r.state == JobState::kDeleted) results_.remove(r.id);
-  for (const std::string& id : table_.restore(std::move(stored.records)))
-    queue_.push(id, /*force=*/true);
+  for (const std::string& id : table_.restore(std::move(stored.records))) {
+    const auto e = table_.find(id);
+    queue_.push(id, e ? e->record.priority : 0, e ? e->record.seq : 0, /*force=*/true);
+  }
   expire_now();
+  // Webhooks of finished jobs not yet delivered (the server stopped or was killed before a 2xx):
+  // at least once means they are sent again.
+  for (const JobState state : {JobState::kSucceeded, JobState::kFailed, JobState::kCancelled})
+    for (const JobEntry& e : table_.list(state, 0, std::numeric_limits<int>::max()))
+      if (WebhookSender::pending(e.record)) webhooks_.schedule(e.record.id, e.record.notify.next_attempt_at);
+  webhooks_.start(WebhookSender::Hooks{
+      [this](const std::string& id) -> std::optional<JobRecord> {
+        auto e = table_.find(id);
+        if (!e) return std::nullopt;
+        return std::move(e->record);
+      },
+      [this](const JobRecord& r) {
+        return webhook_body_ ? webhook_body_(r)
+                             : nlohmann::json{{"id", r.id}, {"state", to_string(r.state)}}.dump();
+      },
+      [this](const std::string& id, const JobRecord::Notify& status) {
+        table_.modify(id, [&](JobEntry& e) {
+          if (e.record.notify.url.empty() || e.record.state == JobState::kDeleted) return false;
+          e.record.notify = status;
+          return true;
+        });
+      }});
   workers_.start(config_.workers);
   reaper_ = std::thread([this] { reaper_loop(); });
 }
@@ -91,23 +132,31 @@ SubmitOutcome JobService::submit(std::string_view body, const std::string& idemp
     return out;
   };
   if (!accepting_) return refuse_shutting_down();
-  api::LoadResult loaded = api::load_scene(body, config_.scene_limits());
+  // "priority" and "notify" are the job's, not the scene's (job_options.h).
+  SplitSubmission split =
+      split_job_options(body, config_.webhook_hosts(), config_.scene_limits().max_json_depth);
+  api::LoadResult loaded = api::load_scene(split.scene_text, config_.scene_limits());
   out.warnings = loaded.warnings;
-  if (!loaded.ok()) {
+  if (!loaded.ok() || !split.errors.empty()) {
     out.kind = loaded.kind == api::LoadErrorKind::kSyntax ? SubmitOutcome::Kind::kSyntax
                                                           : SubmitOutcome::Kind::kInvalid;
-    out.errors = std::move(loaded.errors);
+    out.errors = std::move(split.errors);
+    out.errors.insert(out.errors.end(), loaded.errors.begin(), loaded.errors.end());
     return out;
   }
-  const std::string scene_json(body);
+  const JobOptions& options = split.options;
+  const std::string scene_json = std::move(split.scene_text);
   std::lock_guard submit_lock(submit_mutex_);
   if (!idempotency_key.empty()) {
     if (auto existing = table_.find_by_key(idempotency_key)) {
       // Read from the store: the table keeps no scenes. A submission may wait on a commit here.
       const auto stored_scene = store_.scene(existing->id);
+      const bool same = stored_scene == scene_json &&
+                        existing->priority == options.priority &&
+                        existing->notify.url == options.notify_url &&
+                        existing->notify.secret == options.notify_secret;
       out.record = std::move(*existing);
-      out.kind = stored_scene == scene_json ? SubmitOutcome::Kind::kReplayed
-                                            : SubmitOutcome::Kind::kKeyReused;
+      out.kind = same ? SubmitOutcome::Kind::kReplayed : SubmitOutcome::Kind::kKeyReused;
       return out;
     }
   }
@@ -140,6 +189,9 @@ SubmitOutcome JobService::submit(std::string_view body, const std::string& idemp
   r.height = s.height;
   r.spp = s.spp;
   r.samples_total = uint64_t(s.width) * uint64_t(s.height) * uint64_t(s.spp);
+  r.priority = options.priority;
+  r.notify.url = options.notify_url;
+  r.notify.secret = options.notify_secret;
   if (!out.warnings.empty()) r.warnings_json = diagnostics_json(out.warnings).dump();
   // Committed (fsync'd) before anyone hears 202. Nobody knows the id yet, so no other change
   // of this job can be queued before its insert.
@@ -161,7 +213,7 @@ SubmitOutcome JobService::submit(std::string_view body, const std::string& idemp
   }
   last_seq_ = r.seq;
   table_.add(r);
-  queue_.push(r.id, /*force=*/true);  // capacity was checked under submit_mutex_
+  queue_.push(r.id, r.priority, r.seq, /*force=*/true);  // capacity checked under submit_mutex_
   metrics_.count_submitted();
   out.record = std::move(r);
   out.kind = SubmitOutcome::Kind::kAccepted;
@@ -184,6 +236,25 @@ std::optional<JobView> JobService::view(const std::string& id) const {
   JobView v = make_view(std::move(*entry));
   v.stop_requested = stop_requested;
   return v;
+}
+
+std::vector<JobView> JobService::list_queued(std::optional<RunKey> after, int limit) const {
+  std::vector<JobEntry> queued =
+      table_.list(JobState::kQueued, 0, std::numeric_limits<int>::max());
+  const auto runs_before = [](int p1, int64_t s1, int p2, int64_t s2) {
+    return p1 > p2 || (p1 == p2 && s1 < s2);
+  };
+  std::sort(queued.begin(), queued.end(), [&](const JobEntry& a, const JobEntry& b) {
+    return runs_before(a.record.priority, a.record.seq, b.record.priority, b.record.seq);
+  });
+  std::vector<JobView> out;
+  for (JobEntry& e : queued) {
+    if (int(out.size()) >= limit) break;
+    if (after && !runs_before(after->priority, after->seq, e.record.priority, e.record.seq))
+      continue;
+    out.push_back(make_view(std::move(e)));
+  }
+  return out;
 }
 
 std::vector<JobView> JobService::list(std::optional<JobState> state, int64_t before_seq,
@@ -211,6 +282,7 @@ DeleteOutcome JobService::cancel_or_delete(const std::string& id, std::chrono::m
       r.stats_json.clear();
       r.error_json.clear();
       r.warnings_json.clear();
+      r.notify = {};  // a delivery not yet made is dropped with the job
       return true;
     }
     if (r.state == JobState::kQueued) {
@@ -267,7 +339,10 @@ void JobService::expire_now() {
   // Records first, then files (as before the table existed): a crash in between leaves files
   // nobody serves, never a record whose image is gone.
   writer_.flush();
-  for (const std::string& id : ids) results_.remove(id);
+  for (const std::string& id : ids) {
+    results_.remove(id);
+    events_.forget(id);
+  }
 }
 
 void JobService::reaper_loop() {
@@ -294,6 +369,7 @@ void JobService::begin_shutdown() {
   workers_.begin_shutdown();
   queue_.close();
   table_.wake_all();
+  events_.wake_all();  // event streams end
   { std::lock_guard rl(reaper_mutex_); }
   reaper_cv_.notify_all();
 }
@@ -305,6 +381,7 @@ bool JobService::stop(std::chrono::steady_clock::time_point deadline) {
   }
   workers_.join();
   if (reaper_.joinable()) reaper_.join();
+  webhooks_.stop();  // an attempt under way ends within --webhook-timeout; pending ones stay stored
   writer_.flush();
   return true;
 }
@@ -318,6 +395,8 @@ Metrics::Gauges JobService::gauges() const {
   g.queue_depth = int64_t(queue_.size());
   g.queue_capacity = int64_t(queue_.capacity());
   g.ready = accepting_;
+  g.webhooks_pending = int64_t(webhooks_.backlog());
+  g.event_streams = events_.open_streams();
   return g;
 }
 

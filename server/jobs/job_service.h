@@ -12,6 +12,7 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -21,11 +22,13 @@
 #include <vector>
 
 #include "api/scene_loader.h"
+#include "server/jobs/job_events.h"
 #include "server/jobs/job_queue.h"
 #include "server/jobs/job_table.h"
 #include "server/jobs/render_task.h"
 #include "server/jobs/render_workers.h"
 #include "server/jobs/store_writer.h"
+#include "server/jobs/webhook_sender.h"
 #include "server/metrics.h"
 #include "server/server_config.h"
 #include "server/storage/job_record.h"
@@ -79,6 +82,20 @@ class JobService {
   SubmitOutcome submit(std::string_view body, const std::string& idempotency_key);
   std::optional<JobView> view(const std::string& id) const;
   std::vector<JobView> list(std::optional<JobState> state, int64_t before_seq, int limit) const;
+  // Queued jobs in run order (priority, then seq), starting after the job with run key
+  // `after` (nullopt: from the first to run).
+  struct RunKey {
+    int priority = 0;
+    int64_t seq = 0;
+  };
+  std::vector<JobView> list_queued(std::optional<RunKey> after, int limit) const;
+  // State changes and progress for GET /v1/jobs/{id}/events.
+  JobEvents& events() { return events_; }
+  // The JSON a webhook POSTs for a job (the HTTP layer's job document); set before start().
+  void set_webhook_body(std::function<std::string(const JobRecord&)> body) {
+    webhook_body_ = std::move(body);
+  }
+  bool stopping() const { return stopping_.load(); }
   // Cancels a queued/running job, deletes a finished one. Waits up to `wait` for a running
   // render to stop.
   DeleteOutcome cancel_or_delete(const std::string& id, std::chrono::milliseconds wait);
@@ -109,6 +126,7 @@ class JobService {
 
  private:
   void reaper_loop();
+  void observe(const JobEntry& entry);  // the job table's observer (under its lock)
   JobView make_view(JobEntry entry) const;
 
   const ServerConfig config_;
@@ -119,6 +137,9 @@ class JobService {
   JobTable table_;
   JobQueue queue_;
   RenderWorkers workers_;
+  JobEvents events_;
+  WebhookSender webhooks_;
+  std::function<std::string(const JobRecord&)> webhook_body_;
 
   std::mutex submit_mutex_;  // idempotency check + capacity check + commit + enqueue as one step
   int64_t last_seq_ = 0;     // under submit_mutex_

@@ -31,7 +31,8 @@ void JobTable::add(JobRecord record) {
     by_seq_[record.seq] = record.id;
     if (!record.idempotency_key.empty()) by_key_[record.idempotency_key] = record.id;
     const std::string id = record.id;
-    jobs_[id] = JobEntry{std::move(record), nullptr};
+    const JobEntry& e = jobs_[id] = JobEntry{std::move(record), nullptr};
+    if (observer_) observer_(e);
   }
   changed_.notify_all();
 }
@@ -93,6 +94,7 @@ std::optional<StoreWriter::Ticket> JobTable::modify(const std::string& id,
       if (!e.record.idempotency_key.empty()) by_key_[e.record.idempotency_key] = id;
     }
     ticket = journal_.enqueue(UpdateJob{e.record});
+    if (observer_) observer_(e);
   }
   changed_.notify_all();
   return ticket;

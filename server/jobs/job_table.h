@@ -59,8 +59,15 @@ class JobTable {
                                 const std::function<bool(const JobRecord&)>& done,
                                 const std::function<bool()>& give_up) const;
   void wake_all();
+  // Called under the lock after every add() and every change modify() makes, with the entry as
+  // it now is (the job events and the webhook sender listen here). Set before other threads use
+  // the table; it must take no lock but its own leaf ones and never call back into the table.
+  void set_observer(std::function<void(const JobEntry&)> observer) {
+    observer_ = std::move(observer);
+  }
 
  private:
+  std::function<void(const JobEntry&)> observer_;
   StoreWriter& journal_;
   mutable std::mutex mutex_;
   mutable std::condition_variable changed_;

@@ -31,6 +31,21 @@ struct JobRecord {
   std::string stats_json;     // "" or a JSON object (render statistics)
   std::string error_json;     // "" or a JSON object (why it failed)
   std::string warnings_json;  // "" or a JSON array of {pointer, detail}
+  // Run order of queued jobs: higher first, submission order (seq) within a priority
+  // (server/jobs/job_options.h has the bounds).
+  int priority = 0;
+  // The webhook told of the final state (url empty = none) and how its delivery went
+  // (server/jobs/webhook_delivery.h). The secret is kept for signing and never shown.
+  struct Notify {
+    std::string url, secret;
+    int attempts = 0;             // POSTs made so far
+    int last_status = 0;          // HTTP status of the last attempt, 0 = no answer
+    std::string last_error;       // "" after a success
+    double last_attempt_at = 0;   // Unix seconds, 0 = none yet
+    double next_attempt_at = 0;   // when the next retry is due, 0 = none planned
+    double delivered_at = 0;      // a 2xx answer came
+    double gave_up_at = 0;        // retries exhausted (--webhook-retry-for)
+  } notify;
 };
 
 }  // namespace penumbra::server

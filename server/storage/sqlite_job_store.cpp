@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <set>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
 namespace penumbra::server {
@@ -59,7 +60,39 @@ class Statement {
 constexpr const char* kColumns =
     "id, seq, state, idempotency_key, created_at, started_at, finished_at, attempts, width, "
     "height, "
-    "spp, samples_total, stats, error, warnings";
+    "spp, samples_total, stats, error, warnings, priority, notify";
+
+// The webhook of a job (JobRecord::Notify) as the text of the notify column; "" when none.
+std::string notify_text(const JobRecord::Notify& n) {
+  if (n.url.empty()) return "";
+  return nlohmann::json{{"url", n.url},
+                        {"secret", n.secret},
+                        {"attempts", n.attempts},
+                        {"last_status", n.last_status},
+                        {"last_error", n.last_error},
+                        {"last_attempt_at", n.last_attempt_at},
+                        {"next_attempt_at", n.next_attempt_at},
+                        {"delivered_at", n.delivered_at},
+                        {"gave_up_at", n.gave_up_at}}
+      .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
+JobRecord::Notify notify_from_text(const std::string& text) {
+  JobRecord::Notify n;
+  if (text.empty()) return n;
+  const auto j = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
+  if (!j.is_object()) return n;
+  n.url = j.value("url", "");
+  n.secret = j.value("secret", "");
+  n.attempts = j.value("attempts", 0);
+  n.last_status = j.value("last_status", 0);
+  n.last_error = j.value("last_error", "");
+  n.last_attempt_at = j.value("last_attempt_at", 0.0);
+  n.next_attempt_at = j.value("next_attempt_at", 0.0);
+  n.delivered_at = j.value("delivered_at", 0.0);
+  n.gave_up_at = j.value("gave_up_at", 0.0);
+  return n;
+}
 
 JobRecord read_record(const Statement& s) {
   JobRecord r;
@@ -78,6 +111,8 @@ JobRecord read_record(const Statement& s) {
   r.stats_json = s.text(12);
   r.error_json = s.text(13);
   r.warnings_json = s.text(14);
+  r.priority = int(s.integer(15));
+  r.notify = notify_from_text(s.text(16));
   return r;
 }
 
@@ -117,6 +152,17 @@ SqliteJobStore::SqliteJobStore(const std::string& path)
       " stats TEXT NOT NULL DEFAULT '', error TEXT NOT NULL DEFAULT '', warnings TEXT NOT NULL "
       "DEFAULT '')");
   exec("CREATE INDEX IF NOT EXISTS jobs_by_state ON jobs(state, seq)");
+  // Columns added after the first schema: a data directory of an older version gains them with
+  // their defaults (every old job has priority 0 and no webhook).
+  add_column_if_missing("priority", "INTEGER NOT NULL DEFAULT 0");
+  add_column_if_missing("notify", "TEXT NOT NULL DEFAULT ''");
+}
+
+void SqliteJobStore::add_column_if_missing(const std::string& name, const std::string& decl) {
+  Statement q(db_, "SELECT 1 FROM pragma_table_info('jobs') WHERE name = ?");
+  q.bind(1, name);
+  if (q.step()) return;
+  exec(("ALTER TABLE jobs ADD COLUMN " + name + " " + decl).c_str());
 }
 
 SqliteJobStore::~SqliteJobStore() { sqlite3_close(db_); }
@@ -229,8 +275,9 @@ void SqliteJobStore::apply_one(const JobChange& change,
     write_scene(r.id, insert->scene_json);  // the row keeps '' in its scene column
     Statement s(db_,
                 "INSERT INTO jobs (seq, id, state, scene, idempotency_key, created_at, started_at, "
-                "finished_at, attempts, width, height, spp, samples_total, stats, error, warnings) "
-                "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+                "finished_at, attempts, width, height, spp, samples_total, stats, error, warnings, "
+                "priority, notify) "
+                "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
     s.bind(1, r.seq)
         .bind(2, r.id)
         .bind(3, std::string(to_string(r.state)))
@@ -242,6 +289,7 @@ void SqliteJobStore::apply_one(const JobChange& change,
     s.bind(9, int64_t(r.attempts)).bind(10, int64_t(r.width)).bind(11, int64_t(r.height));
     s.bind(12, int64_t(r.spp)).bind(13, int64_t(r.samples_total)).bind(14, r.stats_json);
     s.bind(15, r.error_json).bind(16, r.warnings_json);
+    s.bind(17, int64_t(r.priority)).bind(18, notify_text(r.notify));
     s.step();
   } else if (const auto* update = std::get_if<UpdateJob>(&change)) {
     const JobRecord& r = update->record;
@@ -250,12 +298,14 @@ void SqliteJobStore::apply_one(const JobChange& change,
         db_,
         "UPDATE jobs SET state = ?1, idempotency_key = ?2, started_at = ?3, finished_at = ?4, "
         "attempts = ?5, samples_total = ?6, stats = ?7, error = ?8, warnings = ?9, "
-        "scene = CASE WHEN ?1 = 'deleted' THEN '' ELSE scene END WHERE id = ?10");
+        "scene = CASE WHEN ?1 = 'deleted' THEN '' ELSE scene END, priority = ?11, notify = ?12 "
+        "WHERE id = ?10");
     s.bind(1, std::string(to_string(r.state)))
         .bind_or_null(2, r.idempotency_key)
         .bind(3, r.started_at);
     s.bind(4, r.finished_at).bind(5, int64_t(r.attempts)).bind(6, int64_t(r.samples_total));
     s.bind(7, r.stats_json).bind(8, r.error_json).bind(9, r.warnings_json).bind(10, r.id);
+    s.bind(11, int64_t(r.priority)).bind(12, notify_text(r.notify));
     s.step();
     if (r.state == JobState::kDeleted) remove_after_commit.push_back(scene_path(r.id));
   } else {

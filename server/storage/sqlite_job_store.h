@@ -33,6 +33,8 @@ class SqliteJobStore final : public JobStore {
 
  private:
   void exec(const char* sql);
+  // An additive migration: ALTER TABLE jobs ADD COLUMN name decl, unless it is there.
+  void add_column_if_missing(const std::string& name, const std::string& decl);
   // Files to remove once the transaction that drops their rows has committed.
   void apply_one(const JobChange& change, std::vector<std::string>& remove_after_commit);
   std::string scene_path(const std::string& id) const;

@@ -20,6 +20,8 @@ TEST(Routes, TemplatesBoundTheMetricLabels) {
   EXPECT_EQ(route_template("/v1/jobs/0123456789abcdef012345678"), "other") << "25 digits";
   EXPECT_EQ(route_template("/v1/jobs/0123456789abcdef01234567/"), "other");
   EXPECT_EQ(route_template("/v1/jobs/0123456789abcdef01234567/result/x"), "other");
+  EXPECT_EQ(route_template("/v1/jobs/0123456789abcdef01234567/events"), "/v1/jobs/{id}/events");
+  EXPECT_EQ(route_template("/v1/jobs/0123456789abcdef01234567/events/"), "other");
   EXPECT_EQ(route_template("/v1/jobs/"), "other");
 }
 
