@@ -14,7 +14,7 @@ PKGS=(
   libembree-dev libopenimageio-dev openimageio-tools libglm-dev
   libcpp-httplib-dev nlohmann-json3-dev libtbb-dev libsqlite3-dev
   libgtest-dev libgmock-dev libbenchmark-dev libtinyobjloader-dev libtinygltf-dev libpng-dev
-  libopenexr-dev
+  libopenexr-dev libssl-dev
 )
 if [ "${1:-}" = "--fuzz" ]; then PKGS+=(clang libclang-rt-14-dev); fi
 missing=()

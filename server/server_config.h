@@ -43,6 +43,12 @@ struct ServerConfig {
   int keep_alive_max_requests = 100;
   double drain_seconds = 1.0;  // after SIGTERM: /readyz answers 503 this long before the port closes
   bool access_log = false;
+  // Assets (docs/http-api.md, assets): the content-addressed store and job manifests.
+  std::uint64_t max_asset_bytes = std::uint64_t(256) << 20;      // one uploaded file
+  std::uint64_t max_job_asset_bytes = std::uint64_t(1) << 30;    // all files of one job
+  std::uint64_t max_asset_store_bytes = std::uint64_t(10) << 30;  // the whole store
+  int max_job_files = 1000;                                      // manifest entries per job
+  int64_t max_image_pixels = int64_t(8192) * 8192;  // one texture, from its header
 
   // The per-scene caps handed to the scene loader.
   api::Limits scene_limits() const;

@@ -60,11 +60,16 @@ std::optional<Problem> guard_request(const httplib::Request& req, const GuardSet
   }
   if (has_length) {
     const unsigned long long length = std::stoull(length_text);
-    if (length > settings.max_body_bytes) {
-      Problem p = make_problem(413, "body-too-large", "Content Too Large",
+    // An asset upload streams to disk (never held in memory) under its own limit.
+    const bool asset_upload = req.method == "PUT" && req.path.rfind("/v1/assets/", 0) == 0;
+    const std::size_t limit = asset_upload ? settings.max_asset_bytes : settings.max_body_bytes;
+    const char* flag = asset_upload ? "--max-asset-size" : "--max-body";
+    if (length > limit) {
+      Problem p = make_problem(413, asset_upload ? "asset-too-large" : "body-too-large",
+                               "Content Too Large",
                                "the body has " + length_text + " bytes; the limit is " +
-                                   std::to_string(settings.max_body_bytes) + " (--max-body)");
-      p.extensions["limit"] = settings.max_body_bytes;
+                                   std::to_string(limit) + " (" + flag + ")");
+      p.extensions["limit"] = limit;
       return p;
     }
   }

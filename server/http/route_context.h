@@ -27,5 +27,6 @@ void add_job_routes(httplib::Server& server,
 void add_result_routes(httplib::Server& server,
                        const RouteContext& context);  // /v1/jobs/{id}/result
 void add_render_routes(httplib::Server& server, const RouteContext& context);  // /v1/render
+void add_asset_routes(httplib::Server& server, const RouteContext& context);   // /v1/assets
 
 }  // namespace penumbra::server

@@ -10,6 +10,8 @@ namespace penumbra::server {
 // (compiled once, at registration).
 inline const std::string kJobRoute = "/v1/jobs/([0-9a-f]{24})";
 inline const std::string kResultRoute = kJobRoute + "/result";
+// Any last segment: a malformed hash gets a 400 naming it rather than a bare 404.
+inline const std::string kAssetRoute = "/v1/assets/([^/]+)";
 
 // The route template of a path ("/v1/jobs/{id}"), or "other": a bounded set of labels.
 std::string route_template(const std::string& path);
