@@ -214,12 +214,19 @@ bool AssetStore::make_room_locked(std::uint64_t incoming) {
   std::vector<std::pair<std::int64_t, std::string>> by_age;
   for (const auto& [hash, e] : index_) by_age.emplace_back(e.last_used_ns, hash);
   std::sort(by_age.begin(), by_age.end());
+  // Chosen first, removed only if they make enough room: a refused upload evicts nothing.
+  std::vector<std::string> victims;
+  std::uint64_t freed = 0;
   for (const auto& [age, hash] : by_age) {
-    if (stored_bytes_ + incoming <= limits_.max_store_bytes) break;
-    const std::string path = asset_path(hash);
+    if (stored_bytes_ - freed + incoming <= limits_.max_store_bytes) break;
     struct stat st {};
-    if (::stat(path.c_str(), &st) == 0 && st.st_nlink > 1) continue;  // in a job's folder
-    if (::unlink(path.c_str()) != 0 && errno != ENOENT) continue;
+    if (::stat(asset_path(hash).c_str(), &st) == 0 && st.st_nlink > 1) continue;  // in a job's folder
+    victims.push_back(hash);
+    freed += index_[hash].size;
+  }
+  if (stored_bytes_ - freed + incoming > limits_.max_store_bytes) return false;
+  for (const std::string& hash : victims) {
+    if (::unlink(asset_path(hash).c_str()) != 0 && errno != ENOENT) continue;
     stored_bytes_ -= index_[hash].size;
     index_.erase(hash);
   }

@@ -215,3 +215,110 @@ TEST(Assets, AnAcknowledgedUploadSurvivesKillDashNine) {
 
 }  // namespace
 }  // namespace penumbra::test
+
+namespace penumbra::test {
+namespace {
+
+Json enveloped(const Json& scene, const std::map<std::string, std::string>& files) {
+  Json manifest = Json::object();
+  for (const auto& [name, bytes] : files) manifest[name] = "sha256:" + sha(bytes);
+  return {{"scene", scene}, {"assets", manifest}};
+}
+
+TEST(AssetLimits, OneAssetsSizeAtTheBoundary) {
+  TempDir dir;
+  ServerProcess server(dir.path(), {"--max-asset-size", "1000"});
+  auto c = server.client();
+  EXPECT_EQ(put_asset(*c, std::string(1000, 'a'))->status, 201);
+  auto over = put_asset(*c, std::string(1001, 'b'));
+  EXPECT_EQ(over->status, 413) << over->body;
+  EXPECT_EQ(Json::parse(over->body)["limit"], 1000);
+  // A body longer than --max-body but within --max-asset-size is an upload, not refused.
+  ServerProcess wide(dir.path() + "-wide", {"--max-body", "1k", "--max-asset-size", "64k"});
+  auto w = wide.client();
+  EXPECT_EQ(put_asset(*w, std::string(60000, 'c'))->status, 201);
+  EXPECT_EQ(post_json(*w, "/v1/jobs", std::string(2000, ' '))->status, 413);
+  std::filesystem::remove_all(dir.path() + "-wide");
+}
+
+TEST(AssetLimits, FilesAndBytesPerJobAtTheBoundary) {
+  TempDir dir;
+  ServerProcess server(dir.path(), {"--max-job-files", "2", "--max-job-assets", "2000"});
+  auto c = server.client();
+  const std::string a(1000, 'a'), b(1000, 'b'), d(1, 'd');
+  for (const auto* bytes : {&a, &b, &d}) ASSERT_EQ(put_asset(*c, *bytes)->status, 201);
+  const Json scene = tiny_scene(4, 4, 1);
+  EXPECT_EQ(post_json(*c, "/v1/jobs", enveloped(scene, {{"a", a}, {"b", b}}).dump())->status, 202);
+  auto files = post_json(*c, "/v1/jobs", enveloped(scene, {{"a", a}, {"b", b}, {"d", d}}).dump());
+  ASSERT_EQ(files->status, 422);
+  EXPECT_EQ(Json::parse(files->body)["errors"][0]["pointer"], "/assets");
+  const std::string b2 = b + "x";  // 1001 bytes: 2001 in all
+  ASSERT_EQ(put_asset(*c, b2)->status, 201);
+  auto bytes = post_json(*c, "/v1/jobs", enveloped(scene, {{"a", a}, {"b", b2}}).dump());
+  ASSERT_EQ(bytes->status, 422) << bytes->body;
+  EXPECT_NE(Json::parse(bytes->body)["errors"][0]["detail"].get<std::string>().find("--max-job-assets"),
+            std::string::npos);
+}
+
+// The texture's width x height is read from its header: 8 x 8 = 64 pixels.
+TEST(AssetLimits, ImagePixelsAtTheBoundary) {
+  const std::string png =
+      read_file(std::string(PENUMBRA_SOURCE_DIR) + "/scenes/textures/checker.png");
+  Json scene = tiny_scene(4, 4, 1);
+  scene["materials"]["white"]["color"] = {{"texture", "checker.png"}};
+  for (const int limit : {64, 63}) {
+    TempDir dir;
+    ServerProcess server(dir.path(), {"--max-image-pixels", std::to_string(limit)});
+    auto c = server.client();
+    ASSERT_EQ(put_asset(*c, png)->status, 201);
+    auto res = post_json(*c, "/v1/jobs", enveloped(scene, {{"checker.png", png}}).dump());
+    if (limit == 64) {
+      EXPECT_EQ(res->status, 202) << res->body;
+    } else {
+      ASSERT_EQ(res->status, 422) << res->body;
+      EXPECT_EQ(Json::parse(res->body)["errors"][0]["pointer"], "/scene/materials/white/color/texture");
+    }
+  }
+}
+
+// Under a small quota the least recently used assets go first, never one a queued or running job
+// has in its folder; once that job is gone its files can go too.
+TEST(AssetStore, EvictsOldestUnreferencedAssetsFirst) {
+  TempDir dir;
+  ServerProcess server(dir.path(), {"--max-asset-store", "300000"});
+  auto c = server.client();
+  const std::string a(130000, 'a'), b(100000, 'b'), cc(100000, 'c'), d(150000, 'd'), e(200000, 'e');
+  const auto present = [&](const std::string& bytes) {
+    return c->Head(("/v1/assets/" + sha(bytes)).c_str())->status == 200;
+  };
+  ASSERT_EQ(put_asset(*c, a)->status, 201);
+  auto job = post_json(*c, "/v1/jobs", enveloped(long_scene(), {{"a.bin", a}}).dump());
+  ASSERT_EQ(job->status, 202) << job->body;
+  const std::string id = Json::parse(job->body)["id"];
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  ASSERT_EQ(put_asset(*c, b)->status, 201);
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  ASSERT_EQ(put_asset(*c, cc)->status, 201);  // 330000: b goes (a is the oldest, but in use)
+  EXPECT_TRUE(present(a));
+  EXPECT_FALSE(present(b));
+  EXPECT_TRUE(present(cc));
+  ASSERT_EQ(put_asset(*c, d)->status, 201);  // c goes
+  EXPECT_TRUE(present(a));
+  EXPECT_FALSE(present(cc));
+  EXPECT_TRUE(present(d));
+  auto full = put_asset(*c, e);  // no room beside a even without d: refused, nothing evicted
+  EXPECT_EQ(full->status, 507) << full->body;
+  EXPECT_TRUE(present(a));
+  EXPECT_TRUE(present(d));
+  EXPECT_FALSE(present(e));
+  ASSERT_EQ(c->Delete(("/v1/jobs/" + id).c_str())->status / 100, 2);
+  wait_for_state(*c, id, {"cancelled"});
+  auto after = put_asset(*c, e);  // the job is over: a (the oldest) and d go now
+  EXPECT_EQ(after->status, 201) << after->body;
+  EXPECT_FALSE(present(a));
+  EXPECT_FALSE(present(d));
+  EXPECT_TRUE(present(e));
+}
+
+}  // namespace
+}  // namespace penumbra::test
