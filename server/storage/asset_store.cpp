@@ -13,6 +13,7 @@
 #include <stdexcept>
 
 #include "server/storage/job_record.h"
+#include "server/storage/sha256.h"
 
 namespace penumbra::server {
 namespace fs = std::filesystem;
@@ -165,6 +166,33 @@ std::optional<std::pair<std::shared_ptr<std::ifstream>, std::uint64_t>> AssetSto
 std::unique_ptr<AssetUpload> AssetStore::begin_upload(const std::string& expected_hash) {
   return std::make_unique<AssetUpload>(expected_hash, root_ + "/tmp/" + random_name() + ".part",
                                        limits_.max_asset_bytes);
+}
+
+PutResult AssetStore::put_bytes(std::string_view bytes, std::string* hash_out) {
+  const std::string hash = sha256_hex(bytes);
+  if (hash_out) *hash_out = hash;
+  if (const auto size = size_of(hash)) return PutResult{PutStatus::kAlreadyStored, hash, *size};
+  auto upload = begin_upload(hash);
+  upload->write(bytes.data(), bytes.size());
+  return finish_upload(std::move(upload));
+}
+
+std::string AssetStore::stage(const std::string& hash, const std::string& name) {
+  std::lock_guard lock(mutex_);  // not evicted between the check and the link
+  const fs::path folder = fs::path(root_) / "tmp" / random_name();
+  fs::create_directories(folder);
+  const fs::path file = folder / name;
+  if (::link(asset_path(hash).c_str(), file.c_str()) != 0) {
+    std::error_code ec;
+    fs::remove_all(folder, ec);
+    throw std::runtime_error("cannot stage " + hash + ": " + std::strerror(errno));
+  }
+  return file.string();
+}
+
+void AssetStore::unstage(const std::string& staged_path) {
+  std::error_code ec;
+  fs::remove_all(fs::path(staged_path).parent_path(), ec);
 }
 
 PutResult AssetStore::finish_upload(std::unique_ptr<AssetUpload> upload) {

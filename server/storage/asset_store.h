@@ -99,6 +99,13 @@ class AssetStore {
       const std::string& hash) const;
 
   std::unique_ptr<AssetUpload> begin_upload(const std::string& expected_hash);
+  // Stores bytes already in memory (the one-shot job forms); same checks as an upload.
+  PutResult put_bytes(std::string_view bytes, std::string* hash_out);
+  // Links a stored file into a fresh folder under tmp/ as `name` and returns its path, to read
+  // it where a file name is needed (the glTF scene builder); unstage removes that folder.
+  std::string stage(const std::string& hash, const std::string& name);
+  void unstage(const std::string& staged_path);
+
   // Checks the hash, makes room (evicting unreferenced assets, oldest use first) and moves the
   // file into place durably. Throws std::runtime_error on an I/O failure.
   PutResult finish_upload(std::unique_ptr<AssetUpload> upload);
