@@ -66,7 +66,7 @@ void parse_manifest(const Json& assets, const ManifestLimits& limits, Diagnostic
   for (const auto& [name, value] : assets.items()) {
     const std::string pointer = child_pointer("/assets", name);
     if (auto problem = manifest_name_problem(name, limits)) {
-      diag.error(pointer, *problem + " ('" + quote_user_string(name) + "')");
+      diag.error(pointer, *problem + " (" + quote_user_string(name) + ")");
       continue;
     }
     const auto hash = value.is_string() ? parse_hash_reference(value.get<std::string>())
@@ -85,7 +85,7 @@ void parse_manifest(const Json& assets, const ManifestLimits& limits, Diagnostic
     for (std::size_t j = i + 1; j < out.size() && out[j].name.compare(0, a.size(), a) == 0; ++j)
       if (out[j].name.size() > a.size() && out[j].name[a.size()] == '/')
         diag.error(child_pointer("/assets", out[j].name),
-                   "'" + quote_user_string(a) + "' is a file, so it cannot also be a folder");
+                   quote_user_string(a) + " is a file, so it cannot also be a folder");
   }
 }
 

@@ -27,8 +27,8 @@ json asset_json(const std::string& hash, std::uint64_t size) {
 
 Problem bad_hash(const std::string& text) {
   Problem p = make_problem(400, "invalid-asset-hash", "Invalid asset hash",
-                           "'" + api::quote_user_string(text) +
-                               "' is not a SHA-256: the path ends in 64 lowercase hex digits");
+                           api::quote_user_string(text) +
+                               " is not a SHA-256: the path ends in 64 lowercase hex digits");
   return p;
 }
 

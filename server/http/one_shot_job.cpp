@@ -35,13 +35,13 @@ Problem store_problem(PutStatus status, const AssetStore& store, const std::stri
     Problem p = make_problem(507, "asset-store-full", "Insufficient Storage",
                              "the asset store (--max-asset-store " +
                                  std::to_string(store.limits().max_store_bytes) +
-                                 " bytes) has no room for '" + api::quote_user_string(name) +
-                                 "' beside the assets queued or running jobs use; retry later");
+                                 " bytes) has no room for " + api::quote_user_string(name) +
+                                 " beside the assets queued or running jobs use; retry later");
     p.retry_after_seconds = 30;
     return p;
   }
   Problem p = make_problem(413, "asset-too-large", "Content Too Large",
-                           "'" + api::quote_user_string(name) + "' is larger than " +
+                           api::quote_user_string(name) + " is larger than " +
                                std::to_string(store.limits().max_asset_bytes) +
                                " bytes (--max-asset-size)");
   return p;
@@ -72,7 +72,7 @@ std::variant<std::string, Problem> multipart_job(const RouteContext& c,
     }
     const std::string pointer = api::child_pointer("/assets", part.name);
     if (auto problem = api::manifest_name_problem(part.name, manifest_limits_)) {
-      errors.push_back({pointer, *problem + " ('" + api::quote_user_string(part.name) + "')"});
+      errors.push_back({pointer, *problem + " (" + api::quote_user_string(part.name) + ")"});
       continue;
     }
     for (const MultipartPart* f : files)
