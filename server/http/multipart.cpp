@@ -200,7 +200,17 @@ MultipartResult parse_multipart(std::string_view body, std::string_view boundary
       out.error = "a part has no Content-Disposition";
       return out;
     }
-    const auto end = body.find(delimiter, pos);
+    // A delimiter is the boundary followed by "--" or (after optional white space) a line
+    // break (RFC 2046 section 5.1.1); "--B" inside a line is data, however unwise the sender's
+    // choice of boundary.
+    std::size_t end = body.find(delimiter, pos);
+    while (end != std::string_view::npos) {
+      std::size_t after = end + delimiter.size();
+      if (body.substr(after, 2) == "--") break;
+      while (after < body.size() && (body[after] == ' ' || body[after] == '\t')) ++after;
+      if (body.substr(after, 2) == "\r\n") break;
+      end = body.find(delimiter, end + 1);
+    }
     if (end == std::string_view::npos) {
       out.error = "the body ends inside the part '" + part.name + "' (no closing boundary)";
       return out;
