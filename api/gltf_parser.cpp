@@ -51,21 +51,6 @@ AffineTransform affine(const glm::dmat4& m) {
   return t;
 }
 
-AffineTransform compose(const AffineTransform& outer, const AffineTransform& inner) {
-  AffineTransform t;
-  t.linear = outer.linear * inner.linear;
-  t.translation = outer.linear * inner.translation + outer.translation;
-  return t;
-}
-
-// x = A y + b  <=>  y = A^-1 x - A^-1 b (A invertible: nodes with a zero determinant are skipped).
-AffineTransform inverse(const AffineTransform& t) {
-  AffineTransform inv;
-  inv.linear = glm::inverse(t.linear);
-  inv.translation = -(inv.linear * t.translation);
-  return inv;
-}
-
 // The glTF images a scene's materials use, each probed once (header only) as a texture.
 class GltfTextures {
  public:
@@ -274,6 +259,7 @@ std::optional<ParsedGltf> parse_gltf_object(ObjectReader& reader, const AffineTr
       continue;
     }
     const GltfMesh& mesh = asset->meshes[size_t(instance.mesh)];
+    GltfPlacement placement{instance.node, instance.mesh, instance.node_name, mesh.name, {}};
     const auto key = std::make_pair(instance.mesh, det < 0);
     auto base = bases.find(key);
     const bool is_base = base == bases.end();
@@ -290,8 +276,9 @@ std::optional<ParsedGltf> parse_gltf_object(ObjectReader& reader, const AffineTr
         continue;
       }
       if (!is_base && base->second.copies_index[p] >= 0) {
-        out.copies[size_t(base->second.copies_index[p])].transforms.push_back(
-            compose(to_world, base->second.from_world));
+        GltfCopies& copies = out.copies[size_t(base->second.copies_index[p])];
+        copies.transforms.push_back(compose(to_world, base->second.from_world));
+        placement.parts.push_back({copies.object, copies.transforms.back()});
         ++instanced;
         continue;
       }
@@ -335,8 +322,10 @@ std::optional<ParsedGltf> parse_gltf_object(ObjectReader& reader, const AffineTr
         base->second.copies_index[p] = std::ptrdiff_t(out.copies.size());
         out.copies.push_back(GltfCopies{out.objects.size(), {}});
       }
+      placement.parts.push_back({out.objects.size(), AffineTransform{}});
       out.objects.push_back(std::move(object));
     }
+    out.placements.push_back(std::move(placement));
   }
   // Primitives no other node uses need no instances.
   out.copies.erase(std::remove_if(out.copies.begin(), out.copies.end(),

@@ -29,9 +29,24 @@ struct GltfCopies {
   std::vector<AffineTransform> transforms;
 };
 
+// What one node placed: each primitive of its mesh as objects[object] moved by `from_object`
+// (identity where the node placed the primitive itself; where it copies another node's
+// placement, the transform from there to here). What an "instances" object naming a glTF node
+// or mesh copies (api/instances_parser.h). Primitives left out (hidden, all degenerate) are absent.
+struct GltfPlacement {
+  int node = 0, mesh = 0;
+  std::string node_name, mesh_name;
+  struct Part {
+    std::size_t object = 0;
+    AffineTransform from_object;
+  };
+  std::vector<Part> parts;
+};
+
 struct ParsedGltf {
   std::vector<ObjectDesc> objects;        // `material` indexes `materials` below
   std::vector<GltfCopies> copies;         // of some of `objects`
+  std::vector<GltfPlacement> placements;  // one per node that places a mesh, in hierarchy order
   std::vector<MaterialParams> materials;  // one per glTF material, then the default material
   std::vector<LightDesc> lights;          // world space, relative to the scene's origin
   int64_t triangles = 0, vertices = 0;

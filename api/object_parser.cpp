@@ -1,5 +1,7 @@
 #include "api/object_parser.h"
 
+#include <map>
+
 #include <cmath>
 
 #include "api/gltf_parser.h"
@@ -97,6 +99,7 @@ ParsedObjects parse_objects(const Json* objects, const std::string& pointer,
 
   std::vector<PendingInstances> pending_instances;  // resolved once every object is read
   std::vector<int64_t> desc_index(objects->size(), -1);
+  std::map<std::size_t, PlacedGltf> placed_gltf;  // what "instances" objects may copy
   for (std::size_t i = 0; i < objects->size(); ++i) {
     ObjectReader reader((*objects)[i], child_pointer(pointer, i), diag);
     if (!reader.valid()) continue;
@@ -236,6 +239,7 @@ ParsedObjects parse_objects(const Json* objects, const std::string& pointer,
       parsed.vertices += gltf->vertices;
       parsed.any_emission = parsed.any_emission || gltf->any_emission;
       parsed.assets.push_back(std::move(gltf->use));
+      placed_gltf[i] = PlacedGltf{first_object, std::move(gltf->placements)};
       continue;
     } else {
       reader.error("type", "unknown object type " + quote_user_string(*type) +
@@ -249,8 +253,8 @@ ParsedObjects parse_objects(const Json* objects, const std::string& pointer,
     desc_index[i] = int64_t(parsed.objects.size());
     parsed.objects.push_back(std::move(object));
   }
-  resolve_instances(pending_instances, *objects, desc_index, parsed.objects, origin,
-                    parsed.instances, diag);
+  resolve_instances(pending_instances, *objects, desc_index, parsed.objects, placed_gltf, origin,
+                    limits, parsed.instance_count, parsed.instances, diag);
   return parsed;
 }
 

@@ -74,6 +74,21 @@ std::optional<AffineTransform> parse_matrix(const Json& value, const std::string
 }
 }  // namespace
 
+AffineTransform compose(const AffineTransform& outer, const AffineTransform& inner) {
+  AffineTransform t;
+  t.linear = outer.linear * inner.linear;
+  t.translation = outer.linear * inner.translation + outer.translation;
+  return t;
+}
+
+// x = A y + b  <=>  y = A^-1 x - A^-1 b.
+AffineTransform inverse(const AffineTransform& t) {
+  AffineTransform inv;
+  inv.linear = glm::inverse(t.linear);
+  inv.translation = -(inv.linear * t.translation);
+  return inv;
+}
+
 std::optional<AffineTransform> parse_transform(const Json& value, const std::string& pointer,
                                                Diagnostics& diag) {
   ObjectReader reader(value, pointer, diag);

@@ -25,6 +25,11 @@ struct AffineTransform {
   std::optional<double> similarity_scale() const;
 };
 
+// outer after inner: x' = outer(inner(x)).
+AffineTransform compose(const AffineTransform& outer, const AffineTransform& inner);
+// The inverse of an invertible transform (the caller checks the determinant).
+AffineTransform inverse(const AffineTransform& t);
+
 // Parses {"scale", "rotate": {"axis", "degrees"}, "translate"} (applied in that order: scale,
 // then rotate, then translate) or {"matrix": 16 numbers, row-major, affine, invertible}.
 // Rotation is right-handed: positive degrees turn counter-clockwise when looking from the tip

@@ -1,21 +1,37 @@
-# Writes a C++ file with every api/*.json document as a string, looked up by file name
-# through penumbra::api::embedded_document(name) (declared in api/embedded_documents.h).
-# "@PENUMBRA_VERSION@" in a document becomes -DPENUMBRA_VERSION (the project's version).
-if(NOT PENUMBRA_VERSION)
-  message(FATAL_ERROR "embed_documents.cmake needs -DPENUMBRA_VERSION=<project version>")
+# Writes a C++ file with every file of DIR matching PATTERN (default *.json) as a string, looked
+# up by file name through FUNCTION(name) (default penumbra::api::embedded_document, declared in
+# HEADER, default api/embedded_documents.h; NAMESPACE default penumbra::api).
+# With -DPENUMBRA_VERSION, "@PENUMBRA_VERSION@" in a file becomes the project's version (the
+# api documents); without it the bytes pass through untouched (the dashboard's files).
+if(NOT PATTERN)
+  set(PATTERN "*.json")
 endif()
-file(GLOB docs ${DIR}/*.json)
-set(body "#include \"api/embedded_documents.h\"\n#include <map>\n#include <string>\nnamespace penumbra::api {\nnamespace {\nconst std::map<std::string, std::string>& documents() {\n  static const std::map<std::string, std::string> m = {\n")
+if(NOT NAMESPACE)
+  set(NAMESPACE "penumbra::api")
+endif()
+if(NOT FUNCTION)
+  set(FUNCTION "embedded_document")
+endif()
+if(NOT HEADER)
+  set(HEADER "api/embedded_documents.h")
+endif()
+file(GLOB docs ${DIR}/${PATTERN})
+list(SORT docs)
+set(body "#include \"${HEADER}\"\n#include <map>\n#include <string>\nnamespace ${NAMESPACE} {\nnamespace {\nconst std::map<std::string, std::string>& documents() {\n  static const std::map<std::string, std::string> m = {\n")
 foreach(doc ${docs})
   get_filename_component(name ${doc} NAME)
-  # Substituted in a copy, then read as hex so that every other byte passes through untouched.
-  configure_file(${doc} ${OUT}.${name} @ONLY)
-  file(READ ${OUT}.${name} hex HEX)
-  file(REMOVE ${OUT}.${name})
+  if(PENUMBRA_VERSION)
+    # Substituted in a copy, then read as hex so that every other byte passes through untouched.
+    configure_file(${doc} ${OUT}.${name} @ONLY)
+    file(READ ${OUT}.${name} hex HEX)
+    file(REMOVE ${OUT}.${name})
+  else()
+    file(READ ${doc} hex HEX)
+  endif()
   string(REGEX REPLACE "([0-9a-f][0-9a-f])" "\\\\x\\1" escaped "${hex}")
   string(LENGTH "${hex}" hexlen)
   math(EXPR len "${hexlen} / 2")
   string(APPEND body "    {\"${name}\", std::string(\"${escaped}\", ${len})},\n")
 endforeach()
-string(APPEND body "  };\n  return m;\n}\n}  // namespace\nconst std::string* embedded_document(const std::string& name) {\n  auto it = documents().find(name);\n  return it == documents().end() ? nullptr : &it->second;\n}\n}  // namespace penumbra::api\n")
+string(APPEND body "  };\n  return m;\n}\n}  // namespace\nconst std::string* ${FUNCTION}(const std::string& name) {\n  auto it = documents().find(name);\n  return it == documents().end() ? nullptr : &it->second;\n}\n}  // namespace ${NAMESPACE}\n")
 file(WRITE ${OUT} "${body}")

@@ -371,6 +371,46 @@ EOF
   grep '^429 ' "$WORK/polls.txt" | grep -qv '^429 1 application/problem+json' &&
     fail "a rate-limited answer without Retry-After: 1 or problem+json: $(grep '^429 ' "$WORK/polls.txt" | sort -u)"
   ok "100 rapid polls: $codes(429 = rate limited, with Retry-After and problem+json)"
+  # The slow-client attack of tests/hostile/slow_clients_test.cpp through the proxy: 264
+  # connections from this host trickle heads and bodies or read nothing, while another client
+  # (the service's container, another address on the network) probes /healthz and a job's status
+  # through the proxy: each must answer 200 within 100 ms. The attacker's own address is held to
+  # limit_conn (32 connections) and its unfinished heads are cut by client_header_timeout (10 s).
+  PROXY_IP=$(podman inspect --format '{{range .NetworkSettings.Networks}}{{.IPAddress}}{{end}}' "$PROXY_NAME")
+  rm -f "$WORK/attack.ready"
+  python3 tests/hostile/proxy_slow_clients.py "$PPORT" "$TOKEN" "$JOB" "$WORK/attack.ready" 13 \
+    >"$WORK/attack.out" 2>&1 &
+  attacker=$!
+  deadline=$(( $(date +%s) + 30 ))
+  until [ -s "$WORK/attack.ready" ]; do
+    kill -0 "$attacker" 2>/dev/null || { cat "$WORK/attack.out" >&2; fail "the attack script exited"; }
+    [ "$(date +%s)" -lt "$deadline" ] || fail "the attack script did not open its connections"
+    sleep 0.2
+  done
+  sleep 1
+  pm exec "$NAME" sh -c "for i in \$(seq 15); do
+      curl -s -o /dev/null -w 'healthz %{http_code} %{time_total}\n' --max-time 5 http://$PROXY_IP:8080/healthz
+      curl -s -o /dev/null -w 'status %{http_code} %{time_total}\n' --max-time 5 \
+        -H 'Authorization: Bearer $TOKEN' http://$PROXY_IP:8080$JOB
+      sleep 0.2
+    done" >"$WORK/probes.txt" || fail "probing through the proxy from the service's container"
+  wait "$attacker" || { cat "$WORK/attack.out" >&2; fail "the attack script failed"; }
+  python3 - "$WORK/probes.txt" "$WORK/attack.out" <<'EOF' || fail "slow clients through the proxy"
+import json, sys
+probes = [line.split() for line in open(sys.argv[1]) if line.strip()]
+outcome = json.loads(open(sys.argv[2]).read().strip().splitlines()[-1])
+bad = [p for p in probes if p[1] != "200" or float(p[2]) >= 0.100]
+times = sorted(float(p[2]) * 1000 for p in probes)
+print(f"   probes: {len(probes)}, median {times[len(times) // 2]:.1f} ms, max {times[-1]:.1f} ms; "
+      f"attacker's connections at the end: {outcome}")
+if len(probes) != 30 or bad:
+    sys.exit(f"probes not answered 200 within 100 ms: {bad or len(probes)}")
+if outcome["heads"].get("closed", 0) != 100:
+    sys.exit("unfinished heads were not all cut after client_header_timeout")
+if outcome["bodies"].get("open", 0) > 32:
+    sys.exit("more than limit_conn (32) trickling bodies held open for one address")
+EOF
+  ok "264 slow connections from one address: probes from another answer 200 within 100 ms"
   pm stop -t 30 "$NAME" >/dev/null
   c=$(curl -sS -D "$WORK/down.headers" -o /dev/null -w '%{http_code}' --max-time 10 "$PBASE/healthz")
   [ "$c" = 503 ] && grep -qi '^retry-after: 5' "$WORK/down.headers" ||

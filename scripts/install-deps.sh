@@ -6,7 +6,13 @@
 #   scripts/install-deps.sh --schemathesis  also the Python venv with schemathesis, the HTTP API
 #                                     fuzzer of the ctest label "schemathesis" (PyPI, pinned;
 #                                     scripts/setup-schemathesis-venv.sh)
+#   scripts/install-deps.sh --browser also Chromium, its WebDriver and a venv with Selenium for the
+#                                     dashboard's browser test (ctest label "browser";
+#                                     scripts/setup-browser-venv.sh)
+# Flags combine: scripts/test.sh passes --schemathesis --browser.
 set -euo pipefail
+want() { local f; for f in "${ARGS[@]}"; do [ "$f" = "$1" ] && return 0; done; return 1; }
+ARGS=("$@")
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
 PKGS=(
@@ -16,7 +22,9 @@ PKGS=(
   libgtest-dev libgmock-dev libbenchmark-dev libtinyobjloader-dev libtinygltf-dev libpng-dev
   libopenexr-dev libssl-dev
 )
-if [ "${1:-}" = "--fuzz" ]; then PKGS+=(clang libclang-rt-14-dev); fi
+if want --fuzz; then PKGS+=(clang libclang-rt-14-dev); fi
+# Debian's chromium and chromium-driver (the same version), fonts for readable screenshots.
+if want --browser; then PKGS+=(chromium chromium-driver fonts-dejavu-core python3-venv); fi
 missing=()
 for p in "${PKGS[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -26,4 +34,5 @@ if [ ${#missing[@]} -gt 0 ]; then
   $SUDO apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
-if [ "${1:-}" = "--schemathesis" ]; then "$(dirname "$0")/setup-schemathesis-venv.sh"; fi
+if want --schemathesis; then "$(dirname "$0")/setup-schemathesis-venv.sh"; fi
+if want --browser; then "$(dirname "$0")/setup-browser-venv.sh"; fi

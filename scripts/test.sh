@@ -2,8 +2,12 @@
 # The test command: installs the dependencies, builds, and runs the whole test suite (ctest).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-# --schemathesis: also the pinned Python venv (.venv-schemathesis) of the "schemathesis" label.
-./scripts/install-deps.sh --schemathesis
+# --schemathesis: also the pinned Python venv (.venv-schemathesis) of the "schemathesis" label;
+# --browser: Debian's chromium and chromium-driver and the Selenium venv of the "browser" label.
+./scripts/install-deps.sh --schemathesis --browser
 ./scripts/build.sh
 BUILD_DIR=${BUILD_DIR:-build}
+# Open Image Denoise beside the binary (the pinned PyPI wheel's libraries; denoising tests).
+BUILD_DIR="$BUILD_DIR" ./scripts/install-oidn.sh
+export PENUMBRA_REQUIRE_OIDN=1
 ctest --test-dir "$BUILD_DIR" --output-on-failure -j"$(nproc)" --timeout 300 "$@"

@@ -1,10 +1,32 @@
 #pragma once
-// Reading one ray of an Embree ray packet (the RTCRayN accessors) as our vector types.
+// Our rays as Embree's single-ray records, and one ray of an Embree ray packet (the RTCRayN
+// accessors) read back as our vector types.
 #include <embree3/rtcore.h>
 
 #include "renderer/core/math.h"
+#include "renderer/core/ray.h"
 
 namespace penumbra {
+
+// An RTCRayHit for rtcIntersect1: the ray from t = 0 to ray.t_max at ray.time, no hit yet.
+inline RTCRayHit embree_ray_hit(const Ray& ray) {
+  RTCRayHit rh;
+  rh.ray.org_x = ray.origin.x;
+  rh.ray.org_y = ray.origin.y;
+  rh.ray.org_z = ray.origin.z;
+  rh.ray.dir_x = ray.direction.x;
+  rh.ray.dir_y = ray.direction.y;
+  rh.ray.dir_z = ray.direction.z;
+  rh.ray.tnear = 0.f;
+  rh.ray.tfar = ray.t_max;
+  rh.ray.time = ray.time;
+  rh.ray.mask = 0xFFFFFFFFu;  // Debian's Embree is built with ray masks: 0 would hit nothing
+  rh.ray.id = 0;
+  rh.ray.flags = 0;
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  return rh;
+}
 
 inline vec3 embree_ray_origin(RTCRayN* ray, unsigned n, unsigned i) {
   return vec3(RTCRayN_org_x(ray, n, i), RTCRayN_org_y(ray, n, i), RTCRayN_org_z(ray, n, i));

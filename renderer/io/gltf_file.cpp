@@ -634,7 +634,7 @@ class Converter {
         if (size_t(node.mesh) >= m_.meshes.size())
           fail(name_, what + ": mesh " + std::to_string(node.mesh) + " does not exist");
         if (node.skin >= 0) warn(what + ": skinning is ignored (the mesh is rendered unposed)");
-        out_.instances.push_back({node.mesh, item.node, world});
+        out_.instances.push_back({node.mesh, item.node, world, node.name});
       }
       if (node.camera >= 0) camera(node, world, what);
       if (auto it = node.extensions.find("KHR_lights_punctual"); it != node.extensions.end())

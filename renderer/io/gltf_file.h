@@ -96,6 +96,7 @@ struct GltfMeshInstance {
   int mesh = 0;
   int node = 0;
   glm::dmat4 to_world{1.0};
+  std::string node_name;
 };
 
 struct GltfCamera {

@@ -1,12 +1,12 @@
 #include "renderer/io/oiio_module.h"
 
 #include <dlfcn.h>
-#include <unistd.h>
 
 #include <atomic>
 #include <cstdlib>
 #include <vector>
 
+#include "renderer/io/executable_dir.h"
 #include "renderer/io/image_io.h"
 #include "renderer/io/image_reader.h"
 
@@ -24,15 +24,6 @@ struct Module {
 };
 
 std::atomic<bool> g_loaded{false};
-
-std::string executable_dir() {
-  std::vector<char> buf(4096);
-  const ssize_t n = ::readlink("/proc/self/exe", buf.data(), buf.size() - 1);
-  if (n <= 0) return "";
-  std::string path(buf.data(), size_t(n));
-  const size_t slash = path.find_last_of('/');
-  return slash == std::string::npos ? "" : path.substr(0, slash);
-}
 
 std::vector<std::string> candidates() {
   if (const char* env = std::getenv("PENUMBRA_OIIO_MODULE"); env && *env) return {env};

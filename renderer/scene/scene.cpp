@@ -2,6 +2,7 @@
 
 #include <embree3/rtcore.h>
 
+#include "renderer/embree/ray_access.h"
 #include "renderer/lights/light.h"
 #include "renderer/materials/coating_tables.h"
 #include "renderer/shapes/shape.h"
@@ -16,21 +17,7 @@ Scene::~Scene() {
 bool Scene::intersect(const Ray& ray, SurfaceHit* hit) const {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
-  RTCRayHit rh;
-  rh.ray.org_x = ray.origin.x;
-  rh.ray.org_y = ray.origin.y;
-  rh.ray.org_z = ray.origin.z;
-  rh.ray.dir_x = ray.direction.x;
-  rh.ray.dir_y = ray.direction.y;
-  rh.ray.dir_z = ray.direction.z;
-  rh.ray.tnear = 0.f;
-  rh.ray.tfar = ray.t_max;
-  rh.ray.time = ray.time;
-  rh.ray.mask = 0xFFFFFFFFu;  // Debian's Embree is built with ray masks: 0 would hit nothing
-  rh.ray.id = 0;
-  rh.ray.flags = 0;
-  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  RTCRayHit rh = embree_ray_hit(ray);
   rtcIntersect1(rtc_scene_, &context, &rh);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
 

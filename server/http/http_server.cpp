@@ -75,6 +75,7 @@ HttpServer::HttpServer(const ServerConfig& config, JobService& jobs, Metrics& me
   add_result_routes(s, context_);
   add_render_routes(s, context_);
   add_asset_routes(s, context_);
+  add_dashboard_routes(s, context_);
 }
 
 HttpServer::~HttpServer() = default;

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "server/http/one_shot_job.h"
+#include "server/http/route_table.h"
 #include "server/http/text_util.h"
 
 namespace penumbra::server {
@@ -29,8 +30,9 @@ std::optional<Problem> guard_request(const httplib::Request& req, const GuardSet
   // (byte_range.h); elsewhere Range is ignored, as RFC 9110 section 14.2 allows.
   // (The Request object is not const in the library; only the handler's view of it is.)
   const_cast<httplib::Request&>(req).ranges.clear();
-  // Liveness must answer whatever the token: orchestrators probe it without credentials.
-  if (auth.enabled() && req.path != "/healthz" &&
+  // Liveness must answer whatever the token: orchestrators probe it without credentials. The
+  // dashboard's static files hold no data (they fetch it with the user's token).
+  if (auth.enabled() && !is_public_route(req.path) &&
       !auth.allows(req.get_header_value("Authorization"))) {
     Problem p = make_problem(401, "unauthorized", "Unauthorized",
                              "send 'Authorization: Bearer <token>' (the server's --token)");

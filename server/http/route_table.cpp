@@ -1,5 +1,7 @@
 #include "server/http/route_table.h"
 
+#include <cctype>
+
 #include "api/job_submission.h"
 #include "server/storage/job_record.h"
 
@@ -7,7 +9,26 @@ namespace penumbra::server {
 
 using api::is_sha256_hex;
 
+bool is_dashboard_file_name(std::string_view name) {
+  const std::size_t dot = name.rfind('.');
+  if (dot == std::string_view::npos || dot == 0 || dot + 1 == name.size()) return false;
+  for (std::size_t i = 0; i < name.size(); ++i) {
+    const char c = name[i];
+    const bool ok = i < dot ? (std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-')
+                            : (c >= 'a' && c <= 'z');
+    if (!ok) return false;
+  }
+  return true;
+}
+
+bool is_public_route(const std::string& path) {
+  return path == "/healthz" || path == "/" || path.rfind("/dashboard/", 0) == 0;
+}
+
 std::string route_template(const std::string& path) {
+  if (path == "/") return "/";
+  if (path.rfind("/dashboard/", 0) == 0)
+    return is_dashboard_file_name(path.substr(11)) ? "/dashboard/{file}" : "other";
   for (const char* fixed :
        {"/healthz", "/readyz", "/metrics", "/v1/openapi.json", "/v1/jobs", "/v1/render",
         "/v1/assets/missing"})

@@ -19,6 +19,20 @@ void set_error(char* error, size_t size, const std::string& message) {
   error[n] = '\0';
 }
 
+// Runs `body`, and turns any exception into the error buffer and `failed`: no C++ exception may
+// cross the C ABI into the renderer.
+template <typename T, typename Body>
+T guarded(char* error, size_t error_size, T failed, Body&& body) {
+  try {
+    return body();
+  } catch (const std::exception& e) {
+    set_error(error, error_size, e.what());
+  } catch (...) {
+    set_error(error, error_size, "OpenImageIO threw an unknown exception");
+  }
+  return failed;
+}
+
 // What a handle points to: the reader and, for an image in memory, the proxy it reads through.
 struct Handle {
   std::unique_ptr<OIIO::Filesystem::IOMemReader> proxy;
@@ -45,7 +59,7 @@ __attribute__((visibility("default"))) int penumbra_oiio_abi_version(void) {
 __attribute__((visibility("default"))) void* penumbra_oiio_open(const char* path,
                                                                 PenumbraImageSpec* spec,
                                                                 char* error, size_t error_size) {
-  try {
+  return guarded<void*>(error, error_size, nullptr, [&]() -> void* {
     auto h = std::make_unique<Handle>();
     h->in = OIIO::ImageInput::open(path);
     if (!h->in) {
@@ -54,16 +68,13 @@ __attribute__((visibility("default"))) void* penumbra_oiio_open(const char* path
     }
     fill(h->in->spec(), spec);
     return h.release();
-  } catch (const std::exception& e) {
-    set_error(error, error_size, e.what());
-    return nullptr;
-  }
+  });
 }
 
 __attribute__((visibility("default"))) void* penumbra_oiio_open_memory(
     const void* bytes, size_t size, const char* format, PenumbraImageSpec* spec, char* error,
     size_t error_size) {
-  try {
+  return guarded<void*>(error, error_size, nullptr, [&]() -> void* {
     auto h = std::make_unique<Handle>();
     h->proxy = std::make_unique<OIIO::Filesystem::IOMemReader>(bytes, size);
     h->in = OIIO::ImageInput::create(format, false, nullptr, h->proxy.get());
@@ -82,10 +93,7 @@ __attribute__((visibility("default"))) void* penumbra_oiio_open_memory(
     }
     fill(h->in->spec(), spec);
     return h.release();
-  } catch (const std::exception& e) {
-    set_error(error, error_size, e.what());
-    return nullptr;
-  }
+  });
 }
 
 __attribute__((visibility("default"))) int penumbra_oiio_read(void* handle, int channels, int type,
@@ -93,16 +101,13 @@ __attribute__((visibility("default"))) int penumbra_oiio_read(void* handle, int 
                                                               size_t error_size) {
   OIIO::ImageInput* in = static_cast<Handle*>(handle)->in.get();
   const OIIO::TypeDesc format = type == PENUMBRA_OIIO_UINT8 ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT;
-  try {
+  return guarded<int>(error, error_size, 0, [&] {
     if (!in->read_image(0, 0, 0, channels, format, pixels)) {
       set_error(error, error_size, in->geterror());
       return 0;
     }
     return 1;
-  } catch (const std::exception& e) {
-    set_error(error, error_size, e.what());
-    return 0;
-  }
+  });
 }
 
 __attribute__((visibility("default"))) void penumbra_oiio_close(void* handle) {

@@ -46,6 +46,18 @@ inline ImageStats image_stats(const Image& img) {
   return st;
 }
 
+// sum |a - b| / sum |b| over every channel of two images of one size (NaN if the sizes differ
+// or b is black).
+inline double relative_l1(const Image& a, const Image& b) {
+  if (a.rgb.size() != b.rgb.size() || a.rgb.empty()) return NAN;
+  double diff = 0, sum = 0;
+  for (std::size_t i = 0; i < a.rgb.size(); ++i) {
+    diff += std::abs(double(a.rgb[i]) - double(b.rgb[i]));
+    sum += std::abs(double(b.rgb[i]));
+  }
+  return sum > 0 ? diff / sum : NAN;
+}
+
 // Mean over a rectangle of pixels of one channel, and the standard error of that mean from the
 // film's per-pixel variance estimates.
 inline void region_mean(const RenderResult& r, int x0, int y0, int x1, int y1, int c, double* mean,

@@ -9,6 +9,7 @@
 
 #include "renderer/core/frame.h"
 #include "renderer/embree/device.h"
+#include "renderer/embree/ray_access.h"
 #include "renderer/sampling/sampling.h"
 #include "renderer/scene/scene.h"
 #include "renderer/shapes/make_shape.h"
@@ -248,13 +249,7 @@ struct DirectCopies {
   int intersect(const Ray& ray, SurfaceHit* hit, uint32_t* prim, vec2* bary) const {
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
-    RTCRayHit rh{};
-    rh.ray.org_x = ray.origin.x, rh.ray.org_y = ray.origin.y, rh.ray.org_z = ray.origin.z;
-    rh.ray.dir_x = ray.direction.x, rh.ray.dir_y = ray.direction.y, rh.ray.dir_z = ray.direction.z;
-    rh.ray.tfar = kInfinity;
-    rh.ray.mask = 0xFFFFFFFFu;
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    RTCRayHit rh = embree_ray_hit(ray);
     rtcIntersect1(top.get(), &context, &rh);
     if (rh.hit.instID[0] == RTC_INVALID_GEOMETRY_ID) return -1;
     *prim = rh.hit.primID;

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "renderer/embree/device.h"
+#include "renderer/embree/ray_access.h"
 #include "renderer/shapes/make_shape.h"
 #include "renderer/shapes/sphere.h"
 
@@ -22,12 +23,7 @@ SurfaceHit hit_from_above(const ShapeDesc& desc, const vec3& target, bool need_u
   const Ray ray{target + vec3(0.f, 0.f, 5.f), vec3(0.f, 0.f, -1.f), 0.f};
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
-  RTCRayHit rh{};
-  rh.ray.org_x = ray.origin.x, rh.ray.org_y = ray.origin.y, rh.ray.org_z = ray.origin.z;
-  rh.ray.dir_x = ray.direction.x, rh.ray.dir_y = ray.direction.y, rh.ray.dir_z = ray.direction.z;
-  rh.ray.tfar = kInfinity;
-  rh.ray.mask = 0xFFFFFFFFu;
-  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  RTCRayHit rh = embree_ray_hit(ray);
   rtcIntersect1(scene.get(), &context, &rh);
   SurfaceHit hit;
   EXPECT_NE(rh.hit.geomID, RTC_INVALID_GEOMETRY_ID);

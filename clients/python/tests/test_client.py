@@ -1,0 +1,298 @@
+"""The Python client against a real `penumbra serve` ($PENUMBRA_BINARY), started per test class
+on an ephemeral port with a token and its own data directory. Standard library unittest; the EXR
+array tests need numpy and are skipped without it."""
+from __future__ import annotations
+
+import io
+import json
+import os
+import re
+import shutil
+import struct
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+import unittest
+import zlib
+from contextlib import redirect_stderr
+
+import penumbra
+from penumbra.__main__ import main as cli_main
+
+BINARY = os.environ.get("PENUMBRA_BINARY", "penumbra")
+TOKEN = "client-test-token"
+
+try:
+    import numpy as np
+except ImportError:  # pragma: no cover - the CI venv has numpy
+    np = None
+
+
+def sky_scene(width=8, height=6, spp=4, radiance=(0.25, 0.5, 0.75)):
+    """A camera that sees only a uniform environment: every pixel is exactly `radiance`."""
+    return {"version": 1, "render": {"width": width, "height": height, "spp": spp, "seed": 3},
+            "camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "fov": 30},
+            "environment": {"radiance": list(radiance)}, "materials": {}, "objects": []}
+
+
+def slow_scene():
+    scene = sky_scene(256, 256, 4096)
+    scene["materials"] = {"m": {"type": "diffuse", "color": [0.5, 0.5, 0.5]}}
+    scene["objects"] = [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m"}]
+    return scene
+
+
+def ply_bytes():
+    """A binary PLY of one triangle facing +z, with uvs."""
+    header = ("ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n"
+              "property float y\nproperty float z\nproperty float u\nproperty float v\n"
+              "element face 1\nproperty list uchar int vertex_indices\nend_header\n").encode()
+    verts = [(-1, -1, 0, 0, 1), (1, -1, 0, 1, 1), (0, 1, 0, 0.5, 0)]
+    body = b"".join(struct.pack("<5f", *v) for v in verts) + struct.pack("<B3i", 3, 0, 1, 2)
+    return header + body
+
+
+def png_bytes(rgb=(200, 100, 50)):
+    """A 2x2 RGB PNG, written with zlib (no imaging library needed)."""
+    def chunk(kind, data):
+        return (struct.pack(">I", len(data)) + kind + data +
+                struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF))
+    raw = b"".join(b"\0" + bytes(rgb) * 2 for _ in range(2))
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", 2, 2, 8, 2, 0, 0, 0)) +
+            chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
+
+
+class Server:
+    def __init__(self, extra=()):
+        self.dir = tempfile.mkdtemp(prefix="penumbra-client-test-")
+        self.proc = subprocess.Popen(
+            [BINARY, "serve", "--port", "0", "--data-dir", os.path.join(self.dir, "data"),
+             "--token", TOKEN, *extra],
+            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+        line = self.proc.stdout.readline()
+        match = re.search(r"listening on (http://\S+)", line)
+        if not match:
+            self.stop()
+            raise RuntimeError(f"penumbra serve did not start: {line!r}")
+        self.url = match.group(1)
+        threading.Thread(target=self.proc.stdout.read, daemon=True).start()
+
+    def stop(self):
+        self.proc.terminate()
+        try:
+            self.proc.wait(timeout=20)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+        shutil.rmtree(self.dir, ignore_errors=True)
+
+
+class ServerTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.server = Server()
+        cls.client = penumbra.Client(cls.server.url, token=TOKEN, timeout=30)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.server.stop()
+
+
+class JobsTest(ServerTest):
+    def test_submit_wait_result_png_and_bytes(self):
+        job = self.client.submit(sky_scene())
+        self.assertIn(job["state"], ("queued", "running", "succeeded"))
+        final = self.client.wait(job, progress=False, timeout=60)
+        self.assertEqual(final["state"], "succeeded")
+        png = self.client.result(job, format="png")
+        self.assertEqual(png[:8], b"\x89PNG\r\n\x1a\n")
+        exr = self.client.result(job, format="exr", as_array=False)
+        self.assertEqual(exr[:4], b"\x76\x2f\x31\x01")
+
+    @unittest.skipIf(np is None, "numpy is not installed")
+    def test_exr_result_is_the_exact_radiance_as_an_array(self):
+        image = self.client.render(sky_scene(radiance=(0.25, 0.5, 0.75)), progress=False)
+        self.assertEqual(image.shape, (6, 8, 3))
+        self.assertEqual(image.dtype, np.float32)
+        np.testing.assert_allclose(image[..., 0], 0.25, rtol=1e-6)
+        np.testing.assert_allclose(image[..., 1], 0.5, rtol=1e-6)
+        np.testing.assert_allclose(image[..., 2], 0.75, rtol=1e-6)
+
+    @unittest.skipIf(np is None, "numpy is not installed")
+    def test_exr_reader_decodes_a_varied_image_like_the_server_png(self):
+        # A lit sphere: many distinct values across ZIP's 16-line blocks; against the PNG of the
+        # same job (8-bit sRGB of the clamped values) to within the PNG's rounding.
+        scene = sky_scene(40, 37, 8)  # 37 lines: a last, partial 16-line block
+        scene["materials"] = {"m": {"type": "diffuse", "color": [0.8, 0.3, 0.1]}}
+        scene["objects"] = [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m"}]
+        job = self.client.submit(scene)
+        self.client.wait(job, progress=False)
+        linear = self.client.result(job)
+        png = self.client.result(job, format="png")
+        srgb = decode_png_rgb(png).astype(np.float64) / 255.0
+        c = np.clip(linear.astype(np.float64), 0, 1)
+        encoded = np.where(c <= 0.0031308, 12.92 * c, 1.055 * np.power(c, 1 / 2.4) - 0.055)
+        self.assertEqual(encoded.shape, srgb.shape)
+        self.assertGreater(len(np.unique(linear)), 100)
+        self.assertLess(np.max(np.abs(encoded - srgb)), 1.01 / 255 + 1e-9)
+
+    def test_invalid_scene_raises_with_field_pointers(self):
+        scene = sky_scene()
+        scene["render"]["width"] = -4
+        with self.assertRaises(penumbra.InvalidRequest) as caught:
+            self.client.submit(scene)
+        self.assertEqual(caught.exception.status, 422)
+        self.assertIn("/render/width", [e.pointer for e in caught.exception.errors])
+        self.assertIn("/render/width", str(caught.exception))
+
+    def test_wrong_token_and_unknown_job(self):
+        with self.assertRaises(penumbra.Unauthorized):
+            penumbra.Client(self.server.url, token="wrong").job("0" * 24)
+        with self.assertRaises(penumbra.NotFound):
+            self.client.job("0" * 24)
+        with self.assertRaises(penumbra.NotFound):
+            self.client.wait("0" * 24, progress=False, timeout=10)
+
+    def test_cancel_and_list(self):
+        job = self.client.submit(slow_scene())
+        ids = [j["id"] for j in self.client.list(limit=1)]  # one per page: paging followed
+        self.assertIn(job["id"], ids)
+        self.client.cancel(job)
+        with self.assertRaises(penumbra.JobFailed) as caught:
+            self.client.wait(job, progress=False, timeout=60)
+        self.assertEqual(caught.exception.job["state"], "cancelled")
+        record = self.client.wait(job, progress=False, check=False)
+        self.assertEqual(record["state"], "cancelled")
+
+    def test_progress_callback_sees_the_final_state(self):
+        seen = []
+        self.client.wait(self.client.submit(sky_scene()), progress=seen.append)
+        self.assertTrue(seen)
+        self.assertEqual(seen[-1]["state"], "succeeded")
+
+    def test_unreachable_server(self):
+        with self.assertRaises(penumbra.ConnectionFailed):
+            penumbra.Client("http://127.0.0.1:9", timeout=2).job("0" * 24)
+
+    def test_command_line_renders_to_a_file(self):
+        folder = tempfile.mkdtemp()
+        try:
+            path = os.path.join(folder, "scene.json")
+            with open(path, "w") as f:
+                json.dump(sky_scene(), f)
+            out = os.path.join(folder, "out.png")
+            with redirect_stderr(io.StringIO()):
+                code = cli_main(["--url", self.server.url, "--token", TOKEN, "render", path,
+                                 "-o", out])
+            self.assertEqual(code, 0)
+            with open(out, "rb") as f:
+                self.assertEqual(f.read(8), b"\x89PNG\r\n\x1a\n")
+        finally:
+            shutil.rmtree(folder)
+
+
+class AssetsTest(ServerTest):
+    """Scenes that name files: the client finds them, uploads only what the server lacks."""
+
+    def write_scene(self, folder):
+        os.makedirs(os.path.join(folder, "tex"), exist_ok=True)
+        with open(os.path.join(folder, "tri.ply"), "wb") as f:
+            f.write(ply_bytes())
+        with open(os.path.join(folder, "tex", "wood.png"), "wb") as f:
+            f.write(png_bytes())
+        scene = sky_scene(16, 12, 2)
+        scene["materials"] = {"wood": {"type": "diffuse", "color": {"texture": "tex/wood.png"}}}
+        scene["objects"] = [{"type": "mesh", "file": "tri.ply", "material": "wood"}]
+        path = os.path.join(folder, "scene.json")
+        with open(path, "w") as f:
+            json.dump(scene, f)
+        return path
+
+    def test_scene_files_are_found_with_gltf_buffers(self):
+        folder = tempfile.mkdtemp()
+        try:
+            self.write_scene(folder)
+            os.makedirs(os.path.join(folder, "m"))
+            with open(os.path.join(folder, "m", "a.gltf"), "w") as f:
+                json.dump({"asset": {"version": "2.0"},
+                           "buffers": [{"uri": "a%20b.bin", "byteLength": 1},
+                                       {"uri": "data:application/octet-stream;base64,AA==",
+                                        "byteLength": 1}]}, f)
+            with open(os.path.join(folder, "m", "a b.bin"), "wb") as f:
+                f.write(b"\0")
+            scene = {"objects": [{"type": "gltf", "file": "m/a.gltf"},
+                                 {"type": "mesh", "file": "tri.ply"}],
+                     "materials": {"x": {"color": {"texture": "tex/wood.png"}}}}
+            files = penumbra.scene_files(scene, folder)
+            self.assertEqual(sorted(files), ["m/a b.bin", "m/a.gltf", "tex/wood.png", "tri.ply"])
+            with self.assertRaises(penumbra.PenumbraError):
+                penumbra.scene_files({"environment": {"map": "../sky.exr"}}, folder)
+            with self.assertRaises(penumbra.PenumbraError):
+                penumbra.scene_files({"environment": {"map": "missing.exr"}}, folder)
+        finally:
+            shutil.rmtree(folder)
+
+    def test_second_submit_of_the_same_scene_uploads_nothing(self):
+        folder = tempfile.mkdtemp()
+        try:
+            path = self.write_scene(folder)
+            client = penumbra.Client(self.server.url, token=TOKEN)
+            first = client.submit(path)
+            self.assertEqual(client.bytes_uploaded, len(ply_bytes()) + len(png_bytes()))
+            self.assertEqual(client.wait(first, progress=False)["state"], "succeeded")
+            second = client.submit(path)
+            self.assertEqual(client.bytes_uploaded, len(ply_bytes()) + len(png_bytes()))
+            self.assertEqual(client.wait(second, progress=False)["state"], "succeeded")
+            self.assertEqual(client.result(first, format="png"), client.result(second, format="png"))
+        finally:
+            shutil.rmtree(folder)
+
+
+def decode_png_rgb(data):
+    """8-bit RGB PNG (no interlace) to a (h, w, 3) uint8 array: enough for the server's PNGs."""
+    pos, chunks = 8, {}
+    idat = b""
+    while pos < len(data):
+        (length,) = struct.unpack_from(">I", data, pos)
+        kind = data[pos + 4:pos + 8]
+        body = data[pos + 8:pos + 8 + length]
+        if kind == b"IDAT":
+            idat += body
+        else:
+            chunks[kind] = body
+        pos += 12 + length
+    w, h, depth, color = struct.unpack(">IIBB", chunks[b"IHDR"][:10])
+    assert depth == 8 and color in (2, 6), (depth, color)
+    bpp = 3 if color == 2 else 4
+    raw = zlib.decompress(idat)
+    stride = w * bpp
+    out = np.zeros((h, stride), dtype=np.int32)
+    prev = np.zeros(stride, dtype=np.int32)
+    for y in range(h):
+        f = raw[y * (stride + 1)]
+        line = np.frombuffer(raw, np.uint8, stride, y * (stride + 1) + 1).astype(np.int32)
+        cur = np.zeros(stride, dtype=np.int32)
+        for x in range(stride):
+            a = cur[x - bpp] if x >= bpp else 0
+            b = prev[x]
+            c = prev[x - bpp] if x >= bpp else 0
+            if f == 0:
+                p = 0
+            elif f == 1:
+                p = a
+            elif f == 2:
+                p = b
+            elif f == 3:
+                p = (a + b) // 2
+            else:
+                pa, pb, pc = abs(b - c), abs(a - c), abs(a + b - 2 * c)
+                p = a if pa <= pb and pa <= pc else (b if pb <= pc else c)
+            cur[x] = (line[x] + p) & 0xFF
+        out[y] = cur
+        prev = cur
+    return out.reshape(h, w, bpp)[..., :3].astype(np.uint8)
+
+
+if __name__ == "__main__":
+    unittest.main()
