@@ -11,7 +11,7 @@ namespace fs = std::filesystem;
 std::optional<fs::path> resolve_asset_path(const AssetFolder& folder, const std::string& relative,
                                            const std::string& pointer, Diagnostics& diag) {
   if (folder.root.empty()) {
-    diag.error(pointer, "this scene cannot name files: it has no asset folder");
+    diag.error(pointer, "this scene cannot name files: it has no asset folder" + folder.missing_hint);
     return std::nullopt;
   }
   if (relative.empty()) {
@@ -40,7 +40,7 @@ std::optional<fs::path> resolve_asset_path(const AssetFolder& folder, const std:
   }
   const fs::path full = fs::canonical(root / rel, ec);
   if (ec) {
-    diag.error(pointer, "no such file in the scene's folder: '" + relative + "'");
+    diag.error(pointer, "no such file in the scene's folder: '" + relative + "'" + folder.missing_hint);
     return std::nullopt;
   }
   // Symbolic links are followed; the target must still be inside the folder.

@@ -15,6 +15,9 @@ class Diagnostics;
 struct AssetFolder {
   std::filesystem::path root;  // empty: this scene may not name files (e.g. inline JSON only)
   int64_t max_file_bytes = int64_t(2) << 30;  // any one asset file
+  // Appended to the error for a file that is not there, to say where it should come from (the
+  // service: the job's "assets" manifest).
+  std::string missing_hint = {};
 };
 
 // The canonical path of an existing regular file inside the folder, or nullopt with an error

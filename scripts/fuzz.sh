@@ -6,6 +6,7 @@
 #   obj_reader    renderer/io/obj_reader (screening + tinyobjloader)
 #   gltf_reader   renderer/io/gltf_file (GLB checks + tinygltf + accessors, hierarchy)
 #   http_head     the HTTP service's head-line checks and Range decisions (server/http)
+#   multipart     the one-shot job form parser and the job envelope's manifest (server/http, api)
 #   scripts/fuzz.sh [SECONDS] [TARGET...]     (default 60 seconds, all targets)
 # Builds with clang in build-fuzz/. Fails (non-zero) on any crash, sanitizer report, leak,
 # timeout (an input taking more than 10 s) or out-of-memory (2 GB). Crash reproducers are left
@@ -15,7 +16,7 @@ set -euo pipefail
 seconds="${1:-60}"
 shift || true
 targets=("$@")
-if [ ${#targets[@]} -eq 0 ]; then targets=(scene_loader ply_reader obj_reader gltf_reader http_head); fi
+if [ ${#targets[@]} -eq 0 ]; then targets=(scene_loader ply_reader obj_reader gltf_reader http_head multipart); fi
 root="$(cd "$(dirname "$0")/.." && pwd)"
 build="$root/build-fuzz"
 jobs="${JOBS:-2}"

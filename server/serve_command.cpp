@@ -74,7 +74,8 @@ int run_serve(int argc, char** argv) {
   SqliteJobStore store((std::filesystem::path(config.data_dir) / "jobs.db").string());
   FileResultStore files(config.data_dir);
   Metrics metrics;
-  JobService jobs(config, store, files, metrics);
+  AssetStore assets(config.data_dir, {config.max_asset_bytes, config.max_asset_store_bytes});
+  JobService jobs(config, store, files, metrics, &assets);
   HttpServer http(config, jobs, metrics);
   const int port = http.bind();
   if (port <= 0) {

@@ -60,6 +60,14 @@ std::vector<Setting> settings() {
                      return "";
                    }};
   };
+  auto byte_setting = [](const char* flag, const char* env, auto member) {
+    return Setting{flag, env, true, [=](ServerConfig& c, const std::string& v) -> std::string {
+                     const auto b = parse_byte_size(v);
+                     if (!b || *b == 0) return bad(flag, v, "a size such as 512k, 16M, 1G");
+                     c.*member = *b;
+                     return "";
+                   }};
+  };
   auto text_setting = [](const char* flag, const char* env, auto member) {
     return Setting{flag, env, true, [=](ServerConfig& c, const std::string& v) -> std::string {
                      if (v.empty()) return std::string("empty ") + flag;
@@ -134,6 +142,15 @@ std::vector<Setting> settings() {
       int_setting("--keep-alive-requests", "PENUMBRA_KEEP_ALIVE_REQUESTS", 1, 1'000'000,
                   &ServerConfig::keep_alive_max_requests),
       duration_setting("--drain", "PENUMBRA_DRAIN", 0.0, &ServerConfig::drain_seconds),
+      byte_setting("--max-asset-size", "PENUMBRA_MAX_ASSET_SIZE", &ServerConfig::max_asset_bytes),
+      byte_setting("--max-job-assets", "PENUMBRA_MAX_JOB_ASSETS",
+                   &ServerConfig::max_job_asset_bytes),
+      byte_setting("--max-asset-store", "PENUMBRA_MAX_ASSET_STORE",
+                   &ServerConfig::max_asset_store_bytes),
+      int_setting("--max-job-files", "PENUMBRA_MAX_JOB_FILES", 0, 1'000'000,
+                  &ServerConfig::max_job_files),
+      int_setting("--max-image-pixels", "PENUMBRA_MAX_IMAGE_PIXELS", 1, int64_t(1) << 40,
+                  &ServerConfig::max_image_pixels),
       {"--access-log", "PENUMBRA_ACCESS_LOG", false,
        [](ServerConfig& c, const std::string& v) -> std::string {
          c.access_log = parse_bool(v);
@@ -164,6 +181,8 @@ api::Limits ServerConfig::scene_limits() const {
   limits.max_spp = max_spp;
   limits.max_triangles = max_triangles;
   limits.max_time_limit = max_render_seconds;
+  limits.max_texture_pixels = max_image_pixels;
+  limits.max_mesh_file_bytes = int64_t(max_asset_bytes);
   return limits;
 }
 
@@ -328,6 +347,17 @@ const char* serve_usage() {
          "                           [PENUMBRA_WEBHOOK_RETRY_FOR]\n"
          "  --max-event-streams N    GET /v1/jobs/{id}/events streams open at once, more -> 503\n"
          "                           (default 256) [PENUMBRA_MAX_EVENT_STREAMS]\n"
+         "  --max-asset-size SIZE    one uploaded asset file (PUT /v1/assets, one-shot job\n"
+         "                           bodies) (default 256M) [PENUMBRA_MAX_ASSET_SIZE]\n"
+         "  --max-job-assets SIZE    all the files one job names (default 1G)\n"
+         "                           [PENUMBRA_MAX_JOB_ASSETS]\n"
+         "  --max-asset-store SIZE   the whole asset store; the least recently used assets no\n"
+         "                           queued or running job needs are evicted (default 10G)\n"
+         "                           [PENUMBRA_MAX_ASSET_STORE]\n"
+         "  --max-job-files N        files in one job's manifest (default 1000)\n"
+         "                           [PENUMBRA_MAX_JOB_FILES]\n"
+         "  --max-image-pixels N     width x height of one texture, read from its header\n"
+         "                           before decoding (default 67108864) [PENUMBRA_MAX_IMAGE_PIXELS]\n"
          "\n"
          "Durations: 90, 90s, 15m, 24h, 7d, 250ms.\n";
 }

@@ -51,6 +51,12 @@ struct ServerConfig {
   double webhook_retry_seconds = 3600.0;
   // GET /v1/jobs/{id}/events streams open at once; each holds a connection thread.
   int max_event_streams = 256;
+  // Assets (docs/http-api.md, assets): the content-addressed store and job manifests.
+  std::uint64_t max_asset_bytes = std::uint64_t(256) << 20;      // one uploaded file
+  std::uint64_t max_job_asset_bytes = std::uint64_t(1) << 30;    // all files of one job
+  std::uint64_t max_asset_store_bytes = std::uint64_t(10) << 30;  // the whole store
+  int max_job_files = 1000;                                      // manifest entries per job
+  int64_t max_image_pixels = int64_t(8192) * 8192;  // one texture, from its header
 
   // The per-scene caps handed to the scene loader.
   api::Limits scene_limits() const;

@@ -2,10 +2,13 @@
 
 #include <httplib.h>
 
+#include <algorithm>
 #include <cstdio>
 
+#include "api/job_submission.h"
 #include "server/http/connection_pool.h"
 #include "server/http/job_json.h"
+#include "server/http/json_response.h"
 #include "server/http/problem.h"
 #include "server/http/request_guard.h"
 #include "server/http/route_table.h"
@@ -60,7 +63,10 @@ HttpServer::HttpServer(const ServerConfig& config, JobService& jobs, Metrics& me
   s.new_task_queue = [threads] {
     return new ConnectionPool(std::size_t(threads), std::chrono::seconds(10));
   };
-  s.set_payload_max_length(config_.max_body_bytes);
+  // The largest body any route takes; each route's own limit is checked by the guard from
+  // Content-Length before a byte is read (request_guard.cpp).
+  s.set_payload_max_length(std::max<std::size_t>(config_.max_body_bytes,
+                                                 std::size_t(config_.max_asset_bytes)));
   s.set_keep_alive_timeout(config_.keep_alive_seconds);
   s.set_keep_alive_max_count(std::size_t(config_.keep_alive_max_requests));
   s.set_tcp_nodelay(true);  // small JSON answers to polls go out without Nagle's delay
@@ -69,6 +75,7 @@ HttpServer::HttpServer(const ServerConfig& config, JobService& jobs, Metrics& me
   add_job_routes(s, context_);
   add_result_routes(s, context_);
   add_render_routes(s, context_);
+  add_asset_routes(s, context_);
   add_dashboard_routes(s, context_);
   add_event_routes(s, context_);
   jobs.set_webhook_body(webhook_body);
@@ -76,9 +83,46 @@ HttpServer::HttpServer(const ServerConfig& config, JobService& jobs, Metrics& me
 
 HttpServer::~HttpServer() = default;
 
+bool HttpServer::answer_known_asset(const httplib::Request& req, httplib::Response& res) {
+  constexpr std::string_view kPrefix = "/v1/assets/";
+  AssetStore* store = context_.jobs.assets();
+  if (!store || req.path.compare(0, kPrefix.size(), kPrefix) != 0) return false;
+  const std::string hash = req.path.substr(kPrefix.size());
+  if (!api::is_sha256_hex(hash)) return false;
+  const auto size = store->size_of(hash);
+  if (!size) return false;
+  res.set_header("Location", req.path);
+  send_json(res, 200, {{"hash", "sha256:" + hash}, {"size", *size}});
+  return true;
+}
+
 void HttpServer::install_handlers() {
   httplib::Server& s = *server_;
-  const GuardSettings guard{config_.max_body_bytes};
+  const GuardSettings guard{config_.max_body_bytes, std::size_t(config_.max_asset_bytes)};
+  // The library asks this before routing, so before the pre-routing guard, whenever a client
+  // sends "Expect: 100-continue"; its default answers 100 to everything. Here the guard runs
+  // first (a body over its limit or without credentials is refused before it is sent), and an
+  // upload of an asset the store already holds is answered at once: its body is never sent
+  // (issue 12). Any status but 100 and 417 is written as the final answer.
+  s.set_expect_100_continue_handler(
+      [this, guard](const httplib::Request& req, httplib::Response& res) -> int {
+        // The library writes such an answer without a Content-Length of its own; the body is
+        // never read, so the connection closes after it (ConnectionStream sees the unread body).
+        const auto early_answer = [&req, &res] {
+          res.set_header("Content-Length", std::to_string(res.body.size()));
+          auto& headers = const_cast<httplib::Request&>(req).headers;
+          headers.erase("Connection");
+          headers.emplace("Connection", "close");
+          return res.status;
+        };
+        if (auto p = guard_request(req, guard, auth_)) {
+          if (p->status == 401) res.set_header("WWW-Authenticate", "Bearer realm=\"penumbra\"");
+          send_problem(res, req, *p);
+          return early_answer();
+        }
+        if (req.method == "PUT" && answer_known_asset(req, res)) return early_answer();
+        return 100;
+      });
   s.set_pre_routing_handler([this, guard](const httplib::Request& req, httplib::Response& res) {
     if (auto p = guard_request(req, guard, auth_)) {
       if (p->status == 401) res.set_header("WWW-Authenticate", "Bearer realm=\"penumbra\"");

@@ -13,6 +13,11 @@
 #include "server/metrics.h"
 #include "server/server_config.h"
 
+namespace httplib {
+struct Request;
+struct Response;
+}  // namespace httplib
+
 namespace penumbra::server {
 
 class HttpServer {
@@ -31,6 +36,8 @@ class HttpServer {
 
  private:
   void install_handlers();
+  // For Expect: 100-continue on PUT /v1/assets/{sha256}: answers 200 when the hash is stored.
+  bool answer_known_asset(const httplib::Request& req, httplib::Response& res);
   const ServerConfig config_;
   Metrics& metrics_;
   BearerAuth auth_;

@@ -7,6 +7,7 @@
 #include "server/http/idempotency_key.h"
 #include "server/http/job_json.h"
 #include "server/http/json_response.h"
+#include "server/http/one_shot_job.h"
 #include "server/http/paging.h"
 #include "server/http/request_values.h"
 #include "server/http/route_context.h"
@@ -22,7 +23,15 @@ using json = nlohmann::ordered_json;
 void submit(const RouteContext& c, const httplib::Request& req, httplib::Response& res) {
   const auto key = parse_idempotency_key(header_value(req, "Idempotency-Key"));
   if (const auto* p = std::get_if<Problem>(&key)) return send_problem(res, req, *p);
-  const SubmitOutcome o = c.jobs.submit(req.body, std::get<std::string>(key));
+  // curl -F ... and --data-binary @model.glb forms become the JSON envelope (one_shot_job.h).
+  std::string one_shot_body;
+  if (is_one_shot_job(req)) {
+    auto body = one_shot_job_body(c, req);
+    if (const auto* p = std::get_if<Problem>(&body)) return send_problem(res, req, *p);
+    one_shot_body = std::move(std::get<std::string>(body));
+  }
+  const SubmitOutcome o = c.jobs.submit(is_one_shot_job(req) ? one_shot_body : req.body,
+                                        std::get<std::string>(key));
   if (auto p = submission_problem(o)) {
     c.metrics.count_rejected(p->type.substr(p->type.rfind(':') + 1));
     return send_problem(res, req, *p);

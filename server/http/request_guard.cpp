@@ -2,9 +2,11 @@
 
 #include <httplib.h>
 
+#include <algorithm>
 #include <cctype>
 #include <string>
 
+#include "server/http/one_shot_job.h"
 #include "server/http/route_table.h"
 #include "server/http/text_util.h"
 
@@ -60,13 +62,40 @@ std::optional<Problem> guard_request(const httplib::Request& req, const GuardSet
       return make_problem(411, "length-required", "Length Required",
                           "a request body needs a Content-Length header");
   }
+  // The one-shot job forms (server/http/one_shot_job.h) carry files: a multipart form or a glTF
+  // binary, up to --max-asset-size. Their Content-Type moves to an internal header so that the
+  // library does not parse the multipart body itself (it would, without bounds, before any
+  // handler); a client-sent copy of that header is dropped. The guard may run twice (also for
+  // Expect: 100-continue), so an already rewritten request is recognised by its marker type.
+  auto& headers = const_cast<httplib::Request&>(req).headers;
+  const std::string media = ascii_lower(
+      std::string(trim_ows(req.get_header_value("Content-Type").substr(
+          0, req.get_header_value("Content-Type").find(';')))));
+  bool one_shot = req.has_header(kOneShotTypeHeader) && media == kOneShotMarkerType;
+  if (!one_shot) headers.erase(kOneShotTypeHeader);
+  if (!one_shot && req.method == "POST" && req.path == "/v1/jobs" &&
+      (media == "multipart/form-data" || media == "model/gltf-binary")) {
+    const std::string original = req.get_header_value("Content-Type");
+    headers.erase("Content-Type");
+    headers.emplace("Content-Type", kOneShotMarkerType);
+    headers.emplace(kOneShotTypeHeader, original);
+    one_shot = true;
+  }
   if (has_length) {
     const unsigned long long length = std::stoull(length_text);
-    if (length > settings.max_body_bytes) {
-      Problem p = make_problem(413, "body-too-large", "Content Too Large",
+    // An asset upload streams to disk (never held in memory) under its own limit; a one-shot
+    // form counts as one upload.
+    const bool asset_upload =
+        one_shot || (req.method == "PUT" && req.path.rfind("/v1/assets/", 0) == 0);
+    const std::size_t limit = asset_upload ? std::max(settings.max_asset_bytes, settings.max_body_bytes)
+                                           : settings.max_body_bytes;
+    const char* flag = asset_upload ? "--max-asset-size" : "--max-body";
+    if (length > limit) {
+      Problem p = make_problem(413, asset_upload ? "asset-too-large" : "body-too-large",
+                               "Content Too Large",
                                "the body has " + length_text + " bytes; the limit is " +
-                                   std::to_string(settings.max_body_bytes) + " (--max-body)");
-      p.extensions["limit"] = settings.max_body_bytes;
+                                   std::to_string(limit) + " (" + flag + ")");
+      p.extensions["limit"] = limit;
       return p;
     }
   }
@@ -75,7 +104,7 @@ std::optional<Problem> guard_request(const httplib::Request& req, const GuardSet
     return make_problem(416, "multiple-ranges", "Range Not Satisfiable",
                         "only a single byte range is served");
   }
-  if (req.method == "POST" && req.has_header("Content-Type")) {
+  if (req.method == "POST" && req.has_header("Content-Type") && !one_shot) {
     // Checked before the body is read: the library would otherwise parse multipart bodies.
     std::string type = ascii_lower(req.get_header_value("Content-Type"));
     type = std::string(trim_ows(type.substr(0, type.find(';'))));
@@ -93,7 +122,8 @@ std::optional<Problem> guard_request(const httplib::Request& req, const GuardSet
     } else if (!json_like) {
       Problem p = make_problem(415, "unsupported-media-type", "Unsupported Media Type",
                                "the body must be a JSON scene: send the header "
-                               "'Content-Type: application/json' (got '" + type + "')");
+                               "'Content-Type: application/json' (got '" + type + "'); POST "
+                               "/v1/jobs also takes multipart/form-data and model/gltf-binary");
       p.extensions["header"] = "Content-Type";
       return p;
     }

@@ -16,6 +16,8 @@ namespace penumbra::server {
 
 struct GuardSettings {
   std::size_t max_body_bytes = 0;
+  // PUT /v1/assets/{sha256} bodies (--max-asset-size) instead of max_body_bytes.
+  std::size_t max_asset_bytes = 0;
 };
 
 // The problem to answer instead of routing, or nullopt to let the request through.

@@ -27,6 +27,7 @@ void add_job_routes(httplib::Server& server,
 void add_result_routes(httplib::Server& server,
                        const RouteContext& context);  // /v1/jobs/{id}/result
 void add_render_routes(httplib::Server& server, const RouteContext& context);  // /v1/render
+void add_asset_routes(httplib::Server& server, const RouteContext& context);   // /v1/assets
 void add_dashboard_routes(httplib::Server& server,
                           const RouteContext& context);  // /, /dashboard/{file}
 void add_event_routes(httplib::Server& server,

@@ -2,9 +2,12 @@
 
 #include <cctype>
 
+#include "api/job_submission.h"
 #include "server/storage/job_record.h"
 
 namespace penumbra::server {
+
+using api::is_sha256_hex;
 
 bool is_dashboard_file_name(std::string_view name) {
   const std::size_t dot = name.rfind('.');
@@ -27,8 +30,13 @@ std::string route_template(const std::string& path) {
   if (path.rfind("/dashboard/", 0) == 0)
     return is_dashboard_file_name(path.substr(11)) ? "/dashboard/{file}" : "other";
   for (const char* fixed :
-       {"/healthz", "/readyz", "/metrics", "/v1/openapi.json", "/v1/jobs", "/v1/render"})
+       {"/healthz", "/readyz", "/metrics", "/v1/openapi.json", "/v1/jobs", "/v1/render",
+        "/v1/assets/missing"})
     if (path == fixed) return fixed;
+  constexpr std::string_view kAssets = "/v1/assets/";
+  if (path.compare(0, kAssets.size(), kAssets) == 0 && path.size() == kAssets.size() + 64 &&
+      is_sha256_hex(std::string_view(path).substr(kAssets.size())))
+    return "/v1/assets/{sha256}";
   constexpr std::string_view kJobs = "/v1/jobs/";
   constexpr std::string_view kResult = "/result";
   constexpr std::size_t kIdLength = 24;
@@ -46,6 +54,8 @@ std::vector<std::string> allowed_methods(const std::string& route) {
   if (route == "/v1/jobs") return {"GET", "HEAD", "POST"};
   if (route == "/v1/jobs/{id}") return {"GET", "HEAD", "DELETE"};
   if (route == "/v1/render") return {"POST"};
+  if (route == "/v1/assets/missing") return {"POST"};
+  if (route == "/v1/assets/{sha256}") return {"GET", "HEAD", "PUT"};
   return {"GET", "HEAD"};
 }
 

@@ -12,6 +12,8 @@ namespace penumbra::server {
 inline const std::string kJobRoute = "/v1/jobs/([0-9a-f]{24})";
 inline const std::string kResultRoute = kJobRoute + "/result";
 inline const std::string kEventsRoute = kJobRoute + "/events";
+// Any last segment: a malformed hash gets a 400 naming it rather than a bare 404.
+inline const std::string kAssetRoute = "/v1/assets/([^/]+)";
 
 // A dashboard file's name as /dashboard/{file} serves it: letters, digits, '_', '-', then one
 // dot and a lowercase extension (the pattern of kDashboardRoute).

@@ -7,6 +7,8 @@
 #include <random>
 
 #include "server/jobs/job_options.h"
+#include "api/diagnostics.h"
+#include "api/job_submission.h"
 #include "server/jobs/retry_estimate.h"
 #include "server/jobs/unix_time.h"
 #include "server/storage/disk_space.h"
@@ -33,12 +35,59 @@ nlohmann::json diagnostics_json(const std::vector<api::Diagnostic>& ds) {
 
 }  // namespace
 
+api::ManifestLimits manifest_limits(const ServerConfig& config) {
+  api::ManifestLimits m;
+  m.max_files = config.max_job_files;
+  return m;
+}
+
+std::optional<SubmitOutcome> JobService::link_assets(
+    const std::string& job_id, const std::vector<api::ManifestEntry>& manifest) {
+  SubmitOutcome out;
+  out.kind = SubmitOutcome::Kind::kInvalid;
+  std::uint64_t total = 0;
+  for (const api::ManifestEntry& m : manifest) total += assets_->size_of(m.hash).value_or(0);
+  if (total > config_.max_job_asset_bytes) {
+    out.errors.push_back({"/assets", "the files add up to " + std::to_string(total) +
+                                         " bytes; the limit is " +
+                                         std::to_string(config_.max_job_asset_bytes) +
+                                         " (--max-job-assets)"});
+    return out;
+  }
+  JobLinkResult linked;
+  try {
+    linked = assets_->link_job_folder(job_id, manifest);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "penumbra serve: linking the assets of a new job failed: %s\n", e.what());
+    out.kind = SubmitOutcome::Kind::kStoreFailed;
+    out.retry_after_seconds = 5;
+    return out;
+  }
+  if (linked.ok()) return std::nullopt;
+  for (const std::string& name : linked.missing) {
+    const auto it = std::find_if(manifest.begin(), manifest.end(),
+                                 [&](const api::ManifestEntry& m) { return m.name == name; });
+    out.errors.push_back({api::child_pointer("/assets", name),
+                          "no asset sha256:" + it->hash +
+                              " is stored; upload it first with PUT /v1/assets/" + it->hash +
+                              " (POST /v1/assets/missing lists what to upload)"});
+  }
+  return out;
+}
+
+bool JobService::job_is_live(const std::string& id) const {
+  const auto entry = table_.find(id);
+  return entry &&
+         (entry->record.state == JobState::kQueued || entry->record.state == JobState::kRunning);
+}
+
 JobService::JobService(const ServerConfig& config, JobStore& store, ResultStore& results,
-                       Metrics& metrics)
+                       Metrics& metrics, AssetStore* assets)
     : config_(config),
       store_(store),
       results_(results),
       metrics_(metrics),
+      assets_(assets),
       writer_(store),
       table_(writer_),
       queue_(std::size_t(config.max_queue)),
@@ -97,6 +146,11 @@ void JobService::start() {
           return true;
         });
       }});
+  if (assets_) {
+    // Folders of jobs that finished, were deleted or expired while the server was down go now.
+    assets_->set_job_liveness([this](const std::string& id) { return job_is_live(id); });
+    assets_->sweep_job_folders();
+  }
   workers_.start(config_.workers);
   reaper_ = std::thread([this] { reaper_loop(); });
 }
@@ -132,10 +186,51 @@ SubmitOutcome JobService::submit(std::string_view body, const std::string& idemp
     return out;
   };
   if (!accepting_) return refuse_shutting_down();
-  // "priority" and "notify" are the job's, not the scene's (job_options.h).
-  SplitSubmission split =
-      split_job_options(body, config_.webhook_hosts(), config_.scene_limits().max_json_depth);
-  api::LoadResult loaded = api::load_scene(split.scene_text, config_.scene_limits());
+  const api::Limits limits = config_.scene_limits();
+  // "priority" and "notify" are the job's, not the scene's (job_options.h): taken off the top
+  // level of a bare scene or of an envelope first.
+  SplitSubmission split = split_job_options(body, config_.webhook_hosts(), limits.max_json_depth);
+  // A bare scene, or {"scene": ..., "assets": {name: "sha256:..."}} (api/job_submission.h).
+  api::JobSubmission submission = api::parse_job_submission(
+      split.scene_text, limits.max_json_depth, manifest_limits(config_));
+  if (!submission.ok()) {
+    out.kind = submission.kind == api::LoadErrorKind::kSyntax ? SubmitOutcome::Kind::kSyntax
+                                                              : SubmitOutcome::Kind::kInvalid;
+    out.errors = std::move(split.errors);
+    out.errors.insert(out.errors.end(), submission.errors.begin(), submission.errors.end());
+    return out;
+  }
+  const std::string job_id = new_job_id();
+  // The job's folder of hard links (asset_store.h) exists from here; it is removed on every
+  // way out but acceptance.
+  struct FolderGuard {
+    AssetStore* assets = nullptr;
+    std::string id;
+    ~FolderGuard() {
+      if (assets) assets->remove_job_folder(id);
+    }
+  } folder_guard;
+  api::AssetFolder folder;
+  folder.max_file_bytes = int64_t(config_.max_asset_bytes);
+  folder.missing_hint = "; name it in the job's \"assets\" manifest ({\"scene\": ..., "
+                        "\"assets\": {\"NAME\": \"sha256:...\"}}) after uploading it with PUT "
+                        "/v1/assets/{sha256}";
+  if (!submission.assets.empty()) {
+    if (!assets_) {
+      out.kind = SubmitOutcome::Kind::kInvalid;
+      out.errors.push_back({"/assets", "this server keeps no assets"});
+      return out;
+    }
+    if (std::optional<SubmitOutcome> refused = link_assets(job_id, submission.assets)) return *refused;
+    folder_guard.assets = assets_;
+    folder_guard.id = job_id;
+    folder.root = assets_->job_folder(job_id);
+  }
+  api::LoadResult loaded = api::load_scene(submission.scene_text, limits, {}, folder);
+  if (submission.enveloped) {
+    api::rebase_scene_diagnostics(loaded.errors);
+    api::rebase_scene_diagnostics(loaded.warnings);
+  }
   out.warnings = loaded.warnings;
   if (!loaded.ok() || !split.errors.empty()) {
     out.kind = loaded.kind == api::LoadErrorKind::kSyntax ? SubmitOutcome::Kind::kSyntax
@@ -145,6 +240,7 @@ SubmitOutcome JobService::submit(std::string_view body, const std::string& idemp
     return out;
   }
   const JobOptions& options = split.options;
+  // What the worker renders: the scene (or envelope) without the job's options.
   const std::string scene_json = std::move(split.scene_text);
   std::lock_guard submit_lock(submit_mutex_);
   if (!idempotency_key.empty()) {
@@ -181,7 +277,7 @@ SubmitOutcome JobService::submit(std::string_view body, const std::string& idemp
     }
   }
   JobRecord r;
-  r.id = new_job_id();
+  r.id = job_id;
   r.seq = last_seq_ + 1;
   r.idempotency_key = idempotency_key;
   r.created_at = unix_now();
@@ -213,6 +309,10 @@ SubmitOutcome JobService::submit(std::string_view body, const std::string& idemp
   }
   last_seq_ = r.seq;
   table_.add(r);
+  if (folder_guard.assets) {
+    assets_->commit_job_folder(r.id);  // now the table says the job is queued: the folder stays
+    folder_guard.assets = nullptr;
+  }
   queue_.push(r.id, r.priority, r.seq, /*force=*/true);  // capacity checked under submit_mutex_
   metrics_.count_submitted();
   out.record = std::move(r);
@@ -303,10 +403,12 @@ DeleteOutcome JobService::cancel_or_delete(const std::string& id, std::chrono::m
       return DeleteOutcome::kDeleted;
     case Found::kFinished:
       results_.remove(id);  // no lock held: polls of other jobs go on meanwhile
+      if (assets_) assets_->remove_job_folder(id);
       writer_.wait_durable(*ticket);
       return DeleteOutcome::kDeleted;
     case Found::kQueued:
       queue_.remove(id);
+      if (assets_) assets_->remove_job_folder(id);
       metrics_.observe_render("cancelled", 0, 0);
       writer_.wait_durable(*ticket);
       return DeleteOutcome::kCancelled;
@@ -342,6 +444,7 @@ void JobService::expire_now() {
   for (const std::string& id : ids) {
     results_.remove(id);
     events_.forget(id);
+    if (assets_) assets_->remove_job_folder(id);
   }
 }
 
@@ -354,6 +457,7 @@ void JobService::reaper_loop() {
     if (stopping_) break;
     try {
       expire_now();
+      if (assets_) assets_->sweep_job_folders();  // jobs finished since: their files are free
     } catch (const std::exception& e) {
       std::fprintf(stderr, "penumbra serve: expiry failed: %s\n", e.what());
     }

@@ -21,6 +21,7 @@
 #include <thread>
 #include <vector>
 
+#include "api/job_submission.h"
 #include "api/scene_loader.h"
 #include "server/jobs/job_events.h"
 #include "server/jobs/job_queue.h"
@@ -31,6 +32,7 @@
 #include "server/jobs/webhook_sender.h"
 #include "server/metrics.h"
 #include "server/server_config.h"
+#include "server/storage/asset_store.h"
 #include "server/storage/job_record.h"
 #include "server/storage/job_store.h"
 #include "server/storage/result_store.h"
@@ -72,9 +74,14 @@ enum class DeleteOutcome {
   kDeleted,     // was finished; record and result removed
 };
 
+// The serve flags that bound a job's manifest.
+api::ManifestLimits manifest_limits(const ServerConfig& config);
+
 class JobService {
  public:
-  JobService(const ServerConfig& config, JobStore& store, ResultStore& results, Metrics& metrics);
+  // `assets` (may be null: then jobs cannot name files) holds the uploaded files jobs name.
+  JobService(const ServerConfig& config, JobStore& store, ResultStore& results, Metrics& metrics,
+             AssetStore* assets = nullptr);
   ~JobService();
 
   // Loads the jobs from the store (interrupted ones run again) and starts the threads.
@@ -108,6 +115,8 @@ class JobService {
                                          std::chrono::steady_clock::time_point deadline) const;
 
   bool accepting() const { return accepting_.load(); }
+  // The asset store (null when the server keeps none).
+  AssetStore* assets() const { return assets_; }
   // False while the data directory has less than --min-free-space available (/readyz).
   bool storage_ok() const;
   // Stops taking jobs; running renders are put back in the queue, except one that will be done
@@ -127,12 +136,19 @@ class JobService {
  private:
   void reaper_loop();
   void observe(const JobEntry& entry);  // the job table's observer (under its lock)
+  // Links the manifest's files into the job's folder; a refusal (missing hashes: 422, over
+  // --max-job-assets: 422, storage failure: 503) or nullopt.
+  std::optional<SubmitOutcome> link_assets(const std::string& job_id,
+                                           const std::vector<api::ManifestEntry>& manifest);
+  // Queued or running: its asset folder is still needed.
+  bool job_is_live(const std::string& id) const;
   JobView make_view(JobEntry entry) const;
 
   const ServerConfig config_;
   JobStore& store_;  // read here (scenes); written only through writer_
   ResultStore& results_;
   Metrics& metrics_;
+  AssetStore* assets_;
   StoreWriter writer_;
   JobTable table_;
   JobQueue queue_;

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 
+#include "api/job_submission.h"
+
 namespace {
 // What follows the sampling, per pixel: resolving the film and its variance, encoding the EXR and
 // the PNG, writing both with fsync. Measured 4.5e-8 s (0.76 s for 4096 x 4096: 0.53 s resolve,
@@ -21,7 +23,13 @@ RenderOutcome run_render_job(const std::string& scene_json, const RenderJobOptio
   RenderOutcome out;
   // Validated at submission; validated again because the server may have restarted with
   // tighter limits since.
-  api::LoadResult loaded = api::load_scene(scene_json, options.limits);
+  // The stored text is the body as submitted: a bare scene or {"scene": ..., "assets": ...}.
+  const api::JobSubmission submission =
+      api::parse_job_submission(scene_json, options.limits.max_json_depth, api::ManifestLimits{
+                                    .max_files = 1 << 30});
+  api::LoadResult loaded =
+      submission.ok() ? api::load_scene(submission.scene_text, options.limits, {}, options.assets)
+                      : api::LoadResult{std::nullopt, submission.kind, submission.errors, {}};
   if (!loaded.ok()) {
     out.error = "the scene is no longer valid under this server's limits: " +
                 loaded.errors.front().to_string();

@@ -13,6 +13,8 @@ namespace penumbra::server {
 
 struct RenderJobOptions {
   api::Limits limits;
+  // The job's own folder of files (its manifest's hard links); empty root: the job names none.
+  api::AssetFolder assets;
   int threads = 0;                // render threads for this job
   double max_render_seconds = 0;  // the server's budget per job; 0 = none
   // When the job started (marked running): a time limit counts from here, so reading the scene,

@@ -1,5 +1,9 @@
 #include "server/jobs/render_workers.h"
 
+#include <filesystem>
+
+#include "server/storage/asset_store.h"
+
 #include <algorithm>
 #include <cstdio>
 #include <nlohmann/json.hpp>
@@ -151,6 +155,10 @@ void RenderWorkers::run_job(const std::string& id) {
   options.threads = config_.threads_per_job();
   options.max_render_seconds = config_.max_render_seconds;
   options.started = started_steady;
+  options.assets.root = job_asset_folder(config_.data_dir, id);
+  options.assets.max_file_bytes = int64_t(config_.max_asset_bytes);
+  if (std::error_code ec; !std::filesystem::is_directory(options.assets.root, ec))
+    options.assets.root.clear();  // a job that names no files
   const RenderOutcome outcome = run_render_job(*scene, options, *runtime);
   if (outcome.kind == RenderOutcome::Kind::kStopped &&
       runtime->stop_reason() == JobRuntime::StopReason::kShutdown) {
