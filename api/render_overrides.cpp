@@ -16,7 +16,7 @@ struct RenderFlag {
   bool list = false;        // the member is an array of strings: the text is split at commas
 };
 
-constexpr std::array<RenderFlag, 10> kRenderFlags = {{
+constexpr std::array<RenderFlag, 11> kRenderFlags = {{
     {"--width", "width", false},
     {"--height", "height", false},
     {"--spp", "spp", false},
@@ -26,7 +26,8 @@ constexpr std::array<RenderFlag, 10> kRenderFlags = {{
     {"--seed", "seed", false},
     {"--noise-threshold", "noise_threshold", false},
     {"--time-limit", "time_limit", false},
-    {"--aov", "outputs", false, true},
+    {"--outputs", "outputs", false, true},
+    {"--aov", "outputs", false, true},  // the name Cycles and Mitsuba users look for
 }};
 
 constexpr std::array<std::string_view, kRenderFlags.size() + 1> kAllFlags = [] {
