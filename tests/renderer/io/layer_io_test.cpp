@@ -145,7 +145,7 @@ TEST(LayerIo, SeparateFiles) {
   d = decode(encode_layer(l[2], kW, kH, ImageFormat::kPng), "png");
   EXPECT_FLOAT_EQ(d.pixels[0], 0.f);
   EXPECT_NEAR(d.pixels[3 * 13], 1.f, 1e-6f);
-  EXPECT_NEAR(d.pixels[3 * 6], std::round(4.f / 12.f * 255.f) / 255.f, 1e-6f);
+  EXPECT_NEAR(d.pixels[3 * 6], std::round(6.f / 13.f * 255.f) / 255.f, 1e-6f);  // depth 8
   EXPECT_NEAR(d.pixels[3 * 14], 1.f, 1e-6f);
   // Albedo: sRGB-encoded like the beauty image (0.5 linear -> 188).
   d = decode(encode_layer(l[0], kW, kH, ImageFormat::kPng), "png");
