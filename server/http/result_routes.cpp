@@ -72,11 +72,15 @@ void get_result(const RouteContext& c, const httplib::Request& req, httplib::Res
   const JobState state = v->record.state;
   if (state == JobState::kSucceeded) {
     if (send_result(res, c.jobs, id, f, header_value(req, "Range"), which)) return;
-    if (which.empty() || which == "blender" || !c.jobs.open_result(id, "png"))
+    if (which.empty() || !c.jobs.open_result(id, "png"))
       return send_problem(res, req, status_problem(404, "the result of job " + id + " is gone"));
+    // The Blender EXR is stored for jobs with output layers only (result_files.h).
     Problem p = make_problem(404, "layer-not-rendered", "Layer not rendered",
-                             "job " + id + " did not ask for the " + which +
-                                 " layer; list it in the scene's render.outputs");
+                             which == "blender"
+                                 ? "job " + id + " has no output layers, so no Blender layout; its "
+                                   "image is the plain EXR (format=exr)"
+                                 : "job " + id + " did not ask for the " + which +
+                                       " layer; list it in the scene's render.outputs");
     p.extensions["layer"] = which;
     return send_problem(res, req, p);
   }

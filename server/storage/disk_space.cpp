@@ -19,7 +19,8 @@ std::uint64_t worst_case_result_bytes(int width, int height, std::uint32_t outpu
   // A layer: at most 3 float channels in each multi-layer EXR and in its own, and a PNG.
   const std::uint64_t layer = 3 * pixels * 12 + png + (16u << 10);
   const std::uint64_t layers = std::uint64_t(__builtin_popcount(outputs)) * layer;
-  return 2 * exr + png + layers + (64u << 10);
+  const std::uint64_t blender = outputs ? exr : 0;  // the Blender-layout copy (with layers only)
+  return exr + png + blender + layers + (64u << 10);
 }
 
 }  // namespace penumbra::server

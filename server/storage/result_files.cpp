@@ -28,8 +28,11 @@ void write_results(ResultStore& store, const std::string& id, const Image& image
               layers.empty() ? encode_image(image, ImageFormat::kExr, metadata)
                              : encode_layered_exr(image, layers, ExrLayout::kPlain, metadata));
   store.write(id, "png", encode_image(image, ImageFormat::kPng, metadata));
-  store.write(id, result_key("", true, "exr"),
-              encode_layered_exr(image, layers, ExrLayout::kBlender, metadata));
+  // Only with layers: a job without them would pay a second copy of its EXR on disk for a
+  // layout only a compositing or denoising workflow asks for.
+  if (!layers.empty())
+    store.write(id, result_key("", true, "exr"),
+                encode_layered_exr(image, layers, ExrLayout::kBlender, metadata));
   for (const ImageLayer& layer : layers)
     for (const ImageFormat f : {ImageFormat::kExr, ImageFormat::kPng})
       store.write(id, result_key(layer.name, false, f == ImageFormat::kExr ? "exr" : "png"),

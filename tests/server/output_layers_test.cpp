@@ -80,11 +80,14 @@ TEST(OutputLayersHttp, LayersLayoutsAndProblems) {
   auto missing = c->Get(("/v1/jobs/" + plain_id + "/result?layer=normal").c_str());
   EXPECT_EQ(missing->status, 404);
   EXPECT_EQ(problem_type(missing), "urn:penumbra:problem:layer-not-rendered");
-  // The Blender layout of a job without layers is its Combined pass.
+  // A job without layers stores no Blender copy: 404 of the same type.
   auto plain_blender = c->Get(("/v1/jobs/" + plain_id + "/result?layout=blender").c_str());
-  EXPECT_EQ(plain_blender->status, 200);
-  EXPECT_TRUE(has_channel(plain_blender->body, "ViewLayer.Combined.A"));
-  EXPECT_FALSE(has_channel(plain_blender->body, "ViewLayer.Depth.Z"));
+  EXPECT_EQ(plain_blender->status, 404);
+  EXPECT_EQ(problem_type(plain_blender), "urn:penumbra:problem:layer-not-rendered");
+  std::size_t plain_files = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir.path() + "/results"))
+    if (e.path().filename().string().rfind(plain_id, 0) == 0) ++plain_files;
+  EXPECT_EQ(plain_files, 2u) << "a job without layers stores its PNG and EXR only";
   auto bad_layout = c->Get((base + "?layout=nuke").c_str());
   EXPECT_EQ(bad_layout->status, 422);
   EXPECT_EQ(problem_type(bad_layout), "urn:penumbra:problem:unknown-layout");
