@@ -7,7 +7,12 @@ namespace penumbra::api {
 namespace {
 void attribute(Diagnostic& d, const std::vector<std::pair<std::string, std::string>>& flags) {
   for (const auto& [pointer, flag] : flags)
-    if (d.flag.empty() && d.pointer == pointer) d.flag = flag;
+    // The flag's field or anything inside it (--aov sets /render/outputs; its items err at
+    // /render/outputs/1).
+    if (d.flag.empty() && (d.pointer == pointer || (d.pointer.size() > pointer.size() &&
+                                                    d.pointer.compare(0, pointer.size(), pointer) == 0 &&
+                                                    d.pointer[pointer.size()] == '/')))
+      d.flag = flag;
 }
 }  // namespace
 

@@ -13,9 +13,10 @@ struct RenderFlag {
   std::string_view flag;
   std::string_view member;  // of the "render" block
   bool text;                // the member is a string: the flag's text is taken as it is
+  bool list = false;        // the member is an array of strings: the text is split at commas
 };
 
-constexpr std::array<RenderFlag, 9> kRenderFlags = {{
+constexpr std::array<RenderFlag, 11> kRenderFlags = {{
     {"--width", "width", false},
     {"--height", "height", false},
     {"--spp", "spp", false},
@@ -25,6 +26,8 @@ constexpr std::array<RenderFlag, 9> kRenderFlags = {{
     {"--seed", "seed", false},
     {"--noise-threshold", "noise_threshold", false},
     {"--time-limit", "time_limit", false},
+    {"--outputs", "outputs", false, true},
+    {"--aov", "outputs", false, true},  // the name Cycles and Mitsuba users look for
 }};
 
 constexpr std::array<std::string_view, kRenderFlags.size() + 1> kAllFlags = [] {
@@ -51,6 +54,18 @@ bool is_render_override_flag(std::string_view flag) {
 Json override_value(const RenderOverride& override_flag) {
   const std::string& text = override_flag.value;
   const RenderFlag* f = find_render_flag(override_flag.flag);
+  if (f && f->list) {
+    // "albedo,normal" -> ["albedo", "normal"]; "" -> [] (no layers). Each item is checked by the
+    // field's parser; the count is bounded there before any item is read.
+    Json items = Json::array();
+    size_t start = 0;
+    while (!text.empty() && start <= text.size()) {
+      const size_t comma = std::min(text.find(',', start), text.size());
+      items.push_back(text.substr(start, comma - start));
+      start = comma + 1;
+    }
+    return items;
+  }
   // Containers are never a flag's value; not parsing them also keeps a hostile argument from
   // building a deeply nested document.
   if ((f && f->text) || text.find_first_of("[{") != std::string::npos) return text;

@@ -20,8 +20,9 @@ inline constexpr std::string_view kThreadsFlag = "--threads";
 // typo from asking for millions of threads; `penumbra serve --render-threads` has the same bound.
 inline constexpr int kMaxThreads = 4096;
 
-// Every override flag: one per member of the "render" block ("--max-depth" for max_depth),
-// then --threads.
+// Every override flag: one per member of the "render" block ("--max-depth" for max_depth; its
+// alias --aov for --outputs, "--aov albedo,normal" is the list ["albedo", "normal"]), then
+// --threads.
 std::span<const std::string_view> render_override_flags();
 bool is_render_override_flag(std::string_view flag);
 

@@ -1,6 +1,8 @@
 #include "api/scene_parser.h"
 
+#include <algorithm>
 #include <cmath>
+#include <iterator>
 
 #include "api/environment_parser.h"
 #include "api/material_parser.h"
@@ -17,6 +19,32 @@ vec3 to_float(const glm::dvec3& v) { return vec3(float(v.x), float(v.y), float(v
 
 std::string limit_text(int64_t value, const char* name) {
   return "must be <= " + std::to_string(value) + " (" + name + ")";
+}
+
+// "outputs": ["albedo", "normal", "depth"], the output layers beside the beauty image
+// (docs/output-layers.md). Each name once; an unknown one is an error with a suggestion.
+void parse_outputs(const Json& outputs, const std::string& pointer, RenderSettings& settings,
+                   Diagnostics& diag) {
+  const std::vector<std::string> known(std::begin(kOutputLayerNames), std::end(kOutputLayerNames));
+  if (!within_count_limit(outputs.size(), kOutputLayerCount, "outputs", "the number of output layers",
+                          pointer, diag))
+    return;
+  uint32_t bits = 0;
+  for (size_t i = 0; i < outputs.size(); ++i) {
+    const std::string item = child_pointer(pointer, i);
+    const auto name = read_string(outputs[i], item, diag);
+    if (!name) continue;
+    const auto it = std::find(known.begin(), known.end(), *name);
+    if (it == known.end()) {
+      diag.error(item, "unknown output layer " + quote_user_string(*name) + did_you_mean(*name, known) +
+                           "; expected \"albedo\", \"normal\" or \"depth\"");
+      continue;
+    }
+    const uint32_t bit = 1u << uint32_t(it - known.begin());
+    if (bits & bit) diag.error(item, "output layer " + quote_user_string(*name) + " is listed twice");
+    bits |= bit;
+  }
+  settings.outputs = bits;
 }
 
 void parse_render(const Json* value, const Limits& limits, RenderSettings& settings,
@@ -72,6 +100,7 @@ void parse_render(const Json* value, const Limits& limits, RenderSettings& setti
     else
       settings.time_limit = *t;
   }
+  if (const Json* outputs = r.array("outputs")) parse_outputs(*outputs, r.pointer_of("outputs"), settings, diag);
   r.report_unknown_keys();
 }
 

@@ -13,6 +13,7 @@
 #include "app/load_report.h"
 #include "app/option_parsing.h"
 #include "renderer/io/image_io.h"
+#include "renderer/io/layer_io.h"
 #include "renderer/render/render.h"
 
 namespace penumbra::app {
@@ -35,7 +36,15 @@ const char* kUsage =
     "  --time-limit SECONDS     stop at this budget with a correct (less converged) image\n"
     "  --noise-threshold X      adaptive sampling: aim for this relative RMS error (0.05 = 5%);\n"
     "                           samples go where the noise is, spp is the per-pixel cap\n"
+    "  --aov LIST               output layers beside the image, comma-separated:\n"
+    "                           albedo,normal,depth (docs/output-layers.md)\n"
+    "  --layout NAME            where the layers go: plain (default; .exr: extra channels\n"
+    "                           albedo.R, normal.X, depth.Z; .png: one file per layer,\n"
+    "                           OUT.albedo.png ...), blender (.exr: Blender's multi-layer\n"
+    "                           names, ViewLayer.Combined.R ...), separate (one file per layer)\n"
     "  -q, --quiet              no progress bar\n";
+
+enum class Layout { kPlain, kBlender, kSeparate };
 
 std::string format_duration(double s) {
   char buf[32];
@@ -50,6 +59,7 @@ std::string format_duration(double s) {
 int run_render(int argc, char** argv) {
   std::string scene_path, output;
   bool quiet = false;
+  std::string layout_name = "plain";
   std::vector<api::RenderOverride> overrides;
   OptionParser p(argc, argv);
   while (p.next()) {
@@ -58,6 +68,8 @@ int run_render(int argc, char** argv) {
       return 0;
     } else if (p.is("-o") || p.is("--output")) {
       if (!p.value(&output)) return p.fail(kUsage);
+    } else if (p.is("--layout")) {
+      if (!p.value(&layout_name)) return p.fail(kUsage);
     } else if (p.is("-q") || p.is("--quiet")) {
       quiet = true;
     } else if (parse_render_override(p, overrides)) {
@@ -71,13 +83,22 @@ int run_render(int argc, char** argv) {
   }
   if (scene_path.empty() || output.empty())
     return p.fail(kUsage, scene_path.empty() ? "no scene given" : "no output given (-o)");
-  // Reject an unsupported output name before spending time on the render.
+  // Reject an unsupported output name or layout before spending time on the render.
+  ImageFormat format;
   try {
-    image_format_from_path(output);
+    format = image_format_from_path(output);
   } catch (const ImageIoError& e) {
     std::fprintf(stderr, "penumbra render: %s\n", e.what());
     return 2;
   }
+  Layout layout;
+  if (layout_name == "plain") layout = format == ImageFormat::kPng ? Layout::kSeparate : Layout::kPlain;
+  else if (layout_name == "separate") layout = Layout::kSeparate;
+  else if (layout_name == "blender" && format == ImageFormat::kExr) layout = Layout::kBlender;
+  else if (layout_name == "blender")
+    return p.fail(kUsage, "--layout blender writes a multi-layer EXR: give -o NAME.exr");
+  else
+    return p.fail(kUsage, "unknown --layout " + layout_name + " (plain, blender or separate)");
 
   api::LoadResult loaded = api::load_scene_file(scene_path, {}, overrides);
   if (!report_load_problems(scene_path, loaded)) return 1;
@@ -119,7 +140,17 @@ int run_render(int argc, char** argv) {
       {"Software", api::kSoftwareName},
   };
   try {
-    write_image_file(output, result.image, meta);
+    if (layout == Layout::kSeparate || (result.layers.empty() && layout == Layout::kPlain)) {
+      write_image_file(output, result.image, meta);
+      for (const ImageLayer& layer : result.layers)
+        write_file_atomically(layer_file_path(output, layer.name),
+                              encode_layer(layer, settings.width, settings.height, format, meta));
+    } else {
+      write_file_atomically(output, encode_layered_exr(result.image, result.layers,
+                                                       layout == Layout::kBlender ? ExrLayout::kBlender
+                                                                                  : ExrLayout::kPlain,
+                                                       meta));
+    }
   } catch (const ImageIoError& e) {
     std::fprintf(stderr, "penumbra render: %s\n", e.what());
     return 1;

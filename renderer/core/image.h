@@ -17,6 +17,17 @@ struct Image {
   const float* pixel(int x, int y) const { return &rgb[(size_t(y) * width + x) * 3]; }
 };
 
+// An output layer beside the beauty image (renderer/render/output_layers.h): `channels` floats
+// per pixel, row-major from the top-left pixel. The kind decides how writers encode it
+// (docs/output-layers.md): a colour, a vector (normal), or a depth.
+struct ImageLayer {
+  enum class Kind { kColor, kVector, kDepth };
+  std::string name;  // "albedo", "normal", "depth"
+  Kind kind = Kind::kColor;
+  int channels = 3;  // 3, or 1 for depth
+  std::vector<float> data;
+};
+
 // Name/value pairs written into the file header where the format allows it (EXR attributes).
 using ImageMetadata = std::vector<std::pair<std::string, std::string>>;
 

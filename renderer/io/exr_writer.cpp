@@ -38,6 +38,30 @@ class MemoryStream : public Imf::OStream {
 
 }  // namespace
 
+std::vector<uint8_t> encode_exr_channels(const std::vector<ExrChannel>& channels, int width,
+                                         int height, const ImageMetadata& metadata) {
+  try {
+    Imf::Header header(width, height);
+    header.compression() = Imf::ZIP_COMPRESSION;
+    for (const ExrChannel& c : channels) header.channels().insert(c.name, Imf::Channel(Imf::FLOAT));
+    for (const auto& [key, value] : metadata) header.insert(key, Imf::StringAttribute(value));
+    Imf::FrameBuffer frame;
+    for (const ExrChannel& c : channels) {
+      char* base = reinterpret_cast<char*>(const_cast<float*>(c.base));
+      frame.insert(c.name, Imf::Slice(Imf::FLOAT, base, c.x_stride, c.x_stride * size_t(width)));
+    }
+    MemoryStream stream;
+    {
+      Imf::OutputFile file(stream, header, 0);
+      file.setFrameBuffer(frame);
+      file.writePixels(height);
+    }
+    return stream.take();
+  } catch (const std::exception& e) {
+    throw ImageIoError(std::string("cannot encode image: ") + e.what());
+  }
+}
+
 std::vector<uint8_t> encode_exr(const float* rgb, int width, int height,
                                 const ImageMetadata& metadata) {
   try {

@@ -1,7 +1,9 @@
 #pragma once
 // OpenEXR encoding through the OpenEXR library: linear float RGB, ZIP compression, metadata as
 // string attributes. Like png_writer.h, it keeps OpenImageIO off the render output path.
+#include <cstddef>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "renderer/core/image.h"
@@ -11,5 +13,17 @@ namespace penumbra {
 // `rgb` holds width * height * 3 floats, rows top to bottom. Throws ImageIoError.
 std::vector<uint8_t> encode_exr(const float* rgb, int width, int height,
                                 const ImageMetadata& metadata);
+
+// One float channel of an EXR: its full name ("R", "albedo.R", "ViewLayer.Combined.A") and its
+// first pixel's value, the next pixel's `x_stride` bytes on, rows `x_stride * width` apart.
+struct ExrChannel {
+  std::string name;
+  const float* base = nullptr;
+  std::size_t x_stride = sizeof(float);
+};
+// Any number of channels in one scan-line part (OpenEXR's multi-layer convention: "layer.channel"
+// names; readers group them by the text before the last dot). Throws ImageIoError.
+std::vector<uint8_t> encode_exr_channels(const std::vector<ExrChannel>& channels, int width,
+                                         int height, const ImageMetadata& metadata);
 
 }  // namespace penumbra

@@ -23,17 +23,18 @@ std::string lower_extension(const std::string& path) {
   return ext;
 }
 
+float srgb_to_linear(float v) {
+  return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
+}
+
+}  // namespace
+
 // IEC 61966-2-1 sRGB transfer function.
 float linear_to_srgb(float v) {
   if (!(v > 0.f)) return 0.f;
   if (v >= 1.f) return 1.f;
   return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.f / 2.4f) - 0.055f;
 }
-float srgb_to_linear(float v) {
-  return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
-}
-
-}  // namespace
 
 ImageFormat image_format_from_path(const std::string& path) {
   const std::string ext = lower_extension(path);
@@ -57,7 +58,10 @@ std::vector<uint8_t> encode_image(const Image& image, ImageFormat format,
 }
 
 void write_image_file(const std::string& path, const Image& image, const ImageMetadata& metadata) {
-  const std::vector<uint8_t> bytes = encode_image(image, image_format_from_path(path), metadata);
+  write_file_atomically(path, encode_image(image, image_format_from_path(path), metadata));
+}
+
+void write_file_atomically(const std::string& path, const std::vector<uint8_t>& bytes) {
   // Temporary file beside the target, then rename: readers never see a partial image.
   std::random_device rd;
   const std::string tmp = path + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(rd());

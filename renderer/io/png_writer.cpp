@@ -24,13 +24,13 @@ void flush(png_structp) {}
 // Every libpng call that may fail, behind the setjmp point: this frame holds nothing with a
 // destructor and changes no local after setjmp, so the longjmp of an error is well defined.
 bool write_png(png_structp png, png_infop info, png_bytepp rows, png_textp texts, int text_count,
-               int width, int height, std::vector<uint8_t>* out) {
+               int width, int height, bool srgb, std::vector<uint8_t>* out) {
   if (setjmp(png_jmpbuf(png))) return false;
   png_set_write_fn(png, out, append, flush);
   png_set_IHDR(png, info, png_uint_32(width), png_uint_32(height), 8, PNG_COLOR_TYPE_RGB,
                PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
   // The pixels are sRGB-encoded: say so (sRGB chunk plus the gAMA/cHRM fallbacks).
-  png_set_sRGB_gAMA_and_cHRM(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
+  if (srgb) png_set_sRGB_gAMA_and_cHRM(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
   if (text_count > 0) png_set_text(png, info, texts, text_count);
   png_set_rows(png, info, rows);
   png_write_png(png, info, PNG_TRANSFORM_IDENTITY, nullptr);
@@ -41,7 +41,7 @@ bool write_png(png_structp png, png_infop info, png_bytepp rows, png_textp texts
 }  // namespace
 
 std::vector<uint8_t> encode_png(const uint8_t* rgb8, int width, int height,
-                                const ImageMetadata& metadata) {
+                                const ImageMetadata& metadata, bool srgb) {
   std::vector<uint8_t> out;
   size_t bound = (size_t(width) * 3 + 1) * size_t(height);
   bound += bound / 64 + 65536;  // IDAT chunks of 8 KB add 12 bytes each
@@ -65,7 +65,7 @@ std::vector<uint8_t> encode_png(const uint8_t* rgb8, int width, int height,
     texts[i].text = const_cast<png_charp>(metadata[i].second.c_str());
     texts[i].text_length = metadata[i].second.size();
   }
-  const bool ok = write_png(png, info, rows.data(), texts.data(), int(texts.size()), width, height, &out);
+  const bool ok = write_png(png, info, rows.data(), texts.data(), int(texts.size()), width, height, srgb, &out);
   png_destroy_write_struct(&png, &info);
   if (!ok) throw ImageIoError("cannot encode image: libpng failed");
   return out;

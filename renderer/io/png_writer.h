@@ -9,7 +9,9 @@
 namespace penumbra {
 
 // `rgb8` holds width * height * 3 bytes, rows top to bottom. Throws ImageIoError.
+// `srgb` false marks the bytes as data (a normal map, a depth ramp): no sRGB/gAMA chunks, so
+// tools read the values as they are.
 std::vector<uint8_t> encode_png(const uint8_t* rgb8, int width, int height,
-                                const ImageMetadata& metadata);
+                                const ImageMetadata& metadata, bool srgb = true);
 
 }  // namespace penumbra

@@ -16,6 +16,9 @@ class ConductorBsdf : public OpaqueBsdf {
 
   bool smooth() const { return smooth_; }
   uint32_t lobes() const { return smooth_ ? kLobeDeltaReflection : kLobeGlossyReflection; }
+  // Reflectance at normal incidence, OIDN's albedo for metals (docs/output-layers.md); the
+  // model's Fresnel term is constant, so it is `color` at every angle.
+  Spectrum albedo() const { return color_; }
   Spectrum eval(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
   float pdf(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
   std::optional<BsdfSample> sample(const BsdfContext& ctx, const vec3& wi, float u_lobe,

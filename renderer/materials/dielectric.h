@@ -24,6 +24,9 @@ class DielectricBsdf {
   // Beer-Lambert sigma_a of the interior; the integrator applies it along segments inside.
   Spectrum absorption() const { return absorption_; }
   uint32_t lobes() const;
+  // 1: OIDN's documented albedo for dielectrics (docs/output-layers.md); the transmitted
+  // colour is the absorption's, which depends on the path length, not the surface.
+  Spectrum albedo() const { return Spectrum(1.f); }
   Spectrum eval(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
   float pdf(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
   std::optional<BsdfSample> sample(const BsdfContext& ctx, const vec3& wi, float u_lobe,

@@ -12,6 +12,8 @@ class DiffuseBsdf : public OpaqueBsdf {
   explicit DiffuseBsdf(const DiffuseParams& params) : DiffuseBsdf(params.color) {}
 
   uint32_t lobes() const { return kLobeDiffuseReflection; }
+  // The first-hit albedo of the "albedo" output (docs/output-layers.md): the reflectance.
+  Spectrum albedo() const { return color_; }
   Spectrum eval(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
   float pdf(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
   std::optional<BsdfSample> sample(const BsdfContext& ctx, const vec3& wi, float u_lobe,

@@ -47,6 +47,10 @@ class MetallicRoughnessBsdf : public OpaqueBsdf {
   std::optional<BsdfSample> sample(const BsdfContext& ctx, const vec3& wi, float u_lobe,
                                    const vec2& u) const;
 
+  // The base colour: glTF's diffuse colour of the dielectric and f0 of the metal, both what
+  // OIDN asks for (docs/output-layers.md).
+  Spectrum albedo() const { return base_color_; }
+
   // The dielectric's specular reflectance f0 (ior 1.5, as glTF: ((1.5 - 1) / (1.5 + 1))^2).
   static constexpr float kDielectricF0 = 0.04f;
 

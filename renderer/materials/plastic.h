@@ -33,6 +33,9 @@ class PlasticBsdf : public OpaqueBsdf {
   uint32_t lobes() const {
     return kLobeDiffuseReflection | (smooth_ ? kLobeDeltaReflection : kLobeGlossyReflection);
   }
+  // The base's diffuse reflectance (the colour a denoiser should keep; the clear coat adds
+  // about 4% white), as Cycles' denoising albedo of a dielectric principled BSDF.
+  Spectrum albedo() const { return color_; }
   Spectrum eval(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
   float pdf(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
   std::optional<BsdfSample> sample(const BsdfContext& ctx, const vec3& wi, float u_lobe,

@@ -110,6 +110,11 @@ uint32_t SurfaceBsdf::lobes() const {
   return std::visit([](const auto& m) { return m.lobes(); }, model_);
 }
 
+Spectrum SurfaceBsdf::albedo() const {
+  const Spectrum a = std::visit([](const auto& m) { return m.albedo(); }, model_);
+  return glm::clamp(a, Spectrum(0.f), Spectrum(1.f));
+}
+
 Spectrum SurfaceBsdf::absorption() const {
   return std::visit([](const auto& m) { return m.absorption(); }, model_);
 }

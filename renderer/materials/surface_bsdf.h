@@ -32,6 +32,11 @@ class SurfaceBsdf {
   // the terminator.
   void set_mapped_normal(const vec3& n);
   bool normal_mapped() const { return normal_mapped_; }
+  // The normal the model is evaluated with for incident direction wi, in the shading frame:
+  // +z, or the mapped normal as perturbed_frame adjusts it (for the "normal" output layer).
+  vec3 shading_normal(const vec3& wi) const {
+    return normal_mapped_ ? perturbed_frame(wi).n : vec3(0.f, 0.f, 1.f);
+  }
 
   Spectrum eval(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
   float pdf(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
@@ -44,6 +49,8 @@ class SurfaceBsdf {
   bool two_sided() const { return two_sided_; }
   // Beer-Lambert sigma_a of the interior, zero for everything that does not absorb inside.
   Spectrum absorption() const;
+  // The surface colour of the "albedo" output layer (each model's albedo(), in [0, 1]).
+  Spectrum albedo() const;
   const BsdfModel& model() const { return model_; }
 
  private:

@@ -39,6 +39,37 @@ Frame tangent_frame(const Scene& scene, float time, SurfaceHit* hit) {
   return f;
 }
 
+// The output layers' view of the camera ray's first hit (docs/output-layers.md). Out of line and
+// only called when layers are requested: it repeats the texture lookup and tangent frame the
+// loop builds later (after emission and the depth test), which costs a requested layer a little
+// and the beauty render nothing.
+[[gnu::noinline]] void record_first_hit(const Scene& scene, const Material& material,
+                                        const Ray& ray, SurfaceHit hit, FirstHit* first) {
+  std::optional<SurfaceBsdf> textured;
+  const SurfaceBsdf* bsdf = &material.bsdf();
+  if (material.varies()) bsdf = &textured.emplace(material.bsdf_at(TextureQuery{hit.p, hit.uv, ray.time}));
+  // The normal the BSDF shades with: the hit's, or a normal map's within the tangent frame.
+  const Frame frame = material.normal_mapped() ? tangent_frame(scene, ray.time, &hit) : Frame(hit.ns);
+  vec3 n = frame.to_world(bsdf->shading_normal(frame.to_local(-ray.direction)));
+  // Facing the viewer, as Cycles' Normal and denoising normal passes: the side the camera sees.
+  if (glm::dot(n, ray.direction) > 0.f) n = -n;
+  first->hit = true;
+  first->albedo = bsdf->albedo();
+  first->normal = n;
+  first->p = hit.p;
+}
+
+void record_miss(const EnvironmentLight* environment, const Ray& ray, FirstHit* first) {
+  first->hit = false;
+  first->normal = vec3(0.f);
+  // The background's colour, clamped into an albedo's range: a denoiser then keeps the
+  // environment's detail where the camera sees it directly (docs/output-layers.md).
+  first->albedo = environment ? glm::clamp(environment->radiance(ray.direction), Spectrum(0.f),
+                                           Spectrum(1.f))
+                              : Spectrum(0.f);
+  if (!is_finite(first->albedo)) first->albedo = Spectrum(0.f);
+}
+
 // Feature bits an instantiation is compiled for. A bit that is off removes that code from the
 // loop entirely (Cycles compiles only the kernel features a scene uses); a bit that is on keeps
 // the run-time test, so the all-on instantiation is the generic integrator and any
@@ -53,7 +84,7 @@ enum IntegratorFeature : uint32_t {
 
 template <bool kDistributed, uint32_t kFeatures>
 Spectrum integrate(const Scene& scene, const IntegratorSettings& settings, Ray ray,
-                   Sampler& sampler, PathCounters& counters) {
+                   Sampler& sampler, PathCounters& counters, FirstHit* first) {
   Spectrum radiance(0.f), beta(1.f);
   const int max_depth = settings.max_depth < 0 ? INT_MAX : settings.max_depth;
   // The strategy that produced the current ray, for MIS on the emitter it may hit.
@@ -69,6 +100,7 @@ Spectrum integrate(const Scene& scene, const IntegratorSettings& settings, Ray r
     SurfaceHit hit;
     ++counters.rays;
     if (!scene.intersect(ray, &hit)) {
+      if (first && depth == 1) record_miss(environment, ray, first);
       if constexpr ((kFeatures & kFeatureEnvironment) != 0) {
         if (!environment) break;
         const float w =
@@ -82,6 +114,7 @@ Spectrum integrate(const Scene& scene, const IntegratorSettings& settings, Ray r
     const SceneObject& obj = scene.object(hit.object);
     const Material& material = scene.material(obj.material);
     const bool front = glm::dot(ray.direction, hit.ng) < 0.f;
+    if (first && depth == 1) record_first_hit(scene, material, ray, hit, first);
 
     // Beer-Lambert: a segment that ends on the back of an absorbing dielectric ran inside it.
     if constexpr ((kFeatures & kFeatureAbsorption) != 0) {

@@ -8,6 +8,7 @@
 
 #include "renderer/core/math.h"
 #include "renderer/core/ray.h"
+#include "renderer/render/output_layers.h"
 #include "renderer/sampling/sampler.h"
 #include "renderer/scene/scene.h"
 
@@ -22,8 +23,11 @@ struct PathCounters {
   uint64_t rays = 0;
 };
 
+// `first`, when not null, receives the camera ray's first hit for the output layers
+// (output_layers.h); null when the render asks for none.
 using IntegrateFn = Spectrum (*)(const Scene& scene, const IntegratorSettings& settings,
-                                 Ray ray, Sampler& sampler, PathCounters& counters);
+                                 Ray ray, Sampler& sampler, PathCounters& counters,
+                                 FirstHit* first);
 
 // The integrator specialised on the features the scene uses (chosen once per render): code for
 // an absent feature (absorption, refraction, environment, lights) is compiled out.

@@ -6,10 +6,12 @@
 
 #include <chrono>
 #include <mutex>
+#include <optional>
 
 #include "renderer/render/adaptive_sampling.h"
 #include "renderer/render/film.h"
 #include "renderer/render/integrator.h"
+#include "renderer/render/output_layers.h"
 #include "renderer/render/thin_lens_camera.h"
 
 namespace penumbra {
@@ -98,6 +100,10 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
   const bool sample_time = scene.features().motion;
 
   Film film(width, height);
+  // Output layers only when asked: otherwise no film, and the integrator gets a null FirstHit.
+  std::optional<LayerFilm> layer_film;
+  if (settings.outputs)
+    layer_film.emplace(width, height, settings.outputs, camera.position(), camera.forward());
   const PixelOrder order = make_pixel_order(width, height, std::max(1, settings.tile_size));
   const int spp = std::max(1, settings.spp);
   const std::vector<int> passes = make_passes(spp);
@@ -156,6 +162,8 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
           }
           Sampler sampler(settings.seed);
           PathCounters counters;
+          FirstHit first_hit;
+          FirstHit* const first = layer_film ? &first_hit : nullptr;
           uint64_t item_samples = 0, item_nonfinite = 0;
           for (size_t k = items[item]; k < items[item + 1]; ++k) {
             const uint32_t pi = order.pixels[k];
@@ -170,8 +178,9 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
               const float time = sample_time ? sampler.get_1d() : 0.f;
               const CameraRay cr = camera.generate_ray(film_pos, lens, time);
               const Spectrum L =
-                  integrate(scene, isettings, Ray{cr.origin, cr.direction, cr.time}, sampler, counters);
+                  integrate(scene, isettings, Ray{cr.origin, cr.direction, cr.time}, sampler, counters, first);
               if (!film.add_sample(x, y, L)) ++item_nonfinite;
+              if (first) layer_film->add_sample(x, y, first_hit);
               ++item_samples;
             }
           }
@@ -194,6 +203,7 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
   RenderResult result;
   result.image = film.resolve();
   result.variance = film.resolve_variance();
+  if (layer_film) result.layers = layer_film->resolve();
   RenderStats& st = result.stats;
   st.seconds = elapsed();
   st.rays = rays.load();

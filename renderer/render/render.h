@@ -43,6 +43,8 @@ struct RenderStats {
 struct RenderResult {
   Image image;     // mean radiance per pixel
   Image variance;  // per pixel and channel: estimated variance of that mean (sample variance / n)
+  // The output layers RenderSettings::outputs asked for, in OutputLayerBit order (empty if none).
+  std::vector<ImageLayer> layers;
   RenderStats stats;
 };
 

@@ -17,6 +17,9 @@ class ThinLensCamera {
 
   // film: continuous pixel coordinates (x right, y down, [0,w)x[0,h)); lens, time: in [0,1).
   CameraRay generate_ray(const vec2& film, const vec2& lens, float time) const;
+  // The centre of the lens and the unit optical axis (z-depth is measured along it).
+  const vec3& position() const { return position_; }
+  const vec3& forward() const { return forward_; }
 
 
  private:

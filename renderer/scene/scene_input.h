@@ -99,6 +99,17 @@ struct SceneInput {
 
 enum class IntegratorKind { kPath, kDistributed };
 
+// Output layers (AOVs) a render may produce beside the beauty image, as bits of
+// RenderSettings::outputs (docs/output-layers.md). The order of the bits is the order in which
+// the layers are listed and written.
+enum OutputLayerBit : uint32_t {
+  kOutputAlbedo = 1u << 0,  // first-hit surface colour, RGB in [0, 1]
+  kOutputNormal = 1u << 1,  // first-hit shading normal, world space, XYZ
+  kOutputDepth = 1u << 2,   // first-hit z-depth along the camera's view axis, Z
+};
+inline constexpr int kOutputLayerCount = 3;
+inline constexpr const char* kOutputLayerNames[kOutputLayerCount] = {"albedo", "normal", "depth"};
+
 struct RenderSettings {
   int width = 256;
   int height = 256;
@@ -111,6 +122,7 @@ struct RenderSettings {
   int tile_size = 16;
   float noise_threshold = 0.f;  // adaptive sampling: stop pixels below this relative error; 0 = off
   double time_limit = 0.0;      // seconds; 0 = none
+  uint32_t outputs = 0;         // OutputLayerBit set; 0 = the beauty image only
 };
 
 }  // namespace penumbra

@@ -12,13 +12,17 @@
 namespace penumbra::server {
 
 bool send_result(httplib::Response& res, const JobService& jobs, const std::string& id,
-                 ImageFormat format, const std::optional<std::string>& range) {
-  auto stored = jobs.open_result(id, file_extension(format));
+                 ImageFormat format, const std::optional<std::string>& range,
+                 const std::string& variant) {
+  const std::string key = variant.empty() ? std::string(file_extension(format))
+                                          : variant + "." + file_extension(format);
+  auto stored = jobs.open_result(id, key);
   if (!stored) return false;
   const std::uint64_t size = stored->size;
-  res.set_header("Content-Disposition",
-                 std::string("inline; filename=\"") + id + "." + file_extension(format) + "\"");
-  res.set_header("ETag", "\"" + id + "-" + file_extension(format) + "\"");
+  std::string tag = key;
+  std::replace(tag.begin(), tag.end(), '.', '-');
+  res.set_header("Content-Disposition", std::string("inline; filename=\"") + id + "." + key + "\"");
+  res.set_header("ETag", "\"" + id + "-" + tag + "\"");
   res.set_header("Cache-Control", "private, max-age=3600");
   res.set_header("Accept-Ranges", "bytes");
   const RangeDecision d = decide_range(range, size);

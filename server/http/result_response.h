@@ -16,7 +16,10 @@ namespace penumbra::server {
 // concurrent DELETE of the job does not cut the answer short. `range` is the Range header:
 // answered 206 with Content-Range, or 416 outside the file (byte_range.h); the library's own
 // range handling is off (request_guard clears the parsed ranges).
+// `variant` names which of the job's result files (server/storage/result_files.h): "" the
+// beauty image, "blender" the Blender-layout EXR, or an output layer's name.
 bool send_result(httplib::Response& res, const JobService& jobs, const std::string& id,
-                 ImageFormat format, const std::optional<std::string>& range);
+                 ImageFormat format, const std::optional<std::string>& range,
+                 const std::string& variant = "");
 
 }  // namespace penumbra::server

@@ -267,7 +267,7 @@ SubmitOutcome JobService::submit(std::string_view body, const std::string& idemp
   // margin; checked before anything is written (under submit_mutex_, so two submissions cannot
   // both take the last room).
   if (const auto available = available_bytes(config_.data_dir)) {
-    const std::uint64_t needed = worst_case_result_bytes(s.width, s.height) + body.size() +
+    const std::uint64_t needed = worst_case_result_bytes(s.width, s.height, s.outputs) + body.size() +
                                  reserved_bytes() + config_.min_free_bytes;
     if (*available < needed) {
       out.kind = SubmitOutcome::Kind::kNoSpace;
@@ -302,7 +302,7 @@ SubmitOutcome JobService::submit(std::string_view body, const std::string& idemp
                    ? SubmitOutcome::Kind::kNoSpace
                    : SubmitOutcome::Kind::kStoreFailed;
     out.bytes_available = available.value_or(0);
-    out.bytes_needed = worst_case_result_bytes(s.width, s.height) + body.size() +
+    out.bytes_needed = worst_case_result_bytes(s.width, s.height, s.outputs) + body.size() +
                        config_.min_free_bytes;
     out.retry_after_seconds = 5;
     return out;

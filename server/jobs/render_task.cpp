@@ -78,6 +78,7 @@ RenderOutcome run_render_job(const std::string& scene_json, const RenderJobOptio
   RenderResult result = render(*scene, settings, control);
   out.stats = result.stats;
   out.image = std::move(result.image);
+  out.layers = std::move(result.layers);
   out.kind =
       result.stats.cancelled ? RenderOutcome::Kind::kStopped : RenderOutcome::Kind::kSucceeded;
   return out;

@@ -30,6 +30,7 @@ struct RenderOutcome {
   enum class Kind { kSucceeded, kFailed, kStopped };
   Kind kind = Kind::kFailed;
   Image image;
+  std::vector<ImageLayer> layers;  // the scene's render.outputs, in OutputLayerBit order
   RenderStats stats;
   RenderSettings settings;
   double build_seconds = 0;

@@ -11,6 +11,7 @@
 #include "api/version.h"
 #include "renderer/io/image_io.h"
 #include "server/jobs/unix_time.h"
+#include "server/storage/result_files.h"
 
 namespace penumbra::server {
 namespace {
@@ -189,8 +190,7 @@ void RenderWorkers::finish_job(const std::string& id, const RenderOutcome& outco
       };
       // Files first, then the record: a crash in between reruns the job, never serves a
       // missing file.
-      results_.write(id, "exr", encode_image(outcome.image, ImageFormat::kExr, meta));
-      results_.write(id, "png", encode_image(outcome.image, ImageFormat::kPng, meta));
+      write_results(results_, id, outcome.image, outcome.layers, meta);
       table_.modify(id, settle(JobState::kSucceeded, now, stats_json(outcome, threads), ""));
       metrics_.observe_render("succeeded", outcome.stats.seconds, outcome.stats.rays);
       if (outcome.stats.stopped_by_time_limit) metrics_.count_stopped_early("time_limit");

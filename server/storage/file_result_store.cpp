@@ -9,6 +9,8 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "server/storage/result_files.h"
+
 namespace penumbra::server {
 namespace fs = std::filesystem;
 
@@ -78,8 +80,7 @@ void FileResultStore::write(const std::string& id, const std::string& format,
 
 void FileResultStore::remove(const std::string& id) {
   std::error_code ec;
-  fs::remove(path(id, "png"), ec);
-  fs::remove(path(id, "exr"), ec);
+  for (const std::string& key : all_result_keys()) fs::remove(path(id, key), ec);
 }
 
 }  // namespace penumbra::server

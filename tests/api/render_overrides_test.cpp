@@ -198,6 +198,32 @@ TEST(RenderOverrides, WithoutFlagsTheLoadIsUnchanged) {
   EXPECT_TRUE(r.errors[0].flag.empty());
 }
 
+// --aov a,b is the list ["a", "b"], checked by the field's own code: errors name the flag and
+// the item's pointer; "" is no layer; the last flag wins.
+TEST(RenderOverrides, AovIsACommaSeparatedList) {
+  LoadResult r = load_with({{"--aov", "depth,albedo"}});
+  EXPECT_LOADS(r);
+  EXPECT_EQ(r.request->settings.outputs, uint32_t(kOutputDepth | kOutputAlbedo));
+  r = load_with({{"--outputs", "normal"}});
+  EXPECT_LOADS(r);
+  EXPECT_EQ(r.request->settings.outputs, uint32_t(kOutputNormal));
+  Json scene = base_scene();
+  scene["render"]["outputs"] = {"albedo"};
+  r = load_with({{"--aov", ""}}, scene);
+  EXPECT_LOADS(r);
+  EXPECT_EQ(r.request->settings.outputs, 0u);
+  EXPECT_EQ(first_error("--aov", "albedo,nrmal"),
+            "--aov (/render/outputs/1): unknown output layer 'nrmal' (did you mean 'normal'?); "
+            "expected \"albedo\", \"normal\" or \"depth\"");
+  EXPECT_EQ(first_error("--aov", "depth,depth"),
+            "--aov (/render/outputs/1): output layer 'depth' is listed twice");
+  EXPECT_EQ(first_error("--aov", "albedo,,normal"),
+            "--aov (/render/outputs/1): unknown output layer ''; "
+            "expected \"albedo\", \"normal\" or \"depth\"");
+  EXPECT_EQ(first_error("--aov", "a,b,c,d"),
+            "--aov (/render/outputs): 4 outputs exceed the limit of 3 (the number of output layers)");
+}
+
 // Every member of the "render" block in the scene schema has its flag, and only those (plus
 // --threads) are flags.
 TEST(RenderOverrides, OneFlagPerRenderMember) {
@@ -213,7 +239,8 @@ TEST(RenderOverrides, OneFlagPerRenderMember) {
     EXPECT_TRUE(is_render_override_flag(flag)) << flag;
   }
   expected.push_back(std::string(kThreadsFlag));
-  EXPECT_EQ(render_override_flags().size(), expected.size());
+  EXPECT_TRUE(is_render_override_flag("--aov"));  // the alias of --outputs
+  EXPECT_EQ(render_override_flags().size(), expected.size() + 1);
 }
 
 }  // namespace

@@ -33,7 +33,7 @@ Image render_generic(const Scene& scene, const RenderSettings& s) {
         const vec2 lens = scene.features().lens ? sampler.get_2d() : vec2(0.5f);
         const float time = scene.features().motion ? sampler.get_1d() : 0.f;
         const CameraRay cr = camera.generate_ray(film, lens, time);
-        const Spectrum L = integrate(scene, is, Ray{cr.origin, cr.direction, cr.time}, sampler, counters);
+        const Spectrum L = integrate(scene, is, Ray{cr.origin, cr.direction, cr.time}, sampler, counters, nullptr);
         if (!is_finite(L)) continue;
         for (int c = 0; c < 3; ++c) sum[c] += double(L[c]);
         ++n;

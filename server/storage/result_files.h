@@ -1,0 +1,27 @@
+#pragma once
+// Which files a finished job's result is, by name in the ResultStore (docs/output-layers.md):
+//   "exr", "png"            the beauty image (the EXR with the output layers as extra channels,
+//                           plain names: albedo.R, normal.X, depth.Z)
+//   "blender.exr"           beauty and layers in Blender's multi-layer layout (jobs with layers)
+//   "<layer>.exr", ".png"   one output layer alone (albedo, normal, depth)
+#include <string>
+#include <vector>
+
+#include "renderer/core/image.h"
+#include "server/storage/result_store.h"
+
+namespace penumbra::server {
+
+// The store key of a result: `layer` "" for the beauty image, `blender` for the Blender layout
+// (EXR only), `extension` "png" or "exr".
+std::string result_key(const std::string& layer, bool blender, const std::string& extension);
+
+// Every key a job's result may have (what a removal deletes).
+const std::vector<std::string>& all_result_keys();
+
+// Encodes and writes them all: the beauty EXR (with the layers' channels) and PNG, and when
+// there are layers the Blender EXR and each layer's EXR and PNG. Throws as ResultStore::write and encoding do.
+void write_results(ResultStore& store, const std::string& id, const Image& image,
+                   const std::vector<ImageLayer>& layers, const ImageMetadata& metadata);
+
+}  // namespace penumbra::server
