@@ -16,7 +16,7 @@ struct RenderFlag {
   bool list = false;        // the member is an array of strings: the text is split at commas
 };
 
-constexpr std::array<RenderFlag, 11> kRenderFlags = {{
+constexpr std::array<RenderFlag, 12> kRenderFlags = {{
     {"--width", "width", false},
     {"--height", "height", false},
     {"--spp", "spp", false},
@@ -28,6 +28,7 @@ constexpr std::array<RenderFlag, 11> kRenderFlags = {{
     {"--time-limit", "time_limit", false},
     {"--outputs", "outputs", false, true},
     {"--aov", "outputs", false, true},  // the name Cycles and Mitsuba users look for
+    {"--denoise", "denoise", false},    // a switch: "--denoise" alone is "--denoise true"
 }};
 
 constexpr std::array<std::string_view, kRenderFlags.size() + 1> kAllFlags = [] {
@@ -46,6 +47,8 @@ const RenderFlag* find_render_flag(std::string_view flag) {
 }  // namespace
 
 std::span<const std::string_view> render_override_flags() { return kAllFlags; }
+
+bool is_switch_override_flag(std::string_view flag) { return flag == "--denoise"; }
 
 bool is_render_override_flag(std::string_view flag) {
   return std::find(kAllFlags.begin(), kAllFlags.end(), flag) != kAllFlags.end();

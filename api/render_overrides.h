@@ -24,6 +24,8 @@ inline constexpr int kMaxThreads = 4096;
 // alias --aov for --outputs, "--aov albedo,normal" is the list ["albedo", "normal"]), then
 // --threads.
 std::span<const std::string_view> render_override_flags();
+// A flag that may stand alone, meaning true ("--denoise"), or take true/false.
+bool is_switch_override_flag(std::string_view flag);
 bool is_render_override_flag(std::string_view flag);
 
 // The JSON value a flag's text stands for: the scalar it spells as JSON (64, 2.5, -1, true),

@@ -101,6 +101,12 @@ void parse_render(const Json* value, const Limits& limits, RenderSettings& setti
       settings.time_limit = *t;
   }
   if (const Json* outputs = r.array("outputs")) parse_outputs(*outputs, r.pointer_of("outputs"), settings, diag);
+  if (const Json* denoise = r.get("denoise")) {
+    if (denoise->is_boolean())
+      settings.denoise = denoise->get<bool>();
+    else
+      r.error("denoise", "must be true or false");
+  }
   r.report_unknown_keys();
 }
 

@@ -59,8 +59,28 @@ int OptionParser::fail(const char* usage, const std::string& error) {
   return 2;
 }
 
+bool OptionParser::switch_value(std::string* out) {
+  if (inline_value_) {
+    *out = *inline_value_;
+    return true;
+  }
+  if (index_ + 1 < argc_ && (!std::strcmp(argv_[index_ + 1], "true") ||
+                             !std::strcmp(argv_[index_ + 1], "false"))) {
+    *out = argv_[++index_];
+    return true;
+  }
+  *out = "true";
+  return true;
+}
+
 bool parse_render_override(OptionParser& p, std::vector<api::RenderOverride>& overrides) {
   if (!api::is_render_override_flag(p.arg())) return false;
+  if (api::is_switch_override_flag(p.arg())) {
+    std::string value;
+    p.switch_value(&value);
+    overrides.push_back({p.arg(), std::move(value)});
+    return true;
+  }
   std::string value;
   if (p.value(&value)) overrides.push_back({p.arg(), std::move(value)});
   return true;

@@ -18,6 +18,8 @@ class OptionParser {
   bool is(const char* name) const { return current_ == name; }
   bool positional() const { return current_.empty() || current_[0] != '-' || current_ == "-"; }
   bool value(std::string* out);      // the option's value, false if missing
+  // A switch's value: "--x=V" or a following "true"/"false" (consumed), else "true".
+  bool switch_value(std::string* out);
   bool int_value(long long lo, long long hi, long long* out);
   bool failed() const { return failed_; }
   // Prints the error (if any) and usage to stderr, returns exit code 2.

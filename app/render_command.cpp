@@ -42,6 +42,9 @@ const char* kUsage =
     "                           albedo.R, normal.X, depth.Z; .png: one file per layer,\n"
     "                           OUT.albedo.png ...), blender (.exr: Blender's multi-layer\n"
     "                           names, ViewLayer.Combined.R ...), separate (one file per layer)\n"
+    "  --denoise                denoise the image with Intel Open Image Denoise, guided by\n"
+    "                           albedo and normal; the image as rendered (unbiased) is kept\n"
+    "                           as the layer noisy (docs/denoising.md)\n"
     "  -q, --quiet              no progress bar\n";
 
 enum class Layout { kPlain, kBlender, kSeparate };
@@ -139,6 +142,12 @@ int run_render(int argc, char** argv) {
       {"penumbra:integrator", settings.integrator == IntegratorKind::kPath ? "path" : "distributed"},
       {"Software", api::kSoftwareName},
   };
+  if (settings.denoise) {
+    meta.push_back({"penumbra:denoised", st.denoised ? "true" : "false"});
+    if (!st.denoised)
+      std::fprintf(stderr, "penumbra render: warning: the image is not denoised: %s\n",
+                   st.denoise_error.c_str());
+  }
   try {
     if (layout == Layout::kSeparate || (result.layers.empty() && layout == Layout::kPlain)) {
       write_image_file(output, result.image, meta);
@@ -157,10 +166,13 @@ int run_render(int argc, char** argv) {
   }
   std::fprintf(stderr,
                "rendered %s -> %s: %dx%d, %.1f spp (min %d, max %d), %.3f s (+%.3f s build), "
-               "%.2f Mrays/s%s%s\n",
+               "%.2f Mrays/s%s%s%s\n",
                scene_path.c_str(), output.c_str(), settings.width, settings.height, st.spp_mean,
                st.spp_min, st.spp_max, st.seconds, build_seconds, st.mrays_per_second(),
                st.stopped_by_time_limit ? ", stopped at the time limit" : "",
+               st.denoised ? (", denoised in " + std::to_string(st.denoise_seconds).substr(0, 5) +
+                              " s").c_str()
+                           : "",
                st.nonfinite_samples ? (", " + std::to_string(st.nonfinite_samples) +
                                        " non-finite samples dropped").c_str()
                                     : "");

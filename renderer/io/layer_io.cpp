@@ -6,6 +6,7 @@
 #include "renderer/io/exr_writer.h"
 #include "renderer/io/png_writer.h"
 #include "renderer/render/output_layers.h"
+#include "renderer/scene/scene_input.h"
 
 namespace penumbra {
 namespace {
@@ -22,6 +23,8 @@ std::vector<std::string> plain_channels(const ImageLayer& layer) {
 // Blender's pass names (RE_PASSNAME_* in its render_result code): the albedo is the one its
 // denoiser reads, "Denoising Albedo".
 std::string blender_pass(const ImageLayer& layer) {
+  // The image before denoising: Blender keeps it as "Noisy Image" when it denoises.
+  if (layer.name == kNoisyLayerName) return "Noisy Image";
   switch (layer.kind) {
     case ImageLayer::Kind::kColor: return "Denoising Albedo";
     case ImageLayer::Kind::kVector: return "Normal";

@@ -11,6 +11,7 @@
 #include "renderer/render/adaptive_sampling.h"
 #include "renderer/render/film.h"
 #include "renderer/render/integrator.h"
+#include "renderer/denoise/denoise_result.h"
 #include "renderer/render/output_layers.h"
 #include "renderer/render/thin_lens_camera.h"
 
@@ -102,8 +103,11 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
   Film film(width, height);
   // Output layers only when asked: otherwise no film, and the integrator gets a null FirstHit.
   std::optional<LayerFilm> layer_film;
-  if (settings.outputs)
-    layer_film.emplace(width, height, settings.outputs, camera.position(), camera.forward());
+  // The denoiser is guided by albedo and normal, rendered for it when not asked for.
+  const uint32_t film_outputs =
+      settings.outputs | (settings.denoise ? uint32_t(kOutputAlbedo | kOutputNormal) : 0u);
+  if (film_outputs)
+    layer_film.emplace(width, height, film_outputs, camera.position(), camera.forward());
   const PixelOrder order = make_pixel_order(width, height, std::max(1, settings.tile_size));
   const int spp = std::max(1, settings.spp);
   const std::vector<int> passes = make_passes(spp);
@@ -205,6 +209,7 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
   result.variance = film.resolve_variance();
   if (layer_film) result.layers = layer_film->resolve();
   RenderStats& st = result.stats;
+  if (settings.denoise && !cancelled.load()) denoise_result(settings.outputs, &result);
   st.seconds = elapsed();
   st.rays = rays.load();
   st.camera_samples = samples_done.load();

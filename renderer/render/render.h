@@ -37,13 +37,19 @@ struct RenderStats {
   bool cancelled = false;
   bool stopped_by_time_limit = false;
   uint64_t nonfinite_samples = 0;  // dropped samples that evaluated to NaN/Inf (should stay 0)
+  // RenderSettings::denoise: whether the image is the denoised one, the denoiser's seconds
+  // (within `seconds`), and why it is not (OIDN missing or failing: the image stays as rendered).
+  bool denoised = false;
+  double denoise_seconds = 0.0;
+  std::string denoise_error;
   double mrays_per_second() const { return seconds > 0 ? rays / seconds * 1e-6 : 0.0; }
 };
 
 struct RenderResult {
   Image image;     // mean radiance per pixel
   Image variance;  // per pixel and channel: estimated variance of that mean (sample variance / n)
-  // The output layers RenderSettings::outputs asked for, in OutputLayerBit order (empty if none).
+  // The output layers RenderSettings::outputs asked for, in OutputLayerBit order (empty if none),
+  // then, when denoised, the image as rendered ("noisy", kNoisyLayerName).
   std::vector<ImageLayer> layers;
   RenderStats stats;
 };

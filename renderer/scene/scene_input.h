@@ -109,6 +109,9 @@ enum OutputLayerBit : uint32_t {
 };
 inline constexpr int kOutputLayerCount = 3;
 inline constexpr const char* kOutputLayerNames[kOutputLayerCount] = {"albedo", "normal", "depth"};
+// With RenderSettings::denoise, the beauty image as rendered (unbiased, noisy) is kept as this
+// extra layer after the requested ones, and the image becomes the denoised one.
+inline constexpr const char* kNoisyLayerName = "noisy";
 
 struct RenderSettings {
   int width = 256;
@@ -123,6 +126,9 @@ struct RenderSettings {
   float noise_threshold = 0.f;  // adaptive sampling: stop pixels below this relative error; 0 = off
   double time_limit = 0.0;      // seconds; 0 = none
   uint32_t outputs = 0;         // OutputLayerBit set; 0 = the beauty image only
+  // Denoise the finished image with Open Image Denoise, guided by albedo and normal layers
+  // (rendered for it whether or not `outputs` asks for them); renderer/denoise/oidn_denoiser.h.
+  bool denoise = false;
 };
 
 }  // namespace penumbra

@@ -35,9 +35,9 @@ std::variant<std::string, Problem> result_variant(const httplib::Request& req) {
   std::string variant;
   if (layer && *layer != "beauty") {
     const auto* end = std::end(kOutputLayerNames);
-    if (std::find(std::begin(kOutputLayerNames), end, *layer) == end)
+    if (std::find(std::begin(kOutputLayerNames), end, *layer) == end && *layer != kNoisyLayerName)
       return unprocessable_parameter("unknown-layer", "Unknown layer", "layer",
-                                     "must be one of beauty, albedo, normal, depth");
+                                     "must be one of beauty, albedo, normal, depth, noisy");
     variant = *layer;
   }
   if (layout && *layout != "plain") {

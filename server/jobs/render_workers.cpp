@@ -28,7 +28,7 @@ std::string error_json(const std::string& detail) {
 
 std::string stats_json(const RenderOutcome& o, int threads) {
   const RenderStats& s = o.stats;
-  return nlohmann::ordered_json{{"seconds", s.seconds},
+  nlohmann::ordered_json j{{"seconds", s.seconds},
                                 {"build_seconds", o.build_seconds},
                                 {"rays", s.rays},
                                 {"mrays_per_second", s.mrays_per_second()},
@@ -37,8 +37,14 @@ std::string stats_json(const RenderOutcome& o, int threads) {
                                 {"spp_max", s.spp_max},
                                 {"camera_samples", s.camera_samples},
                                 {"stopped_by_time_limit", s.stopped_by_time_limit},
-                                {"threads", threads}}
-      .dump();
+                                {"threads", threads}};
+  // render.denoise: whether the result is denoised, and if not, why (the job still succeeds).
+  if (s.denoised || !s.denoise_error.empty()) {
+    j["denoised"] = s.denoised;
+    j["denoise_seconds"] = s.denoise_seconds;
+    if (!s.denoise_error.empty()) j["denoise_error"] = s.denoise_error;
+  }
+  return j.dump();
 }
 
 // A running (or, when `from_queued`, a queued) job ends in `state`.

@@ -16,6 +16,7 @@ const std::vector<std::string>& all_result_keys() {
     std::vector<std::string> k = {"exr", "png", "blender.exr"};
     for (const char* layer : kOutputLayerNames)
       for (const char* ext : {"exr", "png"}) k.push_back(result_key(layer, false, ext));
+    for (const char* ext : {"exr", "png"}) k.push_back(result_key(kNoisyLayerName, false, ext));
     return k;
   }();
   return keys;

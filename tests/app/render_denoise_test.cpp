@@ -1,0 +1,111 @@
+// `penumbra render --denoise` end to end through the binary: the denoised image, the image as
+// rendered kept as the "noisy" layer (bit for bit the render without --denoise), the guide
+// layers not written unless asked for; and without Open Image Denoise, a warning and the image
+// as rendered, never a failure.
+#include <gtest/gtest.h>
+
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfInputFile.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "tests/app/app_test_util.h"
+
+namespace penumbra::test {
+namespace {
+
+std::set<std::string> channels(const std::string& path) {
+  const Imf::InputFile input(path.c_str());
+  std::set<std::string> names;
+  for (auto it = input.header().channels().begin(); it != input.header().channels().end(); ++it)
+    names.insert(it.name());
+  return names;
+}
+
+std::vector<float> read_channel(const std::string& path, const std::string& name) {
+  Imf::InputFile input(path.c_str());
+  const Imath::Box2i dw = input.header().dataWindow();
+  const int w = dw.max.x - dw.min.x + 1, h = dw.max.y - dw.min.y + 1;
+  std::vector<float> data(size_t(w) * h);
+  Imf::FrameBuffer fb;
+  fb.insert(name, Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(data.data()), sizeof(float),
+                             sizeof(float) * size_t(w)));
+  input.setFrameBuffer(fb);
+  input.readPixels(dw.min.y, dw.max.y);
+  return data;
+}
+
+bool oidn_installed() {
+  return std::filesystem::exists(std::filesystem::path(PENUMBRA_BINARY).parent_path() /
+                                 "../lib/penumbra/oidn/libOpenImageDenoise.so.2");
+}
+
+TEST(RenderDenoise, DenoisedImageWithTheNoisyOneKept) {
+  if (!oidn_installed()) {
+    const char* required = std::getenv("PENUMBRA_REQUIRE_OIDN");
+    if (required && std::string(required) == "1") FAIL() << "Open Image Denoise is not installed";
+    GTEST_SKIP() << "Open Image Denoise is not installed (scripts/install-oidn.sh)";
+  }
+  SceneFolder folder;
+  CommandResult r = run_penumbra(folder, "render scene.json --spp 4 -q -o plain.exr");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = run_penumbra(folder, "render scene.json --spp 4 --denoise -q -o d.exr");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("denoised in"), std::string::npos) << r.output;
+  // The guides are not written unless asked for: beauty and noisy only.
+  EXPECT_EQ(channels(folder.file("d.exr")),
+            (std::set<std::string>{"R", "G", "B", "noisy.R", "noisy.G", "noisy.B"}));
+  // The noisy layer is the render without --denoise, bit for bit; the image is not.
+  const auto noisy = read_channel(folder.file("d.exr"), "noisy.G");
+  const auto plain = read_channel(folder.file("plain.exr"), "G");
+  const auto denoised = read_channel(folder.file("d.exr"), "G");
+  EXPECT_EQ(noisy, plain);
+  EXPECT_NE(denoised, plain);
+  for (float v : denoised) ASSERT_TRUE(std::isfinite(v) && v >= 0.f);
+  // Asked-for layers stay; PNG output writes the noisy image beside the denoised one.
+  r = run_penumbra(folder, "render scene.json --spp 4 --denoise --aov albedo -q -o a.exr");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(channels(folder.file("a.exr")),
+            (std::set<std::string>{"R", "G", "B", "albedo.R", "albedo.G", "albedo.B", "noisy.R",
+                                   "noisy.G", "noisy.B"}));
+  r = run_penumbra(folder, "render scene.json --spp 4 --denoise true -q -o p.png");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(std::filesystem::exists(folder.file("p.noisy.png")));
+  EXPECT_FALSE(std::filesystem::exists(folder.file("p.normal.png")));
+}
+
+TEST(RenderDenoise, WithoutOpenImageDenoiseTheImageIsKeptWithAWarning) {
+  SceneFolder folder;
+  const std::string command = "cd " + folder.path().string() +
+                              " && PENUMBRA_OIDN_DIR=/nonexistent " + PENUMBRA_BINARY +
+                              " render scene.json --spp 2 --denoise -q -o missing.exr 2>&1";
+  FILE* pipe = ::popen(command.c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::string output;
+  char buffer[4096];
+  std::size_t n;
+  while ((n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0) output.append(buffer, n);
+  const int status = ::pclose(pipe);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0) << output;
+  EXPECT_NE(output.find("warning: the image is not denoised"), std::string::npos) << output;
+  EXPECT_NE(output.find("install-oidn"), std::string::npos) << output;
+  EXPECT_EQ(channels(folder.file("missing.exr")), (std::set<std::string>{"R", "G", "B"}));
+}
+
+TEST(RenderDenoise, TheFieldAndTheFlagAreChecked) {
+  SceneFolder folder;
+  const CommandResult r = run_penumbra(folder, "render scene.json --denoise=maybe -q -o x.exr");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("--denoise (/render/denoise): must be true or false"), std::string::npos)
+      << r.output;
+}
+
+}  // namespace
+}  // namespace penumbra::test
