@@ -22,6 +22,7 @@ import penumbra
 from penumbra.__main__ import main as cli_main
 
 BINARY = os.environ.get("PENUMBRA_BINARY", "penumbra")
+REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
 TOKEN = "client-test-token"
 
 try:
@@ -190,6 +191,29 @@ class JobsTest(ServerTest):
                 self.assertEqual(f.read(8), b"\x89PNG\r\n\x1a\n")
         finally:
             shutil.rmtree(folder)
+
+
+class JobOptionsTest(ServerTest):
+    """Priorities (higher first), a .glb sent as it is, and a denoised result's noisy layer."""
+
+    def test_priority_orders_the_queue(self):
+        blocker = self.client.submit(slow_scene())
+        low = self.client.submit(sky_scene(), priority=-5)
+        high = self.client.submit(sky_scene(), priority=7)
+        queued = [j["id"] for j in self.client.list(state="queued")]
+        self.assertLess(queued.index(high["id"]), queued.index(low["id"]), queued)
+        self.assertEqual(self.client.job(high)["priority"], 7)
+        self.client.cancel(blocker)
+        for job in (low, high):
+            self.assertEqual(self.client.wait(job, progress=False)["state"], "succeeded")
+
+    def test_glb_is_rendered_with_query_parameters(self):
+        glb = os.path.join(REPO, "scenes", "gltf_showcase.glb")
+        job = self.client.submit(glb, params={"width": 32, "height": 18, "spp": 2}, priority=1)
+        record = self.client.wait(job, progress=False)
+        self.assertEqual(record["render"], {"width": 32, "height": 18, "spp": 2})
+        self.assertEqual(record["priority"], 1)
+        self.assertEqual(self.client.result(job, format="png")[:8], b"\x89PNG\r\n\x1a\n")
 
 
 class AssetsTest(ServerTest):
