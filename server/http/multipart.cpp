@@ -3,20 +3,10 @@
 #include <algorithm>
 #include <cctype>
 
+#include "server/http/text_util.h"
+
 namespace penumbra::server {
 namespace {
-
-std::string lower(std::string_view s) {
-  std::string out(s);
-  for (char& c : out) c = char(std::tolower(static_cast<unsigned char>(c)));
-  return out;
-}
-
-std::string_view trim(std::string_view s) {
-  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\t')) s.remove_suffix(1);
-  return s;
-}
 
 // One parameter value after '=': a token, or a quoted-string with backslash escapes (RFC 9110
 // section 5.6.4). Advances `s` past it; nullopt when a quote is not closed.
@@ -34,7 +24,7 @@ std::optional<std::string> read_param_value(std::string_view& s) {
     return out;
   }
   const auto end = s.find(';');
-  out = std::string(trim(s.substr(0, end)));
+  out = std::string(trim_ows(s.substr(0, end)));
   s.remove_prefix(end == std::string_view::npos ? s.size() : end);
   return out;
 }
@@ -42,7 +32,7 @@ std::optional<std::string> read_param_value(std::string_view& s) {
 // "form-data; name=\"x\"; filename=\"y\"" -> name, filename; false when malformed.
 bool parse_disposition(std::string_view value, MultipartPart& part, std::string& error) {
   const auto semi = value.find(';');
-  if (lower(trim(value.substr(0, semi))) != "form-data") {
+  if (ascii_lower(std::string(trim_ows(value.substr(0, semi)))) != "form-data") {
     error = "a part's Content-Disposition must be form-data";
     return false;
   }
@@ -52,16 +42,16 @@ bool parse_disposition(std::string_view value, MultipartPart& part, std::string&
   }
   std::string_view rest = value.substr(semi + 1);
   bool has_name = false;
-  while (!trim(rest).empty()) {
-    rest = trim(rest);
+  while (!trim_ows(rest).empty()) {
+    rest = trim_ows(rest);
     const auto eq = rest.find('=');
     if (eq == std::string_view::npos) {
       error = "a Content-Disposition parameter has no value";
       return false;
     }
-    const std::string key = lower(trim(rest.substr(0, eq)));
+    const std::string key = ascii_lower(std::string(trim_ows(rest.substr(0, eq))));
     rest.remove_prefix(eq + 1);
-    rest = trim(rest);
+    rest = trim_ows(rest);
     const auto v = read_param_value(rest);
     if (!v) {
       error = "a quoted Content-Disposition parameter is not closed";
@@ -77,7 +67,7 @@ bool parse_disposition(std::string_view value, MultipartPart& part, std::string&
     } else if (key == "filename") {
       part.filename = *v;
     }
-    rest = trim(rest);
+    rest = trim_ows(rest);
     if (!rest.empty()) {
       if (rest.front() != ';') {
         error = "Content-Disposition parameters must be separated by ';'";
@@ -97,24 +87,24 @@ bool parse_disposition(std::string_view value, MultipartPart& part, std::string&
 
 std::optional<std::string> multipart_boundary(std::string_view content_type) {
   const auto semi = content_type.find(';');
-  if (lower(trim(content_type.substr(0, semi))) != "multipart/form-data" ||
+  if (ascii_lower(std::string(trim_ows(content_type.substr(0, semi)))) != "multipart/form-data" ||
       semi == std::string_view::npos)
     return std::nullopt;
   std::string_view rest = content_type.substr(semi + 1);
-  while (!trim(rest).empty()) {
-    rest = trim(rest);
+  while (!trim_ows(rest).empty()) {
+    rest = trim_ows(rest);
     const auto eq = rest.find('=');
     if (eq == std::string_view::npos) return std::nullopt;
-    const std::string key = lower(trim(rest.substr(0, eq)));
+    const std::string key = ascii_lower(std::string(trim_ows(rest.substr(0, eq))));
     rest.remove_prefix(eq + 1);
-    rest = trim(rest);
+    rest = trim_ows(rest);
     const auto v = read_param_value(rest);
     if (!v) return std::nullopt;
     if (key == "boundary") {
       if (v->empty() || v->size() > 70) return std::nullopt;
       return v;
     }
-    rest = trim(rest);
+    rest = trim_ows(rest);
     if (!rest.empty() && rest.front() == ';') rest.remove_prefix(1);
   }
   return std::nullopt;
@@ -179,8 +169,8 @@ MultipartResult parse_multipart(std::string_view body, std::string_view boundary
           out.error = "a part's header line has no name";
           return out;
         }
-        const std::string key = lower(trim(line.substr(0, colon)));
-        const std::string_view value = trim(line.substr(colon + 1));
+        const std::string key = ascii_lower(std::string(trim_ows(line.substr(0, colon))));
+        const std::string_view value = trim_ows(line.substr(colon + 1));
         if (key == "content-disposition") {
           if (has_disposition) {
             out.error = "a part has two Content-Disposition headers";

@@ -3,54 +3,28 @@
 // refusals of a layout that cannot be written.
 #include <gtest/gtest.h>
 
-#include <OpenEXR/ImfChannelList.h>
-#include <OpenEXR/ImfFrameBuffer.h>
-#include <OpenEXR/ImfHeader.h>
-#include <OpenEXR/ImfInputFile.h>
-
 #include <filesystem>
 #include <set>
 #include <string>
 #include <vector>
 
 #include "tests/app/app_test_util.h"
+#include "tests/app/exr_test_util.h"
 
 namespace penumbra::test {
 namespace {
-
-std::set<std::string> channels(const std::string& path) {
-  const Imf::InputFile input(path.c_str());
-  std::set<std::string> names;
-  for (auto it = input.header().channels().begin(); it != input.header().channels().end(); ++it)
-    names.insert(it.name());
-  return names;
-}
-
-// One channel's values, rows top to bottom.
-std::vector<float> read_channel(const std::string& path, const std::string& name) {
-  Imf::InputFile input(path.c_str());
-  const Imath::Box2i dw = input.header().dataWindow();
-  const int w = dw.max.x - dw.min.x + 1, h = dw.max.y - dw.min.y + 1;
-  std::vector<float> data(size_t(w) * h);
-  Imf::FrameBuffer fb;
-  fb.insert(name, Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(data.data()), sizeof(float),
-                             sizeof(float) * size_t(w)));
-  input.setFrameBuffer(fb);
-  input.readPixels(dw.min.y, dw.max.y);
-  return data;
-}
 
 TEST(RenderAov, MultiLayerExrWithPlainNames) {
   SceneFolder folder;
   const CommandResult r = run_penumbra(folder, "render scene.json --aov albedo,normal,depth -q -o out.exr");
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_EQ(channels(folder.file("out.exr")),
+  EXPECT_EQ(exr_channels(folder.file("out.exr")),
             (std::set<std::string>{"R", "G", "B", "albedo.R", "albedo.G", "albedo.B", "normal.X",
                                    "normal.Y", "normal.Z", "depth.Z"}));
   // The scene's sphere (radius 1, 5 from the camera) fills the centre: its front at depth 4,
   // its colour 0.8; the corners see nothing.
-  const std::vector<float> depth = read_channel(folder.file("out.exr"), "depth.Z");
-  const std::vector<float> albedo = read_channel(folder.file("out.exr"), "albedo.G");
+  const std::vector<float> depth = read_exr_channel(folder.file("out.exr"), "depth.Z");
+  const std::vector<float> albedo = read_exr_channel(folder.file("out.exr"), "albedo.G");
   const size_t centre = size_t(6) * 16 + 8;
   EXPECT_NEAR(depth[centre], 4.f, 0.15f);  // a few degrees off the axis
   EXPECT_NEAR(albedo[centre], 0.8f, 1e-6f);
@@ -62,7 +36,7 @@ TEST(RenderAov, BlenderLayoutAndSeparateFiles) {
   SceneFolder folder;
   CommandResult r = run_penumbra(folder, "render scene.json --aov depth --layout blender -q -o b.exr");
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_EQ(channels(folder.file("b.exr")),
+  EXPECT_EQ(exr_channels(folder.file("b.exr")),
             (std::set<std::string>{"ViewLayer.Combined.R", "ViewLayer.Combined.G",
                                    "ViewLayer.Combined.B", "ViewLayer.Combined.A",
                                    "ViewLayer.Depth.Z"}));
@@ -72,8 +46,8 @@ TEST(RenderAov, BlenderLayoutAndSeparateFiles) {
     EXPECT_TRUE(std::filesystem::exists(folder.file(f))) << f;
   r = run_penumbra(folder, "render scene.json --aov normal --layout separate -q -o s.exr");
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_EQ(channels(folder.file("s.exr")), (std::set<std::string>{"R", "G", "B"}));
-  EXPECT_EQ(channels(folder.file("s.normal.exr")), (std::set<std::string>{"X", "Y", "Z"}));
+  EXPECT_EQ(exr_channels(folder.file("s.exr")), (std::set<std::string>{"R", "G", "B"}));
+  EXPECT_EQ(exr_channels(folder.file("s.normal.exr")), (std::set<std::string>{"X", "Y", "Z"}));
 }
 
 TEST(RenderAov, RefusedBeforeRendering) {

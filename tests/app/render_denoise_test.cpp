@@ -4,11 +4,6 @@
 // as rendered, never a failure.
 #include <gtest/gtest.h>
 
-#include <OpenEXR/ImfChannelList.h>
-#include <OpenEXR/ImfFrameBuffer.h>
-#include <OpenEXR/ImfHeader.h>
-#include <OpenEXR/ImfInputFile.h>
-
 #include <cstdlib>
 #include <filesystem>
 #include <set>
@@ -16,30 +11,10 @@
 #include <vector>
 
 #include "tests/app/app_test_util.h"
+#include "tests/app/exr_test_util.h"
 
 namespace penumbra::test {
 namespace {
-
-std::set<std::string> channels(const std::string& path) {
-  const Imf::InputFile input(path.c_str());
-  std::set<std::string> names;
-  for (auto it = input.header().channels().begin(); it != input.header().channels().end(); ++it)
-    names.insert(it.name());
-  return names;
-}
-
-std::vector<float> read_channel(const std::string& path, const std::string& name) {
-  Imf::InputFile input(path.c_str());
-  const Imath::Box2i dw = input.header().dataWindow();
-  const int w = dw.max.x - dw.min.x + 1, h = dw.max.y - dw.min.y + 1;
-  std::vector<float> data(size_t(w) * h);
-  Imf::FrameBuffer fb;
-  fb.insert(name, Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(data.data()), sizeof(float),
-                             sizeof(float) * size_t(w)));
-  input.setFrameBuffer(fb);
-  input.readPixels(dw.min.y, dw.max.y);
-  return data;
-}
 
 bool oidn_installed() {
   return std::filesystem::exists(std::filesystem::path(PENUMBRA_BINARY).parent_path() /
@@ -59,19 +34,19 @@ TEST(RenderDenoise, DenoisedImageWithTheNoisyOneKept) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("denoised in"), std::string::npos) << r.output;
   // The guides are not written unless asked for: beauty and noisy only.
-  EXPECT_EQ(channels(folder.file("d.exr")),
+  EXPECT_EQ(exr_channels(folder.file("d.exr")),
             (std::set<std::string>{"R", "G", "B", "noisy.R", "noisy.G", "noisy.B"}));
   // The noisy layer is the render without --denoise, bit for bit; the image is not.
-  const auto noisy = read_channel(folder.file("d.exr"), "noisy.G");
-  const auto plain = read_channel(folder.file("plain.exr"), "G");
-  const auto denoised = read_channel(folder.file("d.exr"), "G");
+  const auto noisy = read_exr_channel(folder.file("d.exr"), "noisy.G");
+  const auto plain = read_exr_channel(folder.file("plain.exr"), "G");
+  const auto denoised = read_exr_channel(folder.file("d.exr"), "G");
   EXPECT_EQ(noisy, plain);
   EXPECT_NE(denoised, plain);
   for (float v : denoised) ASSERT_TRUE(std::isfinite(v) && v >= 0.f);
   // Asked-for layers stay; PNG output writes the noisy image beside the denoised one.
   r = run_penumbra(folder, "render scene.json --spp 4 --denoise --aov albedo -q -o a.exr");
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_EQ(channels(folder.file("a.exr")),
+  EXPECT_EQ(exr_channels(folder.file("a.exr")),
             (std::set<std::string>{"R", "G", "B", "albedo.R", "albedo.G", "albedo.B", "noisy.R",
                                    "noisy.G", "noisy.B"}));
   r = run_penumbra(folder, "render scene.json --spp 4 --denoise true -q -o p.png");
@@ -96,7 +71,7 @@ TEST(RenderDenoise, WithoutOpenImageDenoiseTheImageIsKeptWithAWarning) {
   EXPECT_EQ(WEXITSTATUS(status), 0) << output;
   EXPECT_NE(output.find("warning: the image is not denoised"), std::string::npos) << output;
   EXPECT_NE(output.find("install-oidn"), std::string::npos) << output;
-  EXPECT_EQ(channels(folder.file("missing.exr")), (std::set<std::string>{"R", "G", "B"}));
+  EXPECT_EQ(exr_channels(folder.file("missing.exr")), (std::set<std::string>{"R", "G", "B"}));
 }
 
 TEST(RenderDenoise, TheFieldAndTheFlagAreChecked) {
