@@ -132,6 +132,14 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
     p.fraction = samples_total ? std::min(1.0, double(p.samples_done) / double(samples_total)) : 1.0;
     p.elapsed_seconds = elapsed();
     p.eta_seconds = p.fraction > 0 ? p.elapsed_seconds * (1.0 - p.fraction) / p.fraction : 0.0;
+    // A time budget ends the render at its deadline whatever the samples say: the fraction is at
+    // least the share of the budget spent, and the ETA at most what is left of it.
+    if (settings.time_limit > 0) {
+      const double share = std::min(1.0, p.elapsed_seconds / settings.time_limit);
+      const double left = std::max(0.0, settings.time_limit - p.elapsed_seconds);
+      p.fraction = std::max(p.fraction, share);
+      p.eta_seconds = p.fraction > share ? std::min(p.eta_seconds, left) : left;
+    }
     p.passes_done = passes_done;
     return p;
   };

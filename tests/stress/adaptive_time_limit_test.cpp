@@ -3,6 +3,9 @@
 // sampling must stay deterministic whatever the thread count.
 #include <gtest/gtest.h>
 
+#include <mutex>
+#include <vector>
+
 #include "tests/stress/stress_util.h"
 
 namespace penumbra::test {
@@ -84,6 +87,31 @@ TEST(TimeLimit, StopsEarlyWithAFiniteCompleteImage) {
   const RenderResult ref = render_input(in, settings(48, 48, 64, 8));
   const BlockComparison cmp = compare_blocks(ref, r, 8, 6.0, 0.05);
   EXPECT_EQ(cmp.bad, 0) << cmp.first_bad;
+}
+
+// Progress under a time budget follows the budget: the fraction reaches the share of the time
+// spent, and the ETA never promises more than what is left of it (not the hours that 2^20 spp
+// would take).
+TEST(TimeLimit, ProgressAndEtaFollowTheBudget) {
+  const SceneInput in = mixed_scene();
+  RenderSettings s = settings(48, 48, 1 << 20, 8);
+  s.time_limit = 0.6;
+  std::mutex m;
+  std::vector<RenderProgress> seen;
+  RenderControl control;
+  control.on_progress = [&](const RenderProgress& p) {
+    std::lock_guard lock(m);
+    seen.push_back(p);
+  };
+  render(*Scene::build(in), s, control);
+  ASSERT_FALSE(seen.empty());
+  double last_fraction = 0;
+  for (const RenderProgress& p : seen) {
+    EXPECT_LE(p.eta_seconds, std::max(0.0, s.time_limit - p.elapsed_seconds) + 1e-9);
+    EXPECT_GE(p.fraction, std::min(1.0, p.elapsed_seconds / s.time_limit) - 1e-9);
+    last_fraction = std::max(last_fraction, p.fraction);
+  }
+  EXPECT_GT(last_fraction, 0.5);
 }
 
 }  // namespace
