@@ -2,7 +2,7 @@
 
 #include <cctype>
 
-#include "server/http/text_util.h"
+#include "server/text_util.h"
 
 namespace penumbra::server {
 namespace {

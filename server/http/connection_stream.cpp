@@ -10,7 +10,7 @@
 #include <cstring>
 
 #include "server/http/header_line_check.h"
-#include "server/http/text_util.h"
+#include "server/text_util.h"
 
 namespace penumbra::server {
 namespace {

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cctype>
 
-#include "server/http/text_util.h"
+#include "server/text_util.h"
 
 namespace penumbra::server {
 namespace {

@@ -12,7 +12,7 @@
 #include "api/render_overrides.h"
 #include "server/http/json_response.h"
 #include "server/http/multipart.h"
-#include "server/http/text_util.h"
+#include "server/text_util.h"
 
 namespace penumbra::server {
 namespace {

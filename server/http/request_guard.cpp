@@ -8,7 +8,7 @@
 
 #include "server/http/one_shot_job.h"
 #include "server/http/route_table.h"
-#include "server/http/text_util.h"
+#include "server/text_util.h"
 
 namespace penumbra::server {
 namespace {

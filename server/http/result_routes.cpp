@@ -14,7 +14,7 @@
 #include "server/http/result_response.h"
 #include "server/http/route_context.h"
 #include "server/http/route_table.h"
-#include "server/http/text_util.h"
+#include "server/text_util.h"
 
 namespace penumbra::server {
 namespace {

@@ -3,14 +3,10 @@
 #include <algorithm>
 #include <cctype>
 
+#include "server/text_util.h"
+
 namespace penumbra::server {
 namespace {
-
-std::string lower(std::string_view s) {
-  std::string out(s);
-  for (char& c : out) c = char(std::tolower(static_cast<unsigned char>(c)));
-  return out;
-}
 
 // A DNS name, an IPv4 literal, or (inside brackets, checked by the caller) an IPv6 literal.
 bool valid_host(std::string_view h, bool v6) {
@@ -42,12 +38,12 @@ bool split_host_port(std::string_view authority, std::string& host, int& port) {
   if (!authority.empty() && authority.front() == '[') {
     const auto close = authority.find(']');
     if (close == std::string_view::npos) return false;
-    host = lower(authority.substr(1, close - 1));
+    host = ascii_lower(std::string(authority.substr(1, close - 1)));
     rest = authority.substr(close + 1);
     v6 = true;
   } else {
     const auto colon = authority.find(':');
-    host = lower(authority.substr(0, colon));
+    host = ascii_lower(std::string(authority.substr(0, colon)));
     rest = colon == std::string_view::npos ? std::string_view() : authority.substr(colon);
   }
   if (!valid_host(host, v6)) return false;
@@ -80,7 +76,7 @@ ParsedWebhookUrl parse_webhook_url(std::string_view text) {
   }
   WebhookUrl url;
   std::string_view rest;
-  const std::string head = lower(text.substr(0, 8));
+  const std::string head = ascii_lower(std::string(text.substr(0, 8)));
   if (head.rfind("https://", 0) == 0) {
     url.https = true;
     rest = text.substr(8);

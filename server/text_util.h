@@ -1,5 +1,5 @@
 #pragma once
-// Small string helpers for HTTP header handling.
+// Small ASCII string helpers for HTTP headers and URLs (server/http/ and server/jobs/).
 #include <cctype>
 #include <string>
 #include <string_view>
