@@ -83,7 +83,11 @@ TEST(EventStream, ResumingAfterARestartGetsTheCurrentState) {
     id = submit(*c, tiny_scene());
     const StreamRead r = read_events(server, id);
     ASSERT_FALSE(r.events.empty());
+    ASSERT_EQ(r.events.back().event, "succeeded") << r.text;
     last = r.events.back().id;
+    // The stream reports a state before the store has committed it: stop gracefully so that
+    // the new run finds the job finished (a SIGKILL here would run it again, as kill -9 does).
+    server.stop_gracefully();
   }
   ServerProcess again(dir.path());
   // An id from the previous run: the new run's ids are above it, the job's state comes again.
