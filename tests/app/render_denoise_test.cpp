@@ -12,21 +12,13 @@
 
 #include "tests/app/app_test_util.h"
 #include "tests/app/exr_test_util.h"
+#include "tests/oidn_test_util.h"
 
 namespace penumbra::test {
 namespace {
 
-bool oidn_installed() {
-  return std::filesystem::exists(std::filesystem::path(PENUMBRA_BINARY).parent_path() /
-                                 "../lib/penumbra/oidn/libOpenImageDenoise.so.2");
-}
-
 TEST(RenderDenoise, DenoisedImageWithTheNoisyOneKept) {
-  if (!oidn_installed()) {
-    const char* required = std::getenv("PENUMBRA_REQUIRE_OIDN");
-    if (required && std::string(required) == "1") FAIL() << "Open Image Denoise is not installed";
-    GTEST_SKIP() << "Open Image Denoise is not installed (scripts/install-oidn.sh)";
-  }
+  PENUMBRA_REQUIRE_OIDN_OR_SKIP();
   SceneFolder folder;
   CommandResult r = run_penumbra(folder, "render scene.json --spp 4 -q -o plain.exr");
   ASSERT_EQ(r.exit_code, 0) << r.output;

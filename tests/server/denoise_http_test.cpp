@@ -7,21 +7,13 @@
 #include <filesystem>
 
 #include "server_process.h"
+#include "tests/oidn_test_util.h"
 
 namespace penumbra::test {
 namespace {
 
-bool oidn_installed() {
-  return std::filesystem::exists(std::filesystem::path(PENUMBRA_BINARY).parent_path() /
-                                 "../lib/penumbra/oidn/libOpenImageDenoise.so.2");
-}
-
 TEST(DenoiseHttp, DenoisedResultWithTheNoisyLayer) {
-  if (!oidn_installed()) {
-    const char* required = std::getenv("PENUMBRA_REQUIRE_OIDN");
-    if (required && std::string(required) == "1") FAIL() << "Open Image Denoise is not installed";
-    GTEST_SKIP() << "Open Image Denoise is not installed (scripts/install-oidn.sh)";
-  }
+  PENUMBRA_REQUIRE_OIDN_OR_SKIP();
   TempDir dir;
   ServerProcess server(dir.path());
   auto c = server.client();

@@ -87,7 +87,8 @@ TEST(EventStream, ResumingAfterARestartGetsTheCurrentState) {
     last = r.events.back().id;
     // The stream reports a state before the store has committed it: stop gracefully so that
     // the new run finds the job finished (a SIGKILL here would run it again, as kill -9 does).
-    server.stop_gracefully();
+    server.signal(SIGTERM);
+    ASSERT_EQ(server.wait_exit(std::chrono::seconds(20)), 0);
   }
   ServerProcess again(dir.path());
   // An id from the previous run: the new run's ids are above it, the job's state comes again.

@@ -94,18 +94,6 @@ class ServerProcess {
   ServerProcess(const ServerProcess&) = delete;
   ServerProcess& operator=(const ServerProcess&) = delete;
 
-  // SIGTERM and wait: the graceful shutdown writes every pending change before the process
-  // exits (the destructor's SIGKILL may lose the last ones, as a real kill -9 would).
-  int stop_gracefully() {
-    int status = -1;
-    if (pid_ > 0) {
-      ::kill(pid_, SIGTERM);
-      ::waitpid(pid_, &status, 0);
-      pid_ = -1;
-    }
-    return status;
-  }
-
   int port() const { return port_; }
   pid_t pid() const { return pid_; }
   std::unique_ptr<httplib::Client> client(const std::string& token = "") const {
