@@ -60,7 +60,7 @@ TEST(OneShotJobs, MultipartErrorsNameThePart) {
 TEST(OneShotJobs, MalformedMultipartBodiesAre400) {
   TempDir dir;
   ServerProcess server(dir.path());
-  for (const std::string body :
+  for (const std::string& body :
        {std::string("no boundary here"), std::string("--XYZ\r\nContent-Disposition: form-data\r\n\r\nx\r\n--XYZ--"),
         std::string("--XYZ\r\nContent-Disposition: form-data; name=\"scene\"\r\n\r\n{}"),
         std::string("--XYZ\r\nContent-Disposition: form-data; name=\"scene\r\n\r\n{}\r\n--XYZ--")}) {
@@ -101,9 +101,8 @@ TEST(OneShotJobs, GltfUrisCannotLeaveTheJobFolder) {
   TempDir dir;
   ServerProcess server(dir.path());
   auto c = server.client();
-  for (const std::string uri : {std::string("../../etc/passwd"), std::string("/etc/passwd"),
-                                std::string("%2e%2e/%2e%2e/etc/passwd"),
-                                std::string("file:///etc/passwd")}) {
+  for (const char* uri :
+       {"../../etc/passwd", "/etc/passwd", "%2e%2e/%2e%2e/etc/passwd", "file:///etc/passwd"}) {
     const Json gltf = {
         {"asset", {{"version", "2.0"}}},
         {"buffers", {{{"uri", uri}, {"byteLength", 36}}}},
