@@ -1,0 +1,148 @@
+"""Blender materials as penumbra materials. What maps (docs/blender.md has the table):
+
+- Principled BSDF: Metallic >= 0.5 -> conductor (colour = Base Color, roughness);
+  Transmission >= 0.5 -> dielectric (IOR, roughness); Specular 0 -> diffuse; else plastic
+  (IOR from Specular: f0 = 0.08 * specular, the Principled convention, so 0.5 -> 1.5).
+  Emission x Emission Strength becomes the object's emission.
+- Diffuse BSDF -> diffuse; Glossy BSDF -> conductor; Glass BSDF -> dielectric;
+  Emission -> black diffuse with emission.
+- A colour from an Image Texture node (uv of the active map) -> a penumbra texture with the
+  image's colour space, interpolation (Closest -> nearest) and extension (Extend -> clamp).
+- Anything else (other shader nodes, linked inputs we do not read) -> grey diffuse (0.8, as
+  Blender's default material) or the input's unlinked value, with a warning in Blender's report.
+"""
+from __future__ import annotations
+
+import math
+from typing import Any, Dict, Optional, Tuple
+
+from .export_context import ExportContext
+from .image_export import colorspace, image_file
+
+DEFAULT_NAME = "__blender_default"
+DEFAULT = {"type": "diffuse", "color": [0.8, 0.8, 0.8]}
+
+
+def _clamp01(x: float) -> float:
+    return min(max(float(x), 0.0), 1.0)
+
+
+def _rgb(value) -> list:
+    return [_clamp01(value[0]), _clamp01(value[1]), _clamp01(value[2])]
+
+
+def _output_shader(material):
+    if not material.use_nodes or material.node_tree is None:
+        return None
+    outputs = [n for n in material.node_tree.nodes if n.bl_idname == "ShaderNodeOutputMaterial"]
+    active = [n for n in outputs if n.is_active_output] or outputs
+    for node in active:
+        socket = node.inputs.get("Surface")
+        if socket is not None and socket.is_linked:
+            return socket.links[0].from_node
+    return None
+
+
+class _Reader:
+    def __init__(self, ctx: ExportContext, material):
+        self.ctx, self.material = ctx, material
+        self.where = f"material '{material.name}'"
+
+    def value(self, node, name: str) -> float:
+        socket = node.inputs[name]
+        if socket.is_linked:
+            self.ctx.warn(f"{self.where}: '{node.name}' input '{name}' is linked to something "
+                          f"penumbra does not read; its own value {socket.default_value:.3g} "
+                          "is used")
+        return float(socket.default_value)
+
+    def color(self, node, name: str, scale=None) -> Any:
+        """An RGB list, or a texture dict for an Image Texture node."""
+        socket = node.inputs[name]
+        if socket.is_linked:
+            src = socket.links[0].from_node
+            if src.bl_idname == "ShaderNodeTexImage" and src.image is not None:
+                if src.inputs["Vector"].is_linked:
+                    self.ctx.warn(f"{self.where}: '{src.name}' has a linked Vector input; "
+                                  "penumbra reads the active uv map")
+                name_in_scene = image_file(self.ctx, src.image, self.where)
+                if name_in_scene is not None:
+                    tex = {"texture": name_in_scene}
+                    if not src.image.is_float:
+                        tex["colorspace"] = colorspace(src.image)
+                    if src.interpolation == "Closest":
+                        tex["filter"] = "nearest"
+                    if src.extension in ("EXTEND", "CLIP"):
+                        tex["wrap"] = "clamp"
+                    if scale is not None:
+                        tex["scale"] = scale
+                    return tex
+            else:
+                self.ctx.warn(f"{self.where}: '{name}' comes from '{src.name}' "
+                              f"({src.bl_idname}), which penumbra does not read; its own value "
+                              "is used")
+        return _rgb(socket.default_value)
+
+
+def export_material(ctx: ExportContext, material) -> Tuple[Dict[str, Any], Optional[list]]:
+    """(penumbra material, emission RGB or None) of a Blender material."""
+    r = _Reader(ctx, material)
+    shader = _output_shader(material)
+    if shader is None:
+        if material.use_nodes:
+            ctx.warn(f"{r.where}: no shader connected to the Material Output; grey diffuse")
+            return dict(DEFAULT), None
+        return {"type": "diffuse", "color": _rgb(material.diffuse_color)}, None
+    kind = shader.bl_idname
+    if kind == "ShaderNodeBsdfPrincipled":
+        return _principled(r, shader)
+    if kind == "ShaderNodeBsdfDiffuse":
+        return {"type": "diffuse", "color": r.color(shader, "Color")}, None
+    if kind == "ShaderNodeBsdfGlossy":
+        return {"type": "conductor", "color": r.color(shader, "Color"),
+                "roughness": _clamp01(r.value(shader, "Roughness"))}, None
+    if kind == "ShaderNodeBsdfGlass":
+        return {"type": "dielectric", "ior": max(r.value(shader, "IOR"), 1e-3),
+                "roughness": _clamp01(r.value(shader, "Roughness"))}, None
+    if kind == "ShaderNodeEmission":
+        strength = r.value(shader, "Strength")
+        color = shader.inputs["Color"].default_value
+        return {"type": "diffuse", "color": [0, 0, 0]}, \
+            [max(0.0, float(c)) * max(0.0, strength) for c in color[:3]]
+    ctx.warn(f"{r.where}: shader '{shader.name}' ({kind}) has no penumbra equivalent; "
+             "grey diffuse")
+    return dict(DEFAULT), None
+
+
+def _principled(r: _Reader, node) -> Tuple[Dict[str, Any], Optional[list]]:
+    base = r.color(node, "Base Color")
+    roughness = _clamp01(r.value(node, "Roughness"))
+    metallic = r.value(node, "Metallic")
+    transmission = r.value(node, "Transmission")
+    ior = max(r.value(node, "IOR"), 1e-3)
+    specular = r.value(node, "Specular")
+    if 0.0 < metallic < 1.0 or 0.0 < transmission < 1.0:
+        r.ctx.warn(f"{r.where}: Metallic {metallic:.2f} / Transmission {transmission:.2f} are "
+                   "rounded to 0 or 1 (penumbra has no blend of the two)")
+    if metallic >= 0.5:
+        material = {"type": "conductor", "color": base, "roughness": roughness}
+    elif transmission >= 0.5:
+        if isinstance(base, dict) or base != [1.0, 1.0, 1.0]:
+            r.ctx.warn(f"{r.where}: a glass's Base Color tints Cycles' transmission; penumbra's "
+                       "dielectric is clear")
+        material = {"type": "dielectric", "ior": ior, "roughness": roughness}
+    elif specular <= 0.0:
+        material = {"type": "diffuse", "color": base}
+    else:
+        # Principled: f0 = 0.08 * specular; f0 = ((n - 1) / (n + 1))^2 solved for n.
+        s = math.sqrt(min(0.08 * specular, 0.99))
+        material = {"type": "plastic", "color": base, "ior": (1 + s) / (1 - s),
+                    "roughness": roughness}
+    emission = None
+    strength = float(node.inputs["Emission Strength"].default_value)
+    color = node.inputs["Emission"].default_value
+    if strength > 0 and any(c > 0 for c in color[:3]):
+        if node.inputs["Emission"].is_linked:
+            r.ctx.warn(f"{r.where}: a linked Emission colour is read as its own value")
+        emission = [max(0.0, float(c)) * strength for c in color[:3]]
+    return material, emission

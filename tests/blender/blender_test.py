@@ -1,0 +1,280 @@
+"""The Blender add-on (clients/blender/penumbra_blender) inside Debian's Blender, headless,
+against a real `penumbra serve` ($PENUMBRA_BINARY) started here. Run by scripts/blender-test.sh:
+
+    blender -b --factory-startup --python-exit-code 1 --python tests/blender/blender_test.py
+
+For (1) Blender's default cube scene and (2) a scene built here (an image-textured plane, a
+glass sphere, an HDR world turned by a Mapping node, a sun), it renders with F12's operator
+through the add-on, then checks that
+- the render result holds what the server rendered: its Combined pass equals, bit for bit,
+  `penumbra render` of the scene folder the add-on's exporter writes (same seed), so the
+  multi-layer EXR went through RenderResult.load_from_file intact;
+- geometry and camera match Blender's own: the object mask of penumbra's Depth pass (< 1e9)
+  against the alpha (> 0) of Cycles rendering the same scene with a transparent film has an
+  IoU > 0.98 and differs only on silhouette edges.
+"""
+from __future__ import annotations
+
+import math
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import threading
+import unittest
+
+import bpy
+
+REPO = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
+BINARY = os.environ.get("PENUMBRA_BINARY", "penumbra")
+WIDTH, HEIGHT = 160, 120
+
+
+def channel_pixels(exr: str, channel: str, work: str) -> list:
+    """One channel of an EXR as a flat list (row 0 at the bottom, as Blender stores images)."""
+    single = os.path.join(work, re.sub(r"[^A-Za-z0-9]", "_", os.path.basename(exr) + channel)
+                          + ".exr")
+    # Renamed to R: Blender reads a file whose channel names have a layer prefix as multi-layer.
+    subprocess.run(["oiiotool", exr, "--ch", "R=" + channel, "-d", "float", "-o", single],
+                   check=True)
+    image = bpy.data.images.load(single)
+    try:
+        pixels = image.pixels[:]
+    finally:
+        bpy.data.images.remove(image)
+    return list(pixels[0::4])
+
+
+def extract(exr: str, channels: str, out: str) -> None:
+    subprocess.run(["oiiotool", exr, "--ch", channels, "-d", "float", "-o", out], check=True)
+
+
+class BlenderAddon(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.dir = tempfile.mkdtemp(prefix="penumbra-blender-test-")
+        cls.log = open(os.path.join(cls.dir, "server.log"), "w")
+        cls.server = subprocess.Popen(
+            [BINARY, "serve", "--port", "0", "--data-dir", os.path.join(cls.dir, "data"),
+             "--token", "blender-test-token"],
+            stdout=subprocess.PIPE, stderr=cls.log, text=True)
+        line = cls.server.stdout.readline()
+        match = re.search(r"listening on (http://\S+)", line)
+        if not match:
+            raise RuntimeError(f"penumbra serve did not start: {line!r}")
+        threading.Thread(target=cls.server.stdout.read, daemon=True).start()
+        # Farm-style configuration: the add-on's preferences are empty, the environment wins.
+        os.environ["PENUMBRA_URL"] = match.group(1)
+        os.environ["PENUMBRA_TOKEN"] = "blender-test-token"
+        sys.path.insert(0, os.path.join(REPO, "clients", "blender"))
+        bpy.ops.preferences.addon_enable(module="penumbra_blender")
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.server.terminate()
+        cls.server.wait(10)
+        cls.log.close()
+        if not os.environ.get("PENUMBRA_KEEP_TEST_DIR"):
+            shutil.rmtree(cls.dir, ignore_errors=True)
+
+    # -- helpers ---------------------------------------------------------------------------------
+    def setup_render(self, scene):
+        scene.render.resolution_x, scene.render.resolution_y = WIDTH, HEIGHT
+        scene.render.resolution_percentage = 100
+        scene.penumbra.samples = 8
+        scene.penumbra.seed = 7
+        bpy.context.view_layer.use_pass_z = True
+
+    def render_penumbra(self, scene, name):
+        """F12 with the add-on; the render result saved as a multi-layer float EXR."""
+        scene.render.engine = "PENUMBRA"
+        bpy.ops.render.render()
+        settings = scene.render.image_settings
+        settings.file_format = "OPEN_EXR_MULTILAYER"
+        settings.color_depth = "32"
+        path = os.path.join(self.dir, name + ".blender.exr")
+        bpy.data.images["Render Result"].save_render(path, scene=scene)
+        return path
+
+    def render_cli(self, name):
+        folder = os.path.join(self.dir, name + "-export")
+        bpy.ops.export_scene.penumbra(directory=folder)
+        out = os.path.join(self.dir, name + ".cli.exr")
+        subprocess.run([BINARY, "render", os.path.join(folder, "scene.json"), "-q",
+                        "--layout", "blender", "-o", out], check=True)
+        return out, folder
+
+    def render_cycles(self, scene, name):
+        scene.render.engine = "CYCLES"
+        scene.cycles.samples = scene.penumbra.samples
+        scene.cycles.use_denoising = False
+        scene.cycles.device = "CPU"
+        scene.render.film_transparent = True
+        settings = scene.render.image_settings
+        settings.file_format = "OPEN_EXR"
+        settings.color_mode = "RGBA"
+        settings.color_depth = "32"
+        scene.render.filepath = os.path.join(self.dir, name + ".cycles.exr")
+        bpy.ops.render.render(write_still=True)
+        return scene.render.filepath
+
+    def check_same_as_cli(self, blender_exr, cli_exr, name):
+        ours = os.path.join(self.dir, name + ".combined.blender.exr")
+        theirs = os.path.join(self.dir, name + ".combined.cli.exr")
+        rgb = ",".join(f"ViewLayer.Combined.{c}" for c in "RGB")
+        extract(blender_exr, rgb, ours)
+        extract(cli_exr, rgb, theirs)
+        diff = subprocess.run(["idiff", "-fail", "0", "-warn", "0", ours, theirs],
+                              capture_output=True, text=True)
+        self.assertEqual(diff.returncode, 0, f"{name}: F12 differs from `penumbra render` of "
+                         f"the exported scene:\n{diff.stdout}")
+        combined = channel_pixels(blender_exr, "ViewLayer.Combined.G", self.dir)
+        self.assertGreater(max(combined), 0.01, f"{name}: the render is black")
+
+    def check_silhouettes(self, blender_exr, cycles_exr, name):
+        depth = channel_pixels(blender_exr, "ViewLayer.Depth.Z", self.dir)
+        alpha = channel_pixels(cycles_exr, "A", self.dir)
+        self.assertEqual(len(depth), WIDTH * HEIGHT)
+        ours = [d < 1e9 for d in depth]
+        # penumbra's depth is averaged over the samples that hit, so a pixel any sample of which
+        # hits a surface is in its mask; Cycles' alpha is the covered fraction: > 0 is the same
+        # "any sample hit" mask (with as many samples), and only pixels the silhouette crosses
+        # can then disagree.
+        cycles = [a > 0.0 for a in alpha]
+        union = sum(1 for a, b in zip(ours, cycles) if a or b)
+        inter = sum(1 for a, b in zip(ours, cycles) if a and b)
+        self.assertGreater(union, WIDTH * HEIGHT // 50, f"{name}: hardly any object in view")
+        self.assertLess(inter, WIDTH * HEIGHT, f"{name}: no background in view")
+        iou = inter / union
+
+        def edge(i):  # a pixel next to a silhouette in Cycles' mask
+            x, y = i % WIDTH, i // WIDTH
+            around = [cycles[yy * WIDTH + xx] for yy in range(max(0, y - 1), min(HEIGHT, y + 2))
+                      for xx in range(max(0, x - 1), min(WIDTH, x + 2))]
+            return any(around) and not all(around)
+
+        inner = [i for i, (a, b) in enumerate(zip(ours, cycles)) if a != b and not edge(i)]
+        print(f"{name}: mask IoU {iou:.4f}, {sum(a != b for a, b in zip(ours, cycles))} pixels "
+              f"differ, {len(inner)} of them off the edges", file=sys.stderr)
+        self.assertGreater(iou, 0.98, f"{name}: silhouettes differ from Cycles' (IoU {iou:.4f})")
+        self.assertEqual(inner, [], f"{name}: pixels off the silhouette edges differ from "
+                         f"Cycles' (first: {inner[:5]})")
+
+    def run_scene(self, name):
+        scene = bpy.context.scene
+        self.setup_render(scene)
+        blender_exr = self.render_penumbra(scene, name)
+        cli_exr, _ = self.render_cli(name)
+        self.check_same_as_cli(blender_exr, cli_exr, name)
+        cycles_exr = self.render_cycles(scene, name)
+        self.check_silhouettes(blender_exr, cycles_exr, name)
+
+    # -- tests -----------------------------------------------------------------------------------
+    def test_1_default_cube(self):
+        bpy.ops.wm.read_factory_settings(use_empty=False)
+        bpy.ops.preferences.addon_enable(module="penumbra_blender")
+        self.run_scene("cube")
+
+    def test_2_textured_glass_hdr_world(self):
+        bpy.ops.wm.read_factory_settings(use_empty=False)
+        bpy.ops.preferences.addon_enable(module="penumbra_blender")
+        build_scene(self.dir)
+        self.run_scene("built")
+        folder = os.path.join(self.dir, "built-export")
+        import json
+        with open(os.path.join(folder, "scene.json")) as f:
+            doc = json.load(f)
+        types = sorted({m["type"] for m in doc["materials"].values()})
+        self.assertIn("dielectric", types)
+        self.assertTrue(any(isinstance(m.get("color"), dict) for m in doc["materials"].values()),
+                        "the image texture was not exported as a texture")
+        self.assertTrue(doc["environment"]["map"].endswith(".hdr"))
+        self.assertEqual(doc["lights"][0]["type"], "directional")
+
+
+def build_scene(work):
+    """An image-textured floor, a glass sphere, a cube, an HDR world turned by a Mapping node,
+    a sun; written images are files, as an artist's would be."""
+    for obj in list(bpy.data.objects):
+        if obj.type != "CAMERA":
+            bpy.data.objects.remove(obj)
+    scene = bpy.context.scene
+    # A checker texture, saved as a PNG file.
+    tex = bpy.data.images.new("checker", 32, 32)
+    px = []
+    for j in range(32):
+        for i in range(32):
+            on = ((i // 4) + (j // 4)) % 2
+            px += [0.9, 0.5, 0.1, 1.0] if on else [0.1, 0.3, 0.8, 1.0]
+    tex.pixels[:] = px
+    tex.filepath_raw = os.path.join(work, "checker.png")
+    tex.file_format = "PNG"
+    tex.save()
+    # An HDR sky: a vertical gradient with a bright band, saved as Radiance .hdr.
+    sky = bpy.data.images.new("sky", 64, 32, float_buffer=True)
+    px = []
+    for j in range(32):
+        for i in range(64):
+            t = j / 31
+            px += [0.2 + 0.6 * t, 0.3 + 0.5 * t, 0.5 + 0.5 * t + (4.0 if 10 < i < 14 else 0), 1]
+    sky.pixels[:] = px
+    sky.filepath_raw = os.path.join(work, "sky.hdr")
+    sky.file_format = "HDR"
+    sky.save()
+    sky_file = bpy.data.images.load(os.path.join(work, "sky.hdr"))
+    checker_file = bpy.data.images.load(os.path.join(work, "checker.png"))
+
+    bpy.ops.mesh.primitive_plane_add(size=8, location=(0, 0, 0))
+    floor = bpy.context.active_object
+    mat = bpy.data.materials.new("floor")
+    mat.use_nodes = True
+    bsdf = mat.node_tree.nodes["Principled BSDF"]
+    image_node = mat.node_tree.nodes.new("ShaderNodeTexImage")
+    image_node.image = checker_file
+    mat.node_tree.links.new(image_node.outputs["Color"], bsdf.inputs["Base Color"])
+    floor.data.materials.append(mat)
+
+    bpy.ops.mesh.primitive_uv_sphere_add(radius=1, location=(-0.6, 0.5, 1), segments=48,
+                                         ring_count=24)
+    sphere = bpy.context.active_object
+    bpy.ops.object.shade_smooth()
+    glass = bpy.data.materials.new("glass")
+    glass.use_nodes = True
+    g = glass.node_tree.nodes["Principled BSDF"]
+    g.inputs["Transmission"].default_value = 1.0
+    g.inputs["Roughness"].default_value = 0.0
+    g.inputs["IOR"].default_value = 1.5
+    sphere.data.materials.append(glass)
+
+    bpy.ops.mesh.primitive_cube_add(size=0.8, location=(1.4, -0.4, 0.4),
+                                    rotation=(0, 0, math.radians(30)))
+
+    bpy.ops.object.light_add(type="SUN", rotation=(math.radians(40), 0, math.radians(30)))
+    bpy.context.active_object.data.energy = 3.0
+
+    world = scene.world
+    world.use_nodes = True
+    nodes = world.node_tree.nodes
+    env = nodes.new("ShaderNodeTexEnvironment")
+    env.image = sky_file
+    mapping = nodes.new("ShaderNodeMapping")
+    mapping.inputs["Rotation"].default_value = (0, 0, math.radians(30))
+    coords = nodes.new("ShaderNodeTexCoord")
+    world.node_tree.links.new(coords.outputs["Generated"], mapping.inputs["Vector"])
+    world.node_tree.links.new(mapping.outputs["Vector"], env.inputs["Vector"])
+    world.node_tree.links.new(env.outputs["Color"], nodes["Background"].inputs["Color"])
+    nodes["Background"].inputs["Strength"].default_value = 1.0
+
+    cam = scene.camera
+    cam.location = (6.5, -6.0, 4.2)
+    cam.data.lens = 40
+    direction = -cam.location
+    cam.rotation_euler = direction.to_track_quat("-Z", "Y").to_euler()
+
+
+if __name__ == "__main__":
+    argv = [sys.argv[0]] + (sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else [])
+    result = unittest.main(argv=argv, exit=False, verbosity=2).result
+    sys.exit(0 if result.wasSuccessful() else 1)
