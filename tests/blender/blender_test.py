@@ -113,8 +113,7 @@ class BlenderAddon(unittest.TestCase):
         scene.cycles.device = "CPU"
         scene.render.film_transparent = True
         settings = scene.render.image_settings
-        settings.file_format = "OPEN_EXR"
-        settings.color_mode = "RGBA"
+        settings.file_format = "OPEN_EXR_MULTILAYER"
         settings.color_depth = "32"
         scene.render.filepath = os.path.join(self.dir, name + ".cycles.exr")
         bpy.ops.render.render(write_still=True)
@@ -135,7 +134,8 @@ class BlenderAddon(unittest.TestCase):
 
     def check_silhouettes(self, blender_exr, cycles_exr, name):
         depth = channel_pixels(blender_exr, "ViewLayer.Depth.Z", self.dir)
-        alpha = channel_pixels(cycles_exr, "A", self.dir)
+        alpha = channel_pixels(cycles_exr, "ViewLayer.Combined.A", self.dir)
+        cycles_depth = channel_pixels(cycles_exr, "ViewLayer.Depth.Z", self.dir)
         self.assertEqual(len(depth), WIDTH * HEIGHT)
         ours = [d < 1e9 for d in depth]
         # penumbra's depth is averaged over the samples that hit, so a pixel any sample of which
@@ -161,6 +161,25 @@ class BlenderAddon(unittest.TestCase):
         self.assertGreater(iou, 0.98, f"{name}: silhouettes differ from Cycles' (IoU {iou:.4f})")
         self.assertEqual(inner, [], f"{name}: pixels off the silhouette edges differ from "
                          f"Cycles' (first: {inner[:5]})")
+
+        # Inside the silhouettes (where one object in front of another does not show in a
+        # mask) the z-depths agree, away from depth discontinuities.
+        def smooth(i):
+            x, y = i % WIDTH, i // WIDTH
+            around = [cycles_depth[yy * WIDTH + xx]
+                      for yy in range(max(0, y - 1), min(HEIGHT, y + 2))
+                      for xx in range(max(0, x - 1), min(WIDTH, x + 2))]
+            return max(around) < 1e9 and max(around) < 1.03 * min(around)
+
+        checked = [i for i in range(WIDTH * HEIGHT) if ours[i] and cycles[i] and smooth(i)]
+        wrong = [i for i in checked
+                 if abs(depth[i] - cycles_depth[i]) > 0.01 * cycles_depth[i]]
+        print(f"{name}: depth checked at {len(checked)} pixels, {len(wrong)} differ by > 1 %",
+              file=sys.stderr)
+        self.assertGreater(len(checked), WIDTH * HEIGHT // 20)
+        self.assertLess(len(wrong), max(3, len(checked) // 200),
+                        f"{name}: z-depth differs from Cycles' at {len(wrong)} pixels "
+                        f"(first: {[(i, depth[i], cycles_depth[i]) for i in wrong[:3]]})")
 
     def run_scene(self, name):
         scene = bpy.context.scene
