@@ -7,8 +7,8 @@ For (1) Blender's default cube scene and (2) a scene built here (an image-textur
 glass sphere, an HDR world turned by a Mapping node, a sun), it renders with F12's operator
 through the add-on, then checks that
 - the render result holds what the server rendered: its Combined pass equals, bit for bit,
-  `penumbra render` of the scene folder the add-on's exporter writes (same seed), so the
-  multi-layer EXR went through RenderResult.load_from_file intact;
+  `penumbra render` of the scene F12 submitted (kept by $PENUMBRA_KEEP_EXPORT; same seed), so
+  the multi-layer EXR went through RenderResult.load_from_file intact;
 - geometry and camera match Blender's own: the object mask of penumbra's Depth pass (< 1e9)
   against the alpha (> 0) of Cycles rendering the same scene with a transparent film has an
   IoU > 0.98 and differs only on silhouette edges.
@@ -90,7 +90,12 @@ class BlenderAddon(unittest.TestCase):
     def render_penumbra(self, scene, name):
         """F12 with the add-on; the render result saved as a multi-layer float EXR."""
         scene.render.engine = "PENUMBRA"
-        bpy.ops.render.render()
+        # The engine keeps a copy of exactly what it submitted, for render_cli.
+        os.environ["PENUMBRA_KEEP_EXPORT"] = os.path.join(self.dir, name + "-submitted")
+        try:
+            bpy.ops.render.render()
+        finally:
+            del os.environ["PENUMBRA_KEEP_EXPORT"]
         settings = scene.render.image_settings
         settings.file_format = "OPEN_EXR_MULTILAYER"
         settings.color_depth = "32"
@@ -99,19 +104,19 @@ class BlenderAddon(unittest.TestCase):
         return path
 
     def render_cli(self, name):
-        folder = os.path.join(self.dir, name + "-export")
-        bpy.ops.export_scene.penumbra(directory=folder)
+        """`penumbra render` of the scene F12 submitted."""
+        folder = os.path.join(self.dir, name + "-submitted")
         out = os.path.join(self.dir, name + ".cli.exr")
         subprocess.run([BINARY, "render", os.path.join(folder, "scene.json"), "-q",
                         "--layout", "blender", "-o", out], check=True)
         return out, folder
 
-    def render_cycles(self, scene, name):
+    def render_cycles(self, scene, name, transparent=True):
         scene.render.engine = "CYCLES"
         scene.cycles.samples = scene.penumbra.samples
         scene.cycles.use_denoising = False
         scene.cycles.device = "CPU"
-        scene.render.film_transparent = True
+        scene.render.film_transparent = transparent
         settings = scene.render.image_settings
         settings.file_format = "OPEN_EXR_MULTILAYER"
         settings.color_depth = "32"
@@ -201,7 +206,7 @@ class BlenderAddon(unittest.TestCase):
         bpy.ops.preferences.addon_enable(module="penumbra_blender")
         build_scene(self.dir)
         self.run_scene("built")
-        folder = os.path.join(self.dir, "built-export")
+        folder = os.path.join(self.dir, "built-submitted")
         import json
         with open(os.path.join(folder, "scene.json")) as f:
             doc = json.load(f)
@@ -211,6 +216,163 @@ class BlenderAddon(unittest.TestCase):
                         "the image texture was not exported as a texture")
         self.assertTrue(doc["environment"]["map"].endswith(".hdr"))
         self.assertEqual(doc["lights"][0]["type"], "directional")
+
+    def test_3_world_orientation_against_cycles(self):
+        """An environment map turned by a Mapping node, seen through a wide lens: penumbra's
+        image of it is Cycles' (orientation of the map, the rotation, the field of view)."""
+        bpy.ops.wm.read_factory_settings(use_empty=False)
+        bpy.ops.preferences.addon_enable(module="penumbra_blender")
+        scene = bpy.context.scene
+        for obj in list(bpy.data.objects):
+            if obj.type != "CAMERA":
+                bpy.data.objects.remove(obj)
+        # Smooth in both directions and periodic in u, so texel conventions do not matter.
+        sky = bpy.data.images.new("smooth_sky", 64, 32, float_buffer=True)
+        px = []
+        for j in range(32):
+            for i in range(64):
+                u, v = (i + 0.5) / 64, (j + 0.5) / 32
+                px += [0.5 + 0.4 * math.cos(2 * math.pi * u), 0.5 + 0.4 * math.sin(2 * math.pi * u),
+                       v, 1.0]
+        sky.pixels[:] = px
+        sky.filepath_raw = os.path.join(self.dir, "smooth_sky.hdr")
+        sky.file_format = "HDR"
+        sky.save()
+        nodes = scene.world.node_tree.nodes
+        env = nodes.new("ShaderNodeTexEnvironment")
+        env.image = bpy.data.images.load(sky.filepath_raw)
+        mapping = nodes.new("ShaderNodeMapping")
+        mapping.inputs["Rotation"].default_value = (0, math.radians(10), math.radians(50))
+        links = scene.world.node_tree.links
+        links.new(nodes.new("ShaderNodeTexCoord").outputs["Generated"], mapping.inputs["Vector"])
+        links.new(mapping.outputs["Vector"], env.inputs["Vector"])
+        links.new(env.outputs["Color"], nodes["Background"].inputs["Color"])
+        nodes["Background"].inputs["Strength"].default_value = 1.5
+        scene.camera.data.lens = 16
+        scene.view_settings.view_transform = "Standard"
+        self.setup_render(scene)
+        ours = self.render_penumbra(scene, "sky")
+        cycles = self.render_cycles(scene, "sky", transparent=False)
+        worst = []
+        for c in "RGB":
+            a = channel_pixels(ours, "ViewLayer.Combined." + c, self.dir)
+            b = channel_pixels(cycles, "ViewLayer.Combined." + c, self.dir)
+            diffs = sorted(abs(x - y) for x, y in zip(a, b))
+            worst.append((c, sum(diffs) / len(diffs), diffs[int(0.99 * len(diffs))]))
+        print(f"sky: (channel, mean, 99th percentile of |penumbra - Cycles|): {worst}",
+              file=sys.stderr)
+        for c, mean, p99 in worst:
+            self.assertLess(mean, 0.02, f"sky {c}: mean difference {mean:.4f} from Cycles")
+            self.assertLess(p99, 0.06, f"sky {c}: 99th percentile difference {p99:.4f}")
+
+    def test_4_motion_depth_of_field_area_light(self):
+        """Keyframed motion becomes velocity and acceleration, Blender's shutter the camera's;
+        the f-stop an aperture radius; an area light an emitting quad. F12 still renders what
+        the exported scene renders with the CLI."""
+        bpy.ops.wm.read_factory_settings(use_empty=False)
+        bpy.ops.preferences.addon_enable(module="penumbra_blender")
+        scene = bpy.context.scene
+        cube = bpy.data.objects["Cube"]
+        for frame, x in ((0, -1.0), (1, 0.0), (2, 1.5)):
+            cube.location = (x, 0, 0)
+            cube.keyframe_insert("location", frame=frame)
+        scene.frame_set(1)
+        scene.render.use_motion_blur = True
+        scene.render.motion_blur_shutter = 0.5
+        cam = scene.camera.data
+        cam.dof.use_dof = True
+        cam.dof.aperture_fstop = 2.8
+        cam.dof.focus_distance = 7.0
+        cam.lens = 50
+        bpy.ops.object.light_add(type="AREA", location=(0, 0, 3))
+        area = bpy.context.active_object.data
+        area.shape = "RECTANGLE"
+        area.size, area.size_y, area.energy = 1.0, 0.5, 100.0
+        self.setup_render(scene)
+        blender_exr = self.render_penumbra(scene, "motion")
+        cli_exr, folder = self.render_cli("motion")
+        self.check_same_as_cli(blender_exr, cli_exr, "motion")
+        import json
+        with open(os.path.join(folder, "scene.json")) as f:
+            doc = json.load(f)
+        moving = [o for o in doc["objects"] if "velocity" in o]
+        self.assertEqual(len(moving), 1)
+        for got, want in zip(moving[0]["velocity"] + moving[0]["acceleration"],
+                             [1.25, 0, 0, 0.5, 0, 0]):
+            self.assertAlmostEqual(got, want, places=5)
+        self.assertEqual(doc["camera"]["shutter"], [-0.25, 0.25])
+        self.assertAlmostEqual(doc["camera"]["aperture_radius"], 0.05 / (2 * 2.8), places=6)
+        self.assertAlmostEqual(doc["camera"]["focus_distance"], 7.0, places=5)
+        # File > Export writes the same scene (evaluating frames with Scene.frame_set where the
+        # engine uses RenderEngine.frame_set), and it renders on its own.
+        exported = os.path.join(self.dir, "motion-export")
+        bpy.ops.export_scene.penumbra(directory=exported)
+        with open(os.path.join(exported, "scene.json")) as f:
+            self.assertEqual(json.load(f), doc)
+        quads = [o for o in doc["objects"] if o["type"] == "quad"]
+        self.assertEqual(len(quads), 1)
+        q = quads[0]
+        normal = [q["u"][1] * q["v"][2] - q["u"][2] * q["v"][1],
+                  q["u"][2] * q["v"][0] - q["u"][0] * q["v"][2],
+                  q["u"][0] * q["v"][1] - q["u"][1] * q["v"][0]]
+        self.assertAlmostEqual(normal[2], -0.5, places=5)  # emits downwards, area 0.5
+        self.assertAlmostEqual(q["emission"][0], 100 / (math.pi * 0.5), places=3)
+
+    def test_5_preview_and_cancel(self):
+        """The engine's job follower against a long job: it loads progressive previews into the
+        render result and, when Blender asks to stop (test_break), cancels the job on the
+        server."""
+        from penumbra_blender.client_import import load_client
+        from penumbra_blender.engine import PenumbraRenderEngine
+        penumbra = load_client()
+        client = penumbra.Client()
+        scene = {"version": 1, "render": {"width": 200, "height": 150, "spp": 1 << 16},
+                 "camera": {"position": [0, 0, 4], "look_at": [0, 0, 0]},
+                 "environment": {"radiance": [0.5, 0.6, 0.7]},
+                 "materials": {"m": {"type": "dielectric", "roughness": 0.3}},
+                 "objects": [{"type": "sphere", "center": [0, 0, 0], "radius": 1,
+                              "material": "m"}]}
+        job = client.submit(scene)
+
+        class Layer:
+            loaded = []
+
+            def load_from_file(self, path):
+                with open(path, "rb") as f:
+                    self.loaded.append(f.read(8))
+
+        class Result:
+            layers = [Layer()]
+
+        class FakeEngine:  # what _follow uses of a RenderEngine
+            stats = []
+
+            def test_break(self):
+                return len(Layer.loaded) >= 2
+
+            def update_progress(self, fraction):
+                pass
+
+            def update_stats(self, a, b):
+                self.stats.append(b)
+
+            def update_result(self, result):
+                pass
+
+            def report(self, kind, text):
+                raise AssertionError(text)
+
+            _show_preview = PenumbraRenderEngine._show_preview
+
+        work = tempfile.mkdtemp(dir=self.dir)
+        record = PenumbraRenderEngine._follow(FakeEngine(), client, penumbra, job["id"],
+                                              Result(), work)
+        self.assertIsNone(record, "the follower did not stop on test_break")
+        self.assertTrue(all(head.startswith(b"\x89PNG") for head in Layer.loaded))
+        self.assertGreaterEqual(len(Layer.loaded), 2)
+        final = client.wait(job["id"], progress=False, check=False, timeout=30)
+        self.assertEqual(final["state"], "cancelled")
+        self.assertTrue(any("running" in s for s in FakeEngine.stats), FakeEngine.stats)
 
 
 def build_scene(work):

@@ -15,7 +15,7 @@ import bpy
 from . import preferences
 from .camera_export import image_size
 from .client_import import load_client
-from .scene_export import export_scene
+from .scene_export import export_scene, write_scene
 
 PREVIEW_INTERVAL = 1.0  # seconds between preview downloads
 
@@ -64,6 +64,9 @@ class PenumbraRenderEngine(bpy.types.RenderEngine):
                                 frame_set=self.frame_set)
         for warning in ctx.warnings:
             self.report({"WARNING"}, warning)
+        keep = os.environ.get("PENUMBRA_KEEP_EXPORT")
+        if keep:
+            keep_export(doc, ctx.files, keep)
         client = penumbra.Client(url, token=token)
         self.update_stats("penumbra", f"Uploading to {client.url}")
         job = client.submit(doc, assets=ctx.files)
@@ -143,6 +146,18 @@ class PenumbraRenderEngine(bpy.types.RenderEngine):
             f.write(data)
         result.layers[0].load_from_file(path)
         self.update_result(result)
+
+
+def keep_export(doc, files, folder) -> None:
+    """$PENUMBRA_KEEP_EXPORT: a copy of exactly what is submitted (scene.json and its files) in
+    a folder `penumbra render` renders on its own. A second export (the Export operator) may
+    differ in the last bits of smooth normals, which Blender computes in parallel."""
+    os.makedirs(folder, exist_ok=True)
+    for name, source in files.items():
+        target = os.path.join(folder, *name.split("/"))
+        os.makedirs(os.path.dirname(target), exist_ok=True)
+        shutil.copyfile(source, target)
+    write_scene(doc, folder)
 
 
 def _describe(error) -> str:
