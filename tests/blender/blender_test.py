@@ -215,6 +215,19 @@ class BlenderAddon(unittest.TestCase):
         self.assertTrue(any(isinstance(m.get("color"), dict) for m in doc["materials"].values()),
                         "the image texture was not exported as a texture")
         self.assertTrue(doc["environment"]["map"].endswith(".hdr"))
+        # The checker lands where Cycles puts it (uv orientation, the image's rows): on the
+        # floor, orange (R > B) and blue squares agree pixel by pixel but for edges and noise.
+        ours = [channel_pixels(os.path.join(self.dir, "built.blender.exr"),
+                               f"ViewLayer.Combined.{c}", self.dir) for c in "RB"]
+        cycles = [channel_pixels(os.path.join(self.dir, "built.cycles.exr"),
+                                 f"ViewLayer.Combined.{c}", self.dir) for c in "RB"]
+        floor = [i for i in range(WIDTH * HEIGHT) if abs(ours[0][i] - ours[1][i]) > 0.05
+                 and abs(cycles[0][i] - cycles[1][i]) > 0.05]
+        agree = sum(1 for i in floor if (ours[0][i] > ours[1][i]) == (cycles[0][i] > cycles[1][i]))
+        print(f"built: checker colour agrees with Cycles at {agree} of {len(floor)} pixels",
+              file=sys.stderr)
+        self.assertGreater(len(floor), WIDTH * HEIGHT // 4)
+        self.assertGreater(agree, 0.9 * len(floor), "the texture is not where Cycles puts it")
         self.assertEqual(doc["lights"][0]["type"], "directional")
 
     def test_3_world_orientation_against_cycles(self):
