@@ -329,7 +329,7 @@ class BlenderAddon(unittest.TestCase):
                   q["u"][2] * q["v"][0] - q["u"][0] * q["v"][2],
                   q["u"][0] * q["v"][1] - q["u"][1] * q["v"][0]]
         self.assertAlmostEqual(normal[2], -0.5, places=5)  # emits downwards, area 0.5
-        self.assertAlmostEqual(q["emission"][0], 100 / (math.pi * 0.5), places=3)
+        self.assertAlmostEqual(q["emission"][0], 100 / (4 * 0.5), places=3)
 
     def test_5_preview_and_cancel(self):
         """The engine's job follower against a long job: it loads progressive previews into the
@@ -386,6 +386,50 @@ class BlenderAddon(unittest.TestCase):
         final = client.wait(job["id"], progress=False, check=False, timeout=30)
         self.assertEqual(final["state"], "cancelled")
         self.assertTrue(any("running" in s for s in FakeEngine.stats), FakeEngine.stats)
+
+    def test_6_light_units_against_cycles(self):
+        """Point, sun and area lights over a white diffuse floor: the floor is as bright in
+        penumbra as in Cycles (Blender's Watts and W/m^2 converted as docs/blender.md says)."""
+        for kind, setup in (("POINT", {"energy": 300.0, "shadow_soft_size": 0.0}),
+                            ("SUN", {"energy": 2.0, "angle": 0.0}),
+                            ("AREA", {"energy": 200.0, "size": 1.0})):
+            bpy.ops.wm.read_factory_settings(use_empty=False)
+            bpy.ops.preferences.addon_enable(module="penumbra_blender")
+            scene = bpy.context.scene
+            for obj in list(bpy.data.objects):
+                if obj.type != "CAMERA":
+                    bpy.data.objects.remove(obj)
+            scene.world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
+            bpy.ops.mesh.primitive_plane_add(size=6)
+            mat = bpy.data.materials.new("white")
+            mat.use_nodes = True
+            out = mat.node_tree.nodes["Material Output"]
+            diffuse = mat.node_tree.nodes.new("ShaderNodeBsdfDiffuse")
+            diffuse.inputs["Color"].default_value = (0.8, 0.8, 0.8, 1)
+            mat.node_tree.links.new(diffuse.outputs[0], out.inputs["Surface"])
+            bpy.context.active_object.data.materials.append(mat)
+            # Outside the view: penumbra's area light is an emitting quad, which (unlike
+            # Cycles' light) the camera would see from behind, dark, over the floor.
+            bpy.ops.object.light_add(type=kind, location=(0.0, 3.0, 1.5),
+                                     rotation=(math.radians(-40), 0, 0))
+            light = bpy.context.active_object.data
+            for key, value in setup.items():
+                setattr(light, key, value)
+            scene.camera.location = (0, 0, 6)
+            scene.camera.rotation_euler = (0, 0, 0)
+            scene.view_settings.view_transform = "Standard"
+            self.setup_render(scene)
+            scene.render.resolution_x, scene.render.resolution_y = 64, 48
+            scene.penumbra.samples = 32
+            scene.cycles.max_bounces = 1  # one bounce: the floor cannot light itself anyway
+            ours = self.render_penumbra(scene, "light-" + kind)
+            cycles = self.render_cycles(scene, "light-" + kind, transparent=False)
+            a = channel_pixels(ours, "ViewLayer.Combined.G", self.dir)
+            b = channel_pixels(cycles, "ViewLayer.Combined.G", self.dir)
+            ratio = sum(a) / sum(b)
+            print(f"light {kind}: penumbra / Cycles mean brightness {ratio:.4f}", file=sys.stderr)
+            self.assertAlmostEqual(ratio, 1.0, delta=0.05, msg=f"{kind} light: brightness "
+                                   f"{ratio:.3f} x Cycles'")
 
 
 def build_scene(work):
