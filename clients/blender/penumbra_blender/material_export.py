@@ -138,6 +138,7 @@ def _principled(r: _Reader, node) -> Tuple[Dict[str, Any], Optional[list]]:
         s = math.sqrt(min(0.08 * specular, 0.99))
         material = {"type": "plastic", "color": base, "ior": (1 + s) / (1 - s),
                     "roughness": roughness}
+    _warn_unread(r, node)
     emission = None
     strength = float(node.inputs["Emission Strength"].default_value)
     color = node.inputs["Emission"].default_value
@@ -146,3 +147,17 @@ def _principled(r: _Reader, node) -> Tuple[Dict[str, Any], Optional[list]]:
             r.ctx.warn(f"{r.where}: a linked Emission colour is read as its own value")
         emission = [max(0.0, float(c)) * strength for c in color[:3]]
     return material, emission
+
+
+# Principled inputs penumbra has no counterpart for, with the value at which they do nothing.
+_UNREAD = (("Subsurface", 0.0), ("Sheen", 0.0), ("Clearcoat", 0.0), ("Alpha", 1.0))
+
+
+def _warn_unread(r: _Reader, node) -> None:
+    for name, neutral in _UNREAD:
+        socket = node.inputs.get(name)
+        if socket is not None and (socket.is_linked or float(socket.default_value) != neutral):
+            r.ctx.warn(f"{r.where}: Principled '{name}' is ignored")
+    normal = node.inputs.get("Normal")
+    if normal is not None and normal.is_linked:
+        r.ctx.warn(f"{r.where}: a linked Normal (normal or bump map) is ignored")
