@@ -431,6 +431,67 @@ class BlenderAddon(unittest.TestCase):
             self.assertAlmostEqual(ratio, 1.0, delta=0.05, msg=f"{kind} light: brightness "
                                    f"{ratio:.3f} x Cycles'")
 
+    def test_7_fallbacks_preferences_and_errors(self):
+        """A shader penumbra lacks becomes grey diffuse with a warning; the preferences win over
+        the environment; a wrong token or an unreachable server is a Blender error, not a
+        crash or a hang."""
+        bpy.ops.wm.read_factory_settings(use_empty=False)
+        bpy.ops.preferences.addon_enable(module="penumbra_blender")
+        from penumbra_blender.scene_export import export_scene
+        scene = bpy.context.scene
+        toon = bpy.data.materials.new("toon")
+        toon.use_nodes = True
+        nodes = toon.node_tree.nodes
+        toon.node_tree.links.new(nodes.new("ShaderNodeBsdfToon").outputs[0],
+                                 nodes["Material Output"].inputs["Surface"])
+        bpy.data.objects["Cube"].data.materials[0] = toon
+        folder = tempfile.mkdtemp(dir=self.dir)
+        doc, ctx = export_scene(bpy.context.evaluated_depsgraph_get(), folder, samples=4,
+                                integrator="path")
+        self.assertEqual(doc["materials"]["toon"], {"type": "diffuse", "color": [0.8, 0.8, 0.8]})
+        self.assertTrue(any("toon" in w and "grey diffuse" in w for w in ctx.warnings),
+                        ctx.warnings)
+
+        self.setup_render(scene)
+        scene.render.engine = "PENUMBRA"
+        prefs = bpy.context.preferences.addons["penumbra_blender"].preferences
+        url = os.environ["PENUMBRA_URL"]
+        saved = dict(os.environ)
+        try:
+            # Preferences first: the environment names a dead server, the preference the real one.
+            os.environ["PENUMBRA_URL"] = "http://127.0.0.1:9"
+            prefs.server_url = url
+            bpy.ops.render.render()
+            self.assertGreater(self.combined_max(scene, "prefs"), 0.01)
+            # A wrong token: an error naming the refusal, and no image.
+            prefs.token = "wrong-token"
+            with self.assertRaises(RuntimeError) as refused:
+                self.render_expecting_error(scene)
+            self.assertIn("401", str(refused.exception))
+            # Nothing listening.
+            prefs.token = ""
+            prefs.server_url = "http://127.0.0.1:9"
+            with self.assertRaises(RuntimeError) as unreachable:
+                self.render_expecting_error(scene)
+            self.assertIn("127.0.0.1:9", str(unreachable.exception))
+        finally:
+            prefs.server_url = ""
+            prefs.token = ""
+            os.environ.clear()
+            os.environ.update(saved)
+
+    def render_expecting_error(self, scene):
+        bpy.ops.render.render()
+        raise AssertionError("the render reported no error")
+
+    def combined_max(self, scene, name):
+        settings = scene.render.image_settings
+        settings.file_format = "OPEN_EXR_MULTILAYER"
+        settings.color_depth = "32"
+        path = os.path.join(self.dir, name + ".blender.exr")
+        bpy.data.images["Render Result"].save_render(path, scene=scene)
+        return max(channel_pixels(path, "ViewLayer.Combined.G", self.dir))
+
 
 def build_scene(work):
     """An image-textured floor, a glass sphere, a cube, an HDR world turned by a Mapping node,
