@@ -492,6 +492,43 @@ class BlenderAddon(unittest.TestCase):
         bpy.data.images["Render Result"].save_render(path, scene=scene)
         return max(channel_pixels(path, "ViewLayer.Combined.G", self.dir))
 
+    def test_8_linked_duplicates_and_collection_instances(self):
+        """Objects sharing a mesh (linked duplicates, a collection instanced twice) become one
+        mesh file and penumbra `instances`: same image as the CLI, same silhouettes as Cycles."""
+        bpy.ops.wm.read_factory_settings(use_empty=False)
+        bpy.ops.preferences.addon_enable(module="penumbra_blender")
+        scene = bpy.context.scene
+        cube = bpy.data.objects["Cube"]
+        for k, (x, y, angle, scale) in enumerate(((2.4, 0.5, 0.5, 0.6), (-2.2, -0.6, -0.3, 0.8),
+                                                  (0.3, 2.5, 1.0, -0.5))):
+            dup = bpy.data.objects.new(f"Cube.linked{k}", cube.data)
+            dup.location, dup.rotation_euler = (x, y, 0.3 * k), (0.2 * k, 0, angle)
+            dup.scale = (scale, abs(scale), abs(scale))  # the last one is mirrored
+            scene.collection.objects.link(dup)
+        rocks = bpy.data.collections.new("Rocks")
+        bpy.ops.mesh.primitive_ico_sphere_add(radius=0.5, location=(0, 0, 0))
+        rock = bpy.context.active_object
+        for collection in rock.users_collection:
+            collection.objects.unlink(rock)
+        rocks.objects.link(rock)
+        for k, location in enumerate(((1.5, -2.0, -0.5), (-1.0, -2.5, 1.2))):
+            holder = bpy.data.objects.new(f"RockInstance{k}", None)
+            holder.instance_type = "COLLECTION"
+            holder.instance_collection = rocks
+            holder.location = location
+            scene.collection.objects.link(holder)
+        scene.camera.location = (9, -8, 6.5)
+        self.run_scene("instances")
+        import json
+        with open(os.path.join(self.dir, "instances-submitted", "scene.json")) as f:
+            doc = json.load(f)
+        kinds = [o["type"] for o in doc["objects"]]
+        self.assertEqual(kinds.count("mesh"), 2, kinds)
+        copies = sorted(len(o["transforms"]) for o in doc["objects"] if o["type"] == "instances")
+        self.assertEqual(copies, [1, 3])
+        meshes = os.listdir(os.path.join(self.dir, "instances-submitted", "meshes"))
+        self.assertEqual(len(meshes), 2, meshes)
+
 
 def build_scene(work):
     """An image-textured floor, a glass sphere, a cube, an HDR world turned by a Mapping node,

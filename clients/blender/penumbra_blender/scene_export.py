@@ -26,6 +26,27 @@ def _matrix_rows(m) -> list:
     return [float(m[r][c]) for r in range(4) for c in range(4)]
 
 
+def _relative(rows: list, base: list) -> list:
+    """rows . base^-1 for affine 4x4 row-major matrices, in double precision (Blender's own
+    matrices are single precision)."""
+    a = [base[0:3], base[4:7], base[8:11]]
+    t = [base[3], base[7], base[11]]
+    det = (a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1])
+           - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0])
+           + a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]))
+    inv = [[(a[(j + 1) % 3][(i + 1) % 3] * a[(j + 2) % 3][(i + 2) % 3]
+             - a[(j + 1) % 3][(i + 2) % 3] * a[(j + 2) % 3][(i + 1) % 3]) / det
+            for j in range(3)] for i in range(3)]
+    inv_t = [-sum(inv[i][j] * t[j] for j in range(3)) for i in range(3)]
+    m = [rows[0:4], rows[4:8], rows[8:12]]
+    out = []
+    for i in range(3):
+        for j in range(3):
+            out.append(sum(m[i][k] * inv[k][j] for k in range(3)))
+        out.append(sum(m[i][k] * inv_t[k] for k in range(3)) + m[i][3])
+    return out + [0.0, 0.0, 0.0, 1.0]
+
+
 def export_scene(depsgraph, folder: str, *, samples: int, integrator: str, seed: int = 0,
                  max_depth: int = 8, copy_assets: bool = True,
                  frame_set: Optional[FrameSet] = None) -> Tuple[Dict[str, Any], ExportContext]:
@@ -52,7 +73,8 @@ def export_scene(depsgraph, folder: str, *, samples: int, integrator: str, seed:
     materials: Dict[str, Any] = {}
     emissions: Dict[str, Optional[list]] = {}
     objects, lights = [], []
-    mesh_files: Dict[str, list] = {}
+    placements: Dict[tuple, list] = {}  # insertion-ordered: objects keep the depsgraph's order
+    first_index: Dict[int, int] = {}
 
     def material_for(obj, index: int) -> Tuple[str, Optional[list]]:
         slots = obj.material_slots
@@ -82,18 +104,39 @@ def export_scene(depsgraph, folder: str, *, samples: int, integrator: str, seed:
         if abs(matrix.determinant()) < 1e-18:
             ctx.warn(f"object '{obj.name}': zero scale, skipped")
             continue
-        files = mesh_files.get(obj.name)
-        if files is None:
-            files = mesh_files[obj.name] = export_mesh_data(ctx, obj, obj.name)
-        for material_index, name in files:
-            mat_name, emission = material_for(obj, material_index)
-            entry: Dict[str, Any] = {"type": "mesh", "file": name, "material": mat_name,
-                                     "transform": {"matrix": _matrix_rows(matrix)}}
-            if emission:
-                entry["emission"] = emission
-            if not inst.is_instance and obj.name in motion:
-                entry["velocity"], entry["acceleration"] = motion[obj.name]
-            objects.append(entry)
+        # Objects that share their evaluated mesh (linked duplicates without modifiers,
+        # collection and particle instances) and materials share one file.
+        mesh_key = obj.data.name if obj.type == "MESH" and not obj.modifiers else obj.name
+        key = (obj.type, mesh_key, tuple(slot.material.name if slot.material else ""
+                                         for slot in obj.material_slots))
+        moving = None if inst.is_instance else motion.get(obj.name)
+        placements.setdefault(key, []).append((obj, _matrix_rows(matrix), moving))
+    for key, placed in placements.items():
+        first = placed[0][0]
+        files = export_mesh_data(ctx, first, first.name)
+        copies: Dict[int, list] = {}
+        for k, (obj, rows, moving) in enumerate(placed):
+            for material_index, name in files:
+                mat_name, emission = material_for(obj, material_index)
+                if k > 0 and not emission and not moving and placed[0][2] is None:
+                    # An Embree instance of the first placement's mesh: the copy's transform
+                    # applies after the mesh's own (docs/scene-format.md#instances).
+                    copies.setdefault(material_index, []).append(
+                        {"matrix": _relative(rows, placed[0][1])})
+                    continue
+                entry: Dict[str, Any] = {"type": "mesh", "file": name, "material": mat_name,
+                                         "transform": {"matrix": rows}}
+                if emission:
+                    entry["emission"] = emission
+                if moving:
+                    entry["velocity"], entry["acceleration"] = moving
+                if k == 0:
+                    first_index[material_index] = len(objects)
+                objects.append(entry)
+        for material_index, transforms in copies.items():
+            objects.append({"type": "instances", "mesh": first_index[material_index],
+                            "transforms": transforms})
+        first_index.clear()
     environment = export_world(ctx, scene.world)
     if environment is not None:
         doc["environment"] = environment
