@@ -529,6 +529,77 @@ class BlenderAddon(unittest.TestCase):
         meshes = os.listdir(os.path.join(self.dir, "instances-submitted", "meshes"))
         self.assertEqual(len(meshes), 2, meshes)
 
+    def test_9_normal_map_against_cycles(self):
+        """A tangent-space normal map whose four quadrants tilt the normal to +u, -u, +v, -v,
+        lit by a sun: each quadrant is as bright as in Cycles (the map's frame and rows)."""
+        bpy.ops.wm.read_factory_settings(use_empty=False)
+        bpy.ops.preferences.addon_enable(module="penumbra_blender")
+        scene = bpy.context.scene
+        for obj in list(bpy.data.objects):
+            if obj.type != "CAMERA":
+                bpy.data.objects.remove(obj)
+        scene.world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
+        s, c = 0.5, math.sqrt(0.75)
+        tilts = {(0, 0): (s, 0), (1, 0): (-s, 0), (0, 1): (0, s), (1, 1): (0, -s)}
+        image = bpy.data.images.new("bumps", 2, 2)
+        px = []
+        for j in range(2):
+            for i in range(2):
+                tx, ty = tilts[(i, j)]
+                px += [0.5 * tx + 0.5, 0.5 * ty + 0.5, 0.5 * c + 0.5, 1.0]
+        image.pixels[:] = px
+        image.filepath_raw = os.path.join(self.dir, "bumps.png")
+        image.file_format = "PNG"
+        image.save()
+        bumps = bpy.data.images.load(image.filepath_raw)
+        bumps.colorspace_settings.name = "Non-Color"
+        bpy.ops.mesh.primitive_plane_add(size=4)
+        mat = bpy.data.materials.new("bumpy")
+        mat.use_nodes = True
+        nodes, links = mat.node_tree.nodes, mat.node_tree.links
+        diffuse = nodes.new("ShaderNodeBsdfDiffuse")
+        diffuse.inputs["Color"].default_value = (0.8, 0.8, 0.8, 1)
+        tex = nodes.new("ShaderNodeTexImage")
+        tex.image, tex.interpolation, tex.extension = bumps, "Closest", "EXTEND"
+        normal_map = nodes.new("ShaderNodeNormalMap")
+        links.new(tex.outputs["Color"], normal_map.inputs["Color"])
+        links.new(normal_map.outputs["Normal"], diffuse.inputs["Normal"])
+        links.new(diffuse.outputs[0], nodes["Material Output"].inputs["Surface"])
+        bpy.context.active_object.data.materials.append(mat)
+        bpy.ops.object.light_add(type="SUN")
+        sun = bpy.context.active_object
+        sun.data.energy, sun.data.angle = 3.0, 0.0
+        sun.rotation_euler = mathutils_vector((0.6, 0.35, 0.7)).to_track_quat("Z", "Y").to_euler()
+        scene.camera.location, scene.camera.rotation_euler = (0, 0, 6), (0, 0, 0)
+        scene.view_settings.view_transform = "Standard"
+        self.setup_render(scene)
+        scene.penumbra.samples = 16
+        ours = self.render_penumbra(scene, "bumps")
+        cycles = self.render_cycles(scene, "bumps", transparent=False)
+        a = channel_pixels(ours, "ViewLayer.Combined.G", self.dir)
+        b = channel_pixels(cycles, "ViewLayer.Combined.G", self.dir)
+
+        def quadrant_means(values):
+            means = []
+            for qy in (0, 1):
+                for qx in (0, 1):
+                    xs = range(qx * WIDTH // 2 + 12, (qx + 1) * WIDTH // 2 - 12)
+                    ys = range(qy * HEIGHT // 2 + 8, (qy + 1) * HEIGHT // 2 - 8)
+                    means.append(sum(values[y * WIDTH + x] for y in ys for x in xs)
+                                 / (len(xs) * len(ys)))
+            return means
+
+        ours_q, cycles_q = quadrant_means(a), quadrant_means(b)
+        print(f"bumps: quadrant means penumbra {[round(v, 4) for v in ours_q]}, Cycles "
+              f"{[round(v, 4) for v in cycles_q]}", file=sys.stderr)
+        for mine, theirs in zip(ours_q, cycles_q):
+            self.assertAlmostEqual(mine / theirs, 1.0, delta=0.05)
+
+
+def mathutils_vector(xyz):
+    from mathutils import Vector
+    return Vector(xyz)
+
 
 def build_scene(work):
     """An image-textured floor, a glass sphere, a cube, an HDR world turned by a Mapping node,

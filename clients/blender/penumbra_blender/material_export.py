@@ -84,8 +84,56 @@ class _Reader:
         return _rgb(socket.default_value)
 
 
+def _normal_map(r: "_Reader", node) -> Optional[Dict[str, Any]]:
+    """penumbra's `normal_map` from a Normal Map node (tangent space, the active uv map) fed by
+    an Image Texture. Both read the texel as 2 rgb - 1 in the frame of the uv tangent, the
+    bitangent n x t and the normal (Blender's "OpenGL" convention, green = +v), so the image is
+    used as it is; the v flip of the uvs flips the rows the same way for both."""
+    socket = node.inputs.get("Normal")
+    if socket is None or not socket.is_linked:
+        return None
+    src = socket.links[0].from_node
+    color = src.inputs["Color"] if src.bl_idname == "ShaderNodeNormalMap" else None
+    if color is None or not color.is_linked or \
+            color.links[0].from_node.bl_idname != "ShaderNodeTexImage" or \
+            color.links[0].from_node.image is None:
+        r.ctx.warn(f"{r.where}: the Normal input of '{node.name}' is not a Normal Map node fed "
+                   "by an Image Texture; ignored")
+        return None
+    if src.space != "TANGENT":
+        r.ctx.warn(f"{r.where}: '{src.name}' is in {src.space} space; penumbra reads tangent "
+                   "space only, ignored")
+        return None
+    if src.uv_map:
+        r.ctx.warn(f"{r.where}: '{src.name}' names uv map '{src.uv_map}'; the active one is used")
+    strength = src.inputs["Strength"]
+    if strength.is_linked or abs(float(strength.default_value) - 1.0) > 1e-6:
+        r.ctx.warn(f"{r.where}: normal map strength {strength.default_value:.3g} read as 1")
+    tex_node = color.links[0].from_node
+    name = image_file(r.ctx, tex_node.image, r.where)
+    if name is None:
+        return None
+    out: Dict[str, Any] = {"texture": name}
+    if tex_node.interpolation == "Closest":
+        out["filter"] = "nearest"
+    if tex_node.extension in ("EXTEND", "CLIP"):
+        out["wrap"] = "clamp"
+    return out
+
+
 def export_material(ctx: ExportContext, material) -> Tuple[Dict[str, Any], Optional[list]]:
     """(penumbra material, emission RGB or None) of a Blender material."""
+    material_dict, emission = _export_shader(ctx, material)
+    shader = _output_shader(material)
+    if shader is not None and "Normal" in shader.inputs and \
+            shader.bl_idname != "ShaderNodeBsdfPrincipled" and shader.inputs["Normal"].is_linked:
+        normal_map = _normal_map(_Reader(ctx, material), shader)
+        if normal_map is not None:
+            material_dict["normal_map"] = normal_map
+    return material_dict, emission
+
+
+def _export_shader(ctx: ExportContext, material) -> Tuple[Dict[str, Any], Optional[list]]:
     r = _Reader(ctx, material)
     shader = _output_shader(material)
     if shader is None:
@@ -139,6 +187,9 @@ def _principled(r: _Reader, node) -> Tuple[Dict[str, Any], Optional[list]]:
         material = {"type": "plastic", "color": base, "ior": (1 + s) / (1 - s),
                     "roughness": roughness}
     _warn_unread(r, node)
+    normal_map = _normal_map(r, node)
+    if normal_map is not None:
+        material["normal_map"] = normal_map
     emission = None
     strength = float(node.inputs["Emission Strength"].default_value)
     color = node.inputs["Emission"].default_value
@@ -158,6 +209,3 @@ def _warn_unread(r: _Reader, node) -> None:
         socket = node.inputs.get(name)
         if socket is not None and (socket.is_linked or float(socket.default_value) != neutral):
             r.ctx.warn(f"{r.where}: Principled '{name}' is ignored")
-    normal = node.inputs.get("Normal")
-    if normal is not None and normal.is_linked:
-        r.ctx.warn(f"{r.where}: a linked Normal (normal or bump map) is ignored")
