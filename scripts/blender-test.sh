@@ -17,4 +17,24 @@ set +e
 PENUMBRA_BINARY="$binary" "$blender" -b --factory-startup --python-exit-code 1 \
   --python "$repo_root/tests/blender/blender_test.py" -- "${@:2}" 2>&1 | grep -v '^Fra:'
 rc=${PIPESTATUS[0]}
+[ "$rc" -ne 0 ] || [ $# -gt 1 ] && exit "$rc"  # a chosen test case: only that
+
+# The packaged zip, installed as a user installs it, renders with the client inside it.
+work="$(mktemp -d)"
+trap 'kill "$server" 2>/dev/null; wait "$server" 2>/dev/null; rm -rf "$work"' EXIT
+"$repo_root/scripts/package-blender-addon.sh" "$work/penumbra_blender.zip" >/dev/null
+mkfifo "$work/out"
+"$binary" serve --port 0 --data-dir "$work/data" >"$work/out" 2>"$work/server.log" &
+server=$!
+exec 3<"$work/out"
+read -r line <&3
+url="$(sed -n 's/.*listening on \(http:[^ ]*\).*/\1/p' <<<"$line")"
+[ -n "$url" ] || { echo "penumbra serve did not start: $line" >&2; exit 1; }
+cat <&3 >/dev/null &
+mkdir -p "$work/scripts"
+BLENDER_USER_SCRIPTS="$work/scripts" BLENDER_USER_CONFIG="$work/config" PENUMBRA_URL="$url" \
+  "$blender" -b --factory-startup --python-exit-code 1 \
+  --python "$repo_root/tests/blender/zip_install_test.py" -- "$work/penumbra_blender.zip" 2>&1 |
+  grep -E 'zip install|Error|Traceback|assert|^  '
+rc=${PIPESTATUS[0]}
 exit "$rc"
