@@ -36,6 +36,12 @@ class PENUMBRA_PT_sampling(bpy.types.Panel):
         col.prop(settings, "samples")
         col.prop(settings, "seed")
         col.prop(settings, "max_depth")
+        col.separator()
+        render = context.scene.render
+        col.prop(render, "use_motion_blur")
+        sub = col.column()
+        sub.active = render.use_motion_blur
+        sub.prop(render, "motion_blur_shutter")
         url, _ = preferences.server_settings(context)
         col.label(text=f"Server: {url}")
 

@@ -25,6 +25,7 @@ class PenumbraRenderEngine(bpy.types.RenderEngine):
     bl_label = "penumbra"
     bl_use_preview = False
     bl_use_shading_nodes_custom = False  # materials keep Blender's (Cycles') node editor
+    bl_use_eevee_viewport = True  # Material Preview shading draws with EEVEE
 
     def update_render_passes(self, scene=None, renderlayer=None):
         self.register_pass(scene, renderlayer, "Combined", 4, "RGBA", "COLOR")
@@ -168,12 +169,20 @@ def _describe(error) -> str:
     return text
 
 
+# EEVEE's panels for what the exporter reads (material and world node trees, the depth of field,
+# the light's power); Cycles' own panels need Cycles' properties, and Blender's generic ones
+# (those listing BLENDER_RENDER) show for any engine.
+_EEVEE_PANELS = ("EEVEE_MATERIAL_PT_context_material", "EEVEE_MATERIAL_PT_surface",
+                 "EEVEE_WORLD_PT_surface", "DATA_PT_EEVEE_light", "DATA_PT_camera_dof",
+                 "DATA_PT_camera_dof_aperture")
+
+
 def compatible_panels():
-    """Blender's own panels (render dimensions, output, camera, light, material, world) that
-    make sense for this engine: those that Cycles shows, as other external engines do."""
+    """The panels of the properties editor to show for this engine."""
     panels = []
     for panel in bpy.types.Panel.__subclasses__():
         engines = getattr(panel, "COMPAT_ENGINES", None)
-        if engines is not None and "BLENDER_RENDER" in engines:
+        if engines is not None and ("BLENDER_RENDER" in engines
+                                    or panel.__name__ in _EEVEE_PANELS):
             panels.append(panel)
     return panels

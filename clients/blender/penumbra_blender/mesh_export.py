@@ -8,6 +8,7 @@ v is written as 1 - v, which makes an image texture land where Blender puts it.
 from __future__ import annotations
 
 import struct
+import sys
 from array import array
 from typing import Dict, List, Tuple
 
@@ -105,7 +106,6 @@ def write_ply(path: str, positions: array, normals: array, uvs: array, indices: 
                        indices[3 * t + 2])
     if vertex_data.itemsize != 4:
         raise RuntimeError("this platform's C float is not 32 bits")
-    import sys
     if sys.byteorder != "little":
         vertex_data.byteswap()
     with open(path, "wb") as f:

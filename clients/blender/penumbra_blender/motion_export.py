@@ -51,7 +51,7 @@ def sample_motion(ctx: ExportContext, depsgraph, frame_set: FrameSet) -> Dict[st
         acceleration = pp - 2 * p0 + pm
         linear_changes = any(abs(a - b) > 1e-6 for m in (mm, mp)
                              for ra, rb in zip(m.to_3x3(), m0.to_3x3()) for a, b in zip(ra, rb))
-        if name == scene.camera.name if scene.camera else False:
+        if scene.camera is not None and name == scene.camera.name:
             if velocity.length > 0 or linear_changes:
                 ctx.warn(f"camera '{name}': camera motion blur is not supported")
             continue
