@@ -437,7 +437,7 @@ class BlenderAddon(unittest.TestCase):
         crash or a hang."""
         bpy.ops.wm.read_factory_settings(use_empty=False)
         bpy.ops.preferences.addon_enable(module="penumbra_blender")
-        from penumbra_blender.scene_export import export_scene
+        from penumbra_blender.scene_export import export_scene, write_scene
         scene = bpy.context.scene
         toon = bpy.data.materials.new("toon")
         toon.use_nodes = True
@@ -451,6 +451,39 @@ class BlenderAddon(unittest.TestCase):
         self.assertEqual(doc["materials"]["toon"], {"type": "diffuse", "color": [0.8, 0.8, 0.8]})
         self.assertTrue(any("toon" in w and "grey diffuse" in w for w in ctx.warnings),
                         ctx.warnings)
+
+        # Roughness and emission from image textures; an object hidden from renders.
+        tex_image = bpy.data.images.new("grey", 4, 4)
+        tex_image.pixels[:] = [0.5, 0.5, 0.5, 1.0] * 16
+        tex_image.filepath_raw = os.path.join(self.dir, "grey.png")
+        tex_image.file_format = "PNG"
+        tex_image.save()
+        metal = bpy.data.materials.new("brushed")
+        metal.use_nodes = True
+        bsdf = metal.node_tree.nodes["Principled BSDF"]
+        bsdf.inputs["Metallic"].default_value = 1.0
+        bsdf.inputs["Emission Strength"].default_value = 3.0
+        image_node = metal.node_tree.nodes.new("ShaderNodeTexImage")
+        image_node.image = bpy.data.images.load(tex_image.filepath_raw)
+        metal.node_tree.links.new(image_node.outputs["Color"], bsdf.inputs["Roughness"])
+        metal.node_tree.links.new(image_node.outputs["Color"], bsdf.inputs["Emission"])
+        bpy.ops.mesh.primitive_cube_add(location=(0, 3, 0))
+        bpy.context.active_object.data.materials.append(metal)
+        bpy.ops.mesh.primitive_cube_add(location=(0, -3, 0))
+        bpy.context.active_object.name = "HiddenFromRenders"
+        bpy.context.active_object.hide_render = True
+        doc, ctx = export_scene(bpy.context.evaluated_depsgraph_get(), folder, samples=4,
+                                integrator="path")
+        self.assertEqual(doc["materials"]["brushed"]["roughness"],
+                         {"texture": "textures/grey.png", "colorspace": "linear", "channel": 0})
+        emitting = [o for o in doc["objects"] if "emission" in o]
+        self.assertEqual(emitting[0]["emission"], {"texture": "textures/grey.png",
+                                                   "colorspace": "srgb", "scale": 3.0})
+        self.assertEqual(len([o for o in doc["objects"] if o["type"] == "mesh"]), 2)
+        self.assertTrue(any("sRGB" in w for w in ctx.warnings), ctx.warnings)
+        validated = subprocess.run([BINARY, "validate", write_scene(doc, folder)],
+                                   capture_output=True, text=True)
+        self.assertEqual(validated.returncode, 0, validated.stderr)
 
         self.setup_render(scene)
         scene.render.engine = "PENUMBRA"

@@ -56,6 +56,28 @@ class _Reader:
                           "is used")
         return float(socket.default_value)
 
+    def scalar(self, node, name: str) -> Any:
+        """A number, or for an Image Texture node's Color a single-channel texture (channel 0,
+        read linearly: a roughness map is data, as Blender's Non-Color setting says)."""
+        socket = node.inputs[name]
+        if socket.is_linked:
+            link = socket.links[0]
+            src = link.from_node
+            if src.bl_idname == "ShaderNodeTexImage" and src.image is not None and \
+                    link.from_socket.name == "Color" and not src.inputs["Vector"].is_linked:
+                name_in_scene = image_file(self.ctx, src.image, self.where)
+                if name_in_scene is not None:
+                    tex = {"texture": name_in_scene, "colorspace": "linear", "channel": 0}
+                    if src.image.colorspace_settings.name == "sRGB" and not src.image.is_float:
+                        self.ctx.warn(f"{self.where}: '{src.name}' feeds '{name}' with colour "
+                                      "space sRGB; penumbra reads it as data (Non-Color)")
+                    if src.interpolation == "Closest":
+                        tex["filter"] = "nearest"
+                    if src.extension in ("EXTEND", "CLIP"):
+                        tex["wrap"] = "clamp"
+                    return tex
+        return _clamp01(self.value(node, name))
+
     def color(self, node, name: str, scale=None) -> Any:
         """An RGB list, or a texture dict for an Image Texture node."""
         socket = node.inputs[name]
@@ -148,10 +170,10 @@ def _export_shader(ctx: ExportContext, material) -> Tuple[Dict[str, Any], Option
         return {"type": "diffuse", "color": r.color(shader, "Color")}, None
     if kind == "ShaderNodeBsdfGlossy":
         return {"type": "conductor", "color": r.color(shader, "Color"),
-                "roughness": _clamp01(r.value(shader, "Roughness"))}, None
+                "roughness": r.scalar(shader, "Roughness")}, None
     if kind == "ShaderNodeBsdfGlass":
         return {"type": "dielectric", "ior": max(r.value(shader, "IOR"), 1e-3),
-                "roughness": _clamp01(r.value(shader, "Roughness"))}, None
+                "roughness": r.scalar(shader, "Roughness")}, None
     if kind == "ShaderNodeEmission":
         strength = r.value(shader, "Strength")
         color = shader.inputs["Color"].default_value
@@ -164,7 +186,7 @@ def _export_shader(ctx: ExportContext, material) -> Tuple[Dict[str, Any], Option
 
 def _principled(r: _Reader, node) -> Tuple[Dict[str, Any], Optional[list]]:
     base = r.color(node, "Base Color")
-    roughness = _clamp01(r.value(node, "Roughness"))
+    roughness = r.scalar(node, "Roughness")
     metallic = r.value(node, "Metallic")
     transmission = r.value(node, "Transmission")
     ior = max(r.value(node, "IOR"), 1e-3)
@@ -184,6 +206,10 @@ def _principled(r: _Reader, node) -> Tuple[Dict[str, Any], Optional[list]]:
     else:
         # Principled: f0 = 0.08 * specular; f0 = ((n - 1) / (n + 1))^2 solved for n.
         s = math.sqrt(min(0.08 * specular, 0.99))
+        if isinstance(roughness, dict):
+            r.ctx.warn(f"{r.where}: a plastic's roughness cannot be a texture in penumbra; "
+                       f"{node.inputs['Roughness'].default_value:.3g} is used")
+            roughness = _clamp01(node.inputs["Roughness"].default_value)
         material = {"type": "plastic", "color": base, "ior": (1 + s) / (1 - s),
                     "roughness": roughness}
     _warn_unread(r, node)
@@ -191,12 +217,14 @@ def _principled(r: _Reader, node) -> Tuple[Dict[str, Any], Optional[list]]:
     if normal_map is not None:
         material["normal_map"] = normal_map
     emission = None
-    strength = float(node.inputs["Emission Strength"].default_value)
-    color = node.inputs["Emission"].default_value
-    if strength > 0 and any(c > 0 for c in color[:3]):
-        if node.inputs["Emission"].is_linked:
-            r.ctx.warn(f"{r.where}: a linked Emission colour is read as its own value")
-        emission = [max(0.0, float(c)) * strength for c in color[:3]]
+    strength = max(0.0, float(node.inputs["Emission Strength"].default_value))
+    color = node.inputs["Emission"]
+    if strength > 0 and color.is_linked:
+        value = r.color(node, "Emission", scale=strength)
+        if isinstance(value, dict):
+            return material, value  # an emission texture: image x strength
+    if strength > 0 and any(c > 0 for c in color.default_value[:3]):
+        emission = [max(0.0, float(c)) * strength for c in color.default_value[:3]]
     return material, emission
 
 

@@ -90,6 +90,10 @@ def export_scene(depsgraph, folder: str, *, samples: int, integrator: str, seed:
         obj = inst.object
         if inst.is_instance and not inst.show_self:
             continue
+        # A viewport depsgraph (File > Export) holds objects hidden from renders; F12's does not.
+        owner = inst.parent if inst.is_instance and inst.parent is not None else obj
+        if owner.original.hide_render:
+            continue
         matrix = inst.matrix_world.copy()
         if obj.type == "LIGHT":
             light, quad = export_light(ctx, obj, matrix)
