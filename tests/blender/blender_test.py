@@ -197,13 +197,11 @@ class BlenderAddon(unittest.TestCase):
 
     # -- tests -----------------------------------------------------------------------------------
     def test_1_default_cube(self):
-        bpy.ops.wm.read_factory_settings(use_empty=False)
-        bpy.ops.preferences.addon_enable(module="penumbra_blender")
+        fresh_scene()
         self.run_scene("cube")
 
     def test_2_textured_glass_hdr_world(self):
-        bpy.ops.wm.read_factory_settings(use_empty=False)
-        bpy.ops.preferences.addon_enable(module="penumbra_blender")
+        fresh_scene(only_camera=True)
         build_scene(self.dir)
         self.run_scene("built")
         folder = os.path.join(self.dir, "built-submitted")
@@ -233,12 +231,7 @@ class BlenderAddon(unittest.TestCase):
     def test_3_world_orientation_against_cycles(self):
         """An environment map turned by a Mapping node, seen through a wide lens: penumbra's
         image of it is Cycles' (orientation of the map, the rotation, the field of view)."""
-        bpy.ops.wm.read_factory_settings(use_empty=False)
-        bpy.ops.preferences.addon_enable(module="penumbra_blender")
-        scene = bpy.context.scene
-        for obj in list(bpy.data.objects):
-            if obj.type != "CAMERA":
-                bpy.data.objects.remove(obj)
+        scene = fresh_scene(only_camera=True)
         # Smooth in both directions and periodic in u, so texel conventions do not matter.
         sky = bpy.data.images.new("smooth_sky", 64, 32, float_buffer=True)
         px = []
@@ -282,8 +275,7 @@ class BlenderAddon(unittest.TestCase):
         """Keyframed motion becomes velocity and acceleration, Blender's shutter the camera's;
         the f-stop an aperture radius; an area light an emitting quad. F12 still renders what
         the exported scene renders with the CLI."""
-        bpy.ops.wm.read_factory_settings(use_empty=False)
-        bpy.ops.preferences.addon_enable(module="penumbra_blender")
+        fresh_scene()
         scene = bpy.context.scene
         cube = bpy.data.objects["Cube"]
         for frame, x in ((0, -1.0), (1, 0.0), (2, 1.5)):
@@ -393,13 +385,7 @@ class BlenderAddon(unittest.TestCase):
         for kind, setup in (("POINT", {"energy": 300.0, "shadow_soft_size": 0.0}),
                             ("SUN", {"energy": 2.0, "angle": 0.0}),
                             ("AREA", {"energy": 200.0, "size": 1.0})):
-            bpy.ops.wm.read_factory_settings(use_empty=False)
-            bpy.ops.preferences.addon_enable(module="penumbra_blender")
-            scene = bpy.context.scene
-            for obj in list(bpy.data.objects):
-                if obj.type != "CAMERA":
-                    bpy.data.objects.remove(obj)
-            scene.world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
+            scene = fresh_scene(only_camera=True, dark=True)
             bpy.ops.mesh.primitive_plane_add(size=6)
             mat = bpy.data.materials.new("white")
             mat.use_nodes = True
@@ -435,8 +421,7 @@ class BlenderAddon(unittest.TestCase):
         """A shader penumbra lacks becomes grey diffuse with a warning; the preferences win over
         the environment; a wrong token or an unreachable server is a Blender error, not a
         crash or a hang."""
-        bpy.ops.wm.read_factory_settings(use_empty=False)
-        bpy.ops.preferences.addon_enable(module="penumbra_blender")
+        fresh_scene()
         from penumbra_blender.scene_export import export_scene, write_scene
         scene = bpy.context.scene
         toon = bpy.data.materials.new("toon")
@@ -528,8 +513,7 @@ class BlenderAddon(unittest.TestCase):
     def test_8_linked_duplicates_and_collection_instances(self):
         """Objects sharing a mesh (linked duplicates, a collection instanced twice) become one
         mesh file and penumbra `instances`: same image as the CLI, same silhouettes as Cycles."""
-        bpy.ops.wm.read_factory_settings(use_empty=False)
-        bpy.ops.preferences.addon_enable(module="penumbra_blender")
+        fresh_scene()
         scene = bpy.context.scene
         cube = bpy.data.objects["Cube"]
         for k, (x, y, angle, scale) in enumerate(((2.4, 0.5, 0.5, 0.6), (-2.2, -0.6, -0.3, 0.8),
@@ -565,13 +549,7 @@ class BlenderAddon(unittest.TestCase):
     def test_9_normal_map_against_cycles(self):
         """A tangent-space normal map whose four quadrants tilt the normal to +u, -u, +v, -v,
         lit by a sun: each quadrant is as bright as in Cycles (the map's frame and rows)."""
-        bpy.ops.wm.read_factory_settings(use_empty=False)
-        bpy.ops.preferences.addon_enable(module="penumbra_blender")
-        scene = bpy.context.scene
-        for obj in list(bpy.data.objects):
-            if obj.type != "CAMERA":
-                bpy.data.objects.remove(obj)
-        scene.world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
+        scene = fresh_scene(only_camera=True, dark=True)
         s, c = 0.5, math.sqrt(0.75)
         tilts = {(0, 0): (s, 0), (1, 0): (-s, 0), (0, 1): (0, s), (1, 1): (0, -s)}
         image = bpy.data.images.new("bumps", 2, 2)
@@ -629,6 +607,20 @@ class BlenderAddon(unittest.TestCase):
             self.assertAlmostEqual(mine / theirs, 1.0, delta=0.05)
 
 
+def fresh_scene(only_camera=False, dark=False):
+    """Blender's factory scene with the add-on enabled; only its camera, or a black world."""
+    bpy.ops.wm.read_factory_settings(use_empty=False)
+    bpy.ops.preferences.addon_enable(module="penumbra_blender")
+    scene = bpy.context.scene
+    if only_camera:
+        for obj in list(bpy.data.objects):
+            if obj.type != "CAMERA":
+                bpy.data.objects.remove(obj)
+    if dark:
+        scene.world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
+    return scene
+
+
 def mathutils_vector(xyz):
     from mathutils import Vector
     return Vector(xyz)
@@ -637,9 +629,6 @@ def mathutils_vector(xyz):
 def build_scene(work):
     """An image-textured floor, a glass sphere, a cube, an HDR world turned by a Mapping node,
     a sun; written images are files, as an artist's would be."""
-    for obj in list(bpy.data.objects):
-        if obj.type != "CAMERA":
-            bpy.data.objects.remove(obj)
     scene = bpy.context.scene
     # A checker texture, saved as a PNG file.
     tex = bpy.data.images.new("checker", 32, 32)

@@ -18,6 +18,7 @@ from typing import Any, Dict, Optional, Tuple
 
 from .export_context import ExportContext
 from .image_export import colorspace, image_file
+from .node_tree import output_shader
 
 DEFAULT_NAME = "__blender_default"
 DEFAULT = {"type": "diffuse", "color": [0.8, 0.8, 0.8]}
@@ -32,15 +33,9 @@ def _rgb(value) -> list:
 
 
 def _output_shader(material):
-    if not material.use_nodes or material.node_tree is None:
+    if not material.use_nodes:
         return None
-    outputs = [n for n in material.node_tree.nodes if n.bl_idname == "ShaderNodeOutputMaterial"]
-    active = [n for n in outputs if n.is_active_output] or outputs
-    for node in active:
-        socket = node.inputs.get("Surface")
-        if socket is not None and socket.is_linked:
-            return socket.links[0].from_node
-    return None
+    return output_shader(material.node_tree, "ShaderNodeOutputMaterial")
 
 
 class _Reader:

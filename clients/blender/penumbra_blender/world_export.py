@@ -14,16 +14,7 @@ from typing import Any, Dict, Optional
 
 from .export_context import ExportContext
 from .image_export import image_file
-
-
-def _world_output_shader(world):
-    outputs = [n for n in world.node_tree.nodes if n.bl_idname == "ShaderNodeOutputWorld"]
-    active = [n for n in outputs if n.is_active_output] or outputs
-    for node in active:
-        socket = node.inputs.get("Surface")
-        if socket is not None and socket.is_linked:
-            return socket.links[0].from_node
-    return None
+from .node_tree import output_shader
 
 
 def _mapping_rotation(ctx: ExportContext, tex):
@@ -64,7 +55,7 @@ def export_world(ctx: ExportContext, world) -> Optional[Dict[str, Any]]:
         return None
     if not world.use_nodes or world.node_tree is None:
         return {"radiance": [max(0.0, c) for c in world.color[:3]]}
-    shader = _world_output_shader(world)
+    shader = output_shader(world.node_tree, "ShaderNodeOutputWorld")
     if shader is None:
         return None
     if shader.bl_idname != "ShaderNodeBackground":
