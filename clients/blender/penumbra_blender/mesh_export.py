@@ -7,9 +7,9 @@ v is written as 1 - v, which makes an image texture land where Blender puts it.
 """
 from __future__ import annotations
 
-import struct
 import sys
 from array import array
+from itertools import chain
 from typing import Dict, List, Tuple
 
 from .export_context import ExportContext, safe_name
@@ -53,28 +53,33 @@ def mesh_parts(mesh) -> Dict[int, Tuple[array, array, array, array]]:
         uvs = _floats(2 * n_loop)
         mesh.uv_layers.active.data.foreach_get("uv", uvs)
 
-    parts: Dict[int, list] = {}
-    for t in range(n_tri):
-        part = parts.get(tri_mat[t])
-        if part is None:
-            part = parts[tri_mat[t]] = [array("f"), array("f"), array("f"), array("i"), {}]
-        pos, nrm, uv, idx, seen = part
-        for k in range(3):
-            loop = tri_loops[3 * t + k]
-            v = loop_vert[loop]
-            key = (v,
-                   tuple(normals[3 * loop:3 * loop + 3]) if normals is not None else None,
-                   tuple(uvs[2 * loop:2 * loop + 2]) if uvs is not None else None)
-            i = seen.get(key)
-            if i is None:
-                i = seen[key] = len(pos) // 3
-                pos.extend(co[3 * v:3 * v + 3])
-                if normals is not None:
-                    nrm.extend(key[1])
-                if uvs is not None:
-                    uv.extend((key[2][0], 1.0 - key[2][1]))
-            idx.append(i)
-    return {m: (p[0], p[1], p[2], p[3]) for m, p in parts.items()}
+    # One hashable key per face corner, built by zip (in C): the corner's vertex, normal, uv.
+    triples = zip(*[iter(normals)] * 3) if normals is not None else iter(lambda: None, 0)
+    pairs = zip(*[iter(uvs)] * 2) if uvs is not None else iter(lambda: None, 0)
+    corner_key = list(zip(loop_vert, triples, pairs))
+    xs, ys, zs = co[0::3], co[1::3], co[2::3]
+    parts = {}
+    for material_index in sorted(set(tri_mat)):
+        if len(parts) == 0 and tri_mat.count(material_index) == n_tri:
+            corners = tri_loops
+        else:
+            corners = [loop for t in range(n_tri) if tri_mat[t] == material_index
+                       for loop in tri_loops[3 * t:3 * t + 3]]
+        # Corners sharing vertex, normal and uv become one vertex, numbered as first seen
+        # (setdefault's len() is taken before the insertion).
+        index: Dict[tuple, int] = {}
+        indices = array("i", [index.setdefault(corner_key[loop], len(index)) for loop in corners])
+        keys = list(index)
+        verts = [k[0] for k in keys]
+        positions = array("f", chain.from_iterable(zip(map(xs.__getitem__, verts),
+                                                       map(ys.__getitem__, verts),
+                                                       map(zs.__getitem__, verts))))
+        nrm = array("f", chain.from_iterable(k[1] for k in keys)) if normals is not None \
+            else array("f")
+        uv = array("f", chain.from_iterable((k[2][0], 1.0 - k[2][1]) for k in keys)) \
+            if uvs is not None else array("f")
+        parts[material_index] = (positions, nrm, uv, indices)
+    return parts
 
 
 def write_ply(path: str, positions: array, normals: array, uvs: array, indices: array) -> None:
@@ -88,26 +93,25 @@ def write_ply(path: str, positions: array, normals: array, uvs: array, indices: 
         header += ["property float u", "property float v"]
     header += [f"element face {len(indices) // 3}", "property list uchar int vertex_indices",
                "end_header"]
-    per_vertex = 3 + (3 if len(normals) else 0) + (2 if len(uvs) else 0)
-    vertex_data = array("f", bytes(4 * per_vertex * n))
-    for i in range(n):
-        o = i * per_vertex
-        vertex_data[o:o + 3] = positions[3 * i:3 * i + 3]
-        o += 3
-        if len(normals):
-            vertex_data[o:o + 3] = normals[3 * i:3 * i + 3]
-            o += 3
-        if len(uvs):
-            vertex_data[o:o + 2] = uvs[2 * i:2 * i + 2]
-    face = struct.Struct("<B3i")
-    faces = bytearray(face.size * (len(indices) // 3))
-    for t in range(len(indices) // 3):
-        face.pack_into(faces, t * face.size, 3, indices[3 * t], indices[3 * t + 1],
-                       indices[3 * t + 2])
-    if vertex_data.itemsize != 4:
-        raise RuntimeError("this platform's C float is not 32 bits")
+    columns = [zip(*[iter(positions)] * 3)]
+    if len(normals):
+        columns.append(zip(*[iter(normals)] * 3))
+    if len(uvs):
+        columns.append(zip(*[iter(uvs)] * 2))
+    vertex_data = array("f", chain.from_iterable(chain.from_iterable(zip(*columns))))
+    if vertex_data.itemsize != 4 or indices.itemsize != 4:
+        raise RuntimeError("this platform's C float or int is not 32 bits")
+    index_data = array("i", indices)
     if sys.byteorder != "little":
         vertex_data.byteswap()
+        index_data.byteswap()
+    # Each face: a count byte (3), then three int32; interleaved by strided slices (in C).
+    n_faces = len(indices) // 3
+    raw = index_data.tobytes()
+    faces = bytearray(13 * n_faces)
+    faces[0::13] = b"\x03" * n_faces
+    for k in range(12):
+        faces[1 + k::13] = raw[k::12]
     with open(path, "wb") as f:
         f.write(("\n".join(header) + "\n").encode("ascii"))
         f.write(vertex_data.tobytes())
