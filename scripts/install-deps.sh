@@ -9,7 +9,9 @@
 #   scripts/install-deps.sh --browser also Chromium, its WebDriver and a venv with Selenium for the
 #                                     dashboard's browser test (ctest label "browser";
 #                                     scripts/setup-browser-venv.sh)
-# Flags combine: scripts/test.sh passes --schemathesis --browser.
+#   scripts/install-deps.sh --blender also Debian's Blender 3.4 for the add-on's test (ctest label
+#                                     "blender"; scripts/blender-test.sh)
+# Flags combine: scripts/test.sh passes --schemathesis --browser --blender.
 set -euo pipefail
 want() { local f; for f in "${ARGS[@]}"; do [ "$f" = "$1" ] && return 0; done; return 1; }
 ARGS=("$@")
@@ -25,6 +27,8 @@ PKGS=(
 if want --fuzz; then PKGS+=(clang libclang-rt-14-dev); fi
 # Debian's chromium and chromium-driver (the same version), fonts for readable screenshots.
 if want --browser; then PKGS+=(chromium chromium-driver fonts-dejavu-core python3-venv); fi
+# Debian's Blender (3.4.1, system Python 3.11): the add-on's headless test renders through it.
+if want --blender; then PKGS+=(blender); fi
 missing=()
 for p in "${PKGS[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -304,10 +304,15 @@ class Client:
             delay = min(delay * 1.5, 2.0)
 
     def result(self, job: JobRef, format: str = "exr", layer: Optional[str] = None,
-               as_array: Optional[bool] = None, layout: Optional[str] = None):
+               as_array: Optional[bool] = None, layout: Optional[str] = None,
+               preview: bool = False):
         """The job's image: bytes of the PNG or EXR, or (EXR, when numpy is installed and
-        `as_array` is not False) a float32 array of shape (height, width, channels)."""
+        `as_array` is not False) a float32 array of shape (height, width, channels).
+        `preview=True`: the progressive image of a running job (a ProblemError with status 409
+        until its first pass is done)."""
         query: Dict[str, str] = {"format": format}
+        if preview:
+            query["preview"] = "true"
         if layer:
             query["layer"] = layer
         if layout:

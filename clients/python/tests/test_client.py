@@ -166,6 +166,23 @@ class JobsTest(ServerTest):
         record = self.client.wait(job, progress=False, check=False)
         self.assertEqual(record["state"], "cancelled")
 
+    def test_preview_of_a_running_job(self):
+        job = self.client.submit(slow_scene())
+        try:
+            deadline = time.monotonic() + 60
+            while True:
+                try:
+                    png = self.client.result(job, format="png", preview=True)
+                    break
+                except penumbra.ProblemError as e:  # 409 until the first pass is done
+                    self.assertEqual(e.status, 409)
+                    self.assertLess(time.monotonic(), deadline, "no preview in 60 s")
+                    time.sleep(0.1)
+            self.assertTrue(png.startswith(b"\x89PNG"))
+            self.assertEqual(self.client.job(job)["state"], "running")  # a preview, not the result
+        finally:
+            self.client.cancel(job)
+
     def test_progress_callback_sees_the_final_state(self):
         seen = []
         self.client.wait(self.client.submit(sky_scene()), progress=seen.append)
