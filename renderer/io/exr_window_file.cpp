@@ -4,10 +4,14 @@
 #include <OpenEXR/ImfFrameBuffer.h>
 #include <OpenEXR/ImfHeader.h>
 #include <OpenEXR/ImfInputFile.h>
+#include <OpenEXR/ImfStdIO.h>
 #include <OpenEXR/ImfStringAttribute.h>
 
 #include <cmath>
+#include <cstring>
 #include <exception>
+#include <memory>
+#include <stdexcept>
 #include <vector>
 
 #include "renderer/io/image_io.h"
@@ -24,15 +28,38 @@ std::vector<ImageLayer> known_layers() {
           {kOutputLayerNames[2], ImageLayer::Kind::kDepth, 1, {}}};
 }
 
-}  // namespace
+// Encoded bytes held in memory as an OpenEXR input stream.
+class MemoryIStream : public Imf::IStream {
+ public:
+  MemoryIStream(const std::string& name, const std::vector<uint8_t>& bytes)
+      : Imf::IStream(name.c_str()), bytes_(bytes) {}
+  bool read(char c[], int n) override {
+    if (n < 0 || pos_ + uint64_t(n) > bytes_.size())
+      throw std::runtime_error("unexpected end of file");
+    std::memcpy(c, bytes_.data() + pos_, size_t(n));
+    pos_ += uint64_t(n);
+    return pos_ < bytes_.size();
+  }
+  uint64_t tellg() override { return pos_; }
+  void seekg(uint64_t pos) override { pos_ = pos; }
 
-ExrWindowFile read_exr_window(const std::string& path, const ExrWindowLimits& limits) {
+ private:
+  const std::vector<uint8_t>& bytes_;
+  uint64_t pos_ = 0;
+};
+
+ExrWindowFile read_stream(Imf::IStream& stream, const std::string& path, const ExrWindowLimits& limits) {
   ExrWindowFile out;
   out.part.name = path;
   try {
-    Imf::InputFile file(path.c_str(), 1);
+    Imf::InputFile file(stream, 1);
     const Imf::Header& header = file.header();
     const Imath::Box2i dw = header.dataWindow(), disp = header.displayWindow();
+    // Exclusive ends below must not overflow; anything near INT_MAX is far over the limits anyway.
+    constexpr int kMaxCoordinate = 1 << 30;
+    for (int v : {dw.min.x, dw.min.y, dw.max.x, dw.max.y, disp.max.x, disp.max.y})
+      if (v < -kMaxCoordinate || v > kMaxCoordinate)
+        throw ImageIoError(path + ": a data or display window coordinate is out of range");
     if (disp.min.x != 0 || disp.min.y != 0)
       throw ImageIoError(path + ": the display window does not start at pixel (0, 0)");
     out.display = {0, 0, disp.max.x + 1, disp.max.y + 1};
@@ -108,13 +135,30 @@ ExrWindowFile read_exr_window(const std::string& path, const ExrWindowLimits& li
     finite(out.part.image.rgb, "the image");
     for (const ImageLayer& l : layers) finite(l.data, "layer " + l.name);
     out.part.layers = std::move(layers);
-    (void)h;
   } catch (const ImageIoError&) {
     throw;
   } catch (const std::exception& e) {
     throw ImageIoError(path + ": " + e.what());
   }
   return out;
+}
+
+}  // namespace
+
+ExrWindowFile read_exr_window(const std::string& path, const ExrWindowLimits& limits) {
+  std::unique_ptr<Imf::IStream> stream;
+  try {
+    stream = std::make_unique<Imf::StdIFStream>(path.c_str());
+  } catch (const std::exception& e) {
+    throw ImageIoError(path + ": " + e.what());
+  }
+  return read_stream(*stream, path, limits);
+}
+
+ExrWindowFile read_exr_window(const std::string& name, const std::vector<uint8_t>& bytes,
+                              const ExrWindowLimits& limits) {
+  MemoryIStream stream(name, bytes);
+  return read_stream(stream, name, limits);
 }
 
 }  // namespace penumbra

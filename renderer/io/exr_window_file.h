@@ -4,6 +4,7 @@
 // output layers, for merging (renderer/render/window_merge.h).
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "renderer/core/pixel_window.h"
 #include "renderer/io/layer_io.h"
@@ -29,5 +30,8 @@ struct ExrWindowFile {
 // at (0, 0), its data window is not inside the display window, or it is over the limits (checked
 // from the header, before any pixel is decoded).
 ExrWindowFile read_exr_window(const std::string& path, const ExrWindowLimits& limits = {});
+// The same from encoded bytes in memory; `name` names them in errors.
+ExrWindowFile read_exr_window(const std::string& name, const std::vector<uint8_t>& bytes,
+                              const ExrWindowLimits& limits = {});
 
 }  // namespace penumbra

@@ -73,7 +73,7 @@ TEST(Animation, BadFieldsNameTheirPointer) {
       {{{"frames", {1, 2.5}}}, "/animation/frames/1", "integer"},
       {{{"frames", {0, 2000000}}}, "/animation/frames/1", "must be in"},
       {{{"frames", {0, 200000}}}, "/animation/frames", "max_frames"},
-      {{{"frames", {0, 1}}, {"fps", 0}}, "/animation/fps", "> 0"},
+      {{{"frames", {0, 1}}, {"fps", 0}}, "/animation/fps", "must be in (0, 1000]"},
       {{{"frames", {0, 1}}, {"fps", "24"}}, "/animation/fps", "number"},
       {{{"frames", {0, 1}}, {"shutter", 1.5}}, "/animation/shutter", "[0, 1]"},
       {{{"frames", {0, 1}}, {"shuter", 0.5}}, "/animation/shuter", "shutter"},
