@@ -94,5 +94,17 @@ TEST(AnimationFrames, FrameFlagErrors) {
   EXPECT_NE(none.output.find("no \"animation\""), std::string::npos) << none.output;
 }
 
+TEST(AnimationFrames, InfoShowsTheAnimationAndTheWindow) {
+  SceneFolder folder;
+  nlohmann::json scene = animated_scene(3, 50);
+  scene["render"]["window"] = {2, 3, 12, 9};
+  write_split_frame_scene(folder, scene);
+  const CommandResult r = run_penumbra(folder, "info scene.json");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("animation   frames 3 to 50 (48), 24 fps, shutter 0.5 of a frame"), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("window      [2, 3, 12, 9): 10 x 6 pixels"), std::string::npos) << r.output;
+}
+
 }  // namespace
 }  // namespace penumbra::test
