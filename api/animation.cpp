@@ -22,7 +22,9 @@ bool has_frame_pattern(const std::string& pattern) { return pattern.find('#') !=
 
 std::string frame_path(const std::string& pattern, int64_t frame) {
   std::string out;
-  const std::string digits = std::to_string(frame < 0 ? -frame : frame);
+  // The magnitude in unsigned arithmetic: -INT64_MIN does not fit an int64_t.
+  const uint64_t magnitude = frame < 0 ? uint64_t(0) - uint64_t(frame) : uint64_t(frame);
+  const std::string digits = std::to_string(magnitude);
   for (size_t i = 0; i < pattern.size();) {
     if (pattern[i] != '#') {
       out += pattern[i++];

@@ -123,6 +123,7 @@ TEST(Animation, FramePathReplacesHashRuns) {
   EXPECT_EQ(frame_path("f##/img_###.png", 5), "f05/img_005.png");
   EXPECT_EQ(frame_path("out_####.exr", -3), "out_-0003.exr");
   EXPECT_EQ(frame_path("out.exr", 3), "out.exr");
+  EXPECT_EQ(frame_path("#", INT64_MIN), "-9223372036854775808");
   EXPECT_TRUE(has_frame_pattern("a#.exr"));
   EXPECT_FALSE(has_frame_pattern("a.exr"));
 }
