@@ -7,9 +7,11 @@
 #include <OpenEXR/ImfStdIO.h>
 #include <OpenEXR/ImfStringAttribute.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <exception>
+#include <fstream>
 #include <memory>
 #include <stdexcept>
 #include <vector>
@@ -26,6 +28,44 @@ std::vector<ImageLayer> known_layers() {
   return {{kOutputLayerNames[0], ImageLayer::Kind::kColor, 3, {}},
           {kOutputLayerNames[1], ImageLayer::Kind::kVector, 3, {}},
           {kOutputLayerNames[2], ImageLayer::Kind::kDepth, 1, {}}};
+}
+
+// OpenEXR 3.1 allocates an attribute's value at the size the file declares before reading it, so
+// a 40-byte file can make it allocate 2 GB (found by the exr_window fuzzer). Walk the header
+// first (OpenEXR file layout: magic, version, then name\0 type\0 int32 size value, up to a
+// null byte) and refuse any size beyond the bytes the file holds. `head` is the file's start,
+// at most kMaxHeaderBytes; `file_size` the whole file's.
+constexpr size_t kMaxHeaderBytes = size_t(1) << 20;
+
+uint32_t le32(const uint8_t* p) { return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24; }
+
+void check_header(const uint8_t* head, size_t head_size, uint64_t file_size, const std::string& path) {
+  if (head_size < 8 || le32(head) != 20000630u) throw ImageIoError(path + ": not an OpenEXR file");
+  // Multi-part (0x1000) and deep (0x800) files are nothing penumbra writes for a window.
+  if (le32(head + 4) & 0x1800u) throw ImageIoError(path + ": a multi-part or deep EXR, not a window of a frame");
+  size_t pos = 8;
+  auto skip_text = [&](const char* what) {
+    const size_t end = std::min(head_size, pos + 256);
+    const uint8_t* zero = static_cast<const uint8_t*>(std::memchr(head + pos, 0, end - pos));
+    if (!zero) throw ImageIoError(path + ": the header's attribute " + what + " is unterminated or too long");
+    pos = size_t(zero - head) + 1;
+  };
+  while (true) {
+    if (pos >= head_size)
+      throw ImageIoError(path + ": the header is truncated or larger than " + std::to_string(kMaxHeaderBytes) + " bytes");
+    if (head[pos] == 0) return;
+    const size_t name_at = pos;
+    skip_text("name");
+    const std::string name(reinterpret_cast<const char*>(head + name_at));
+    skip_text("type");
+    if (pos + 4 > head_size) throw ImageIoError(path + ": the header is truncated");
+    const int32_t size = int32_t(le32(head + pos));
+    pos += 4;
+    if (size < 0 || uint64_t(size) > file_size - pos)
+      throw ImageIoError(path + ": header attribute \"" + name + "\" claims " + std::to_string(size) +
+                         " bytes, more than the file holds");
+    pos += size_t(size);
+  }
 }
 
 // Encoded bytes held in memory as an OpenEXR input stream.
@@ -146,6 +186,17 @@ ExrWindowFile read_stream(Imf::IStream& stream, const std::string& path, const E
 }  // namespace
 
 ExrWindowFile read_exr_window(const std::string& path, const ExrWindowLimits& limits) {
+  {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw ImageIoError(path + ": cannot open the file");
+    in.seekg(0, std::ios::end);
+    const uint64_t file_size = uint64_t(std::max<std::streamoff>(0, in.tellg()));
+    in.seekg(0);
+    std::vector<uint8_t> head(size_t(std::min<uint64_t>(file_size, kMaxHeaderBytes)));
+    in.read(reinterpret_cast<char*>(head.data()), std::streamsize(head.size()));
+    if (!in) throw ImageIoError(path + ": cannot read the file");
+    check_header(head.data(), head.size(), file_size, path);
+  }
   std::unique_ptr<Imf::IStream> stream;
   try {
     stream = std::make_unique<Imf::StdIFStream>(path.c_str());
@@ -157,6 +208,7 @@ ExrWindowFile read_exr_window(const std::string& path, const ExrWindowLimits& li
 
 ExrWindowFile read_exr_window(const std::string& name, const std::vector<uint8_t>& bytes,
                               const ExrWindowLimits& limits) {
+  check_header(bytes.data(), std::min(bytes.size(), kMaxHeaderBytes), bytes.size(), name);
   MemoryIStream stream(name, bytes);
   return read_stream(stream, name, limits);
 }

@@ -107,6 +107,14 @@ TEST(ExrWindowFile, FilesThatAreNotWindowsAreErrorsNamingTheFile) {
   for (size_t n : {size_t(0), size_t(4), size_t(100), good.size() / 2, good.size() - 1})
     expect_error(std::vector<uint8_t>(good.begin(), good.begin() + std::ptrdiff_t(n)), "");
   expect_error({'n', 'o', 't', ' ', 'e', 'x', 'r'}, "");
+  // A header attribute declaring 2 GB in a 30-byte file: refused before OpenEXR allocates it.
+  std::vector<uint8_t> liar = {0x76, 0x2f, 0x31, 0x01, 2, 0, 0, 0};
+  for (char ch : std::string("x\0string\0", 9)) liar.push_back(uint8_t(ch));
+  for (int b : {0xff, 0xff, 0xff, 0x7f, int('a'), int('b')}) liar.push_back(uint8_t(b));
+  expect_error(liar, "header attribute \"x\" claims 2147483647 bytes, more than the file holds");
+  std::vector<uint8_t> deep = good;
+  deep[5] |= 0x08;  // the deep-data flag of the version field
+  expect_error(deep, "multi-part or deep");
   // Over the limit, judged from the header.
   ExrWindowLimits small;
   small.max_pixels = 69;
