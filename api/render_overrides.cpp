@@ -14,9 +14,10 @@ struct RenderFlag {
   std::string_view member;  // of the "render" block
   bool text;                // the member is a string: the flag's text is taken as it is
   bool list = false;        // the member is an array of strings: the text is split at commas
+  bool numbers = false;     // with list: the items are numbers, read as JSON scalars
 };
 
-constexpr std::array<RenderFlag, 12> kRenderFlags = {{
+constexpr std::array<RenderFlag, 13> kRenderFlags = {{
     {"--width", "width", false},
     {"--height", "height", false},
     {"--spp", "spp", false},
@@ -29,6 +30,7 @@ constexpr std::array<RenderFlag, 12> kRenderFlags = {{
     {"--outputs", "outputs", false, true},
     {"--aov", "outputs", false, true},  // the name Cycles and Mitsuba users look for
     {"--denoise", "denoise", false},    // a switch: "--denoise" alone is "--denoise true"
+    {"--window", "window", false, true, true},  // "--window 0,0,64,32" is [0, 0, 64, 32]
 }};
 
 constexpr std::array<std::string_view, kRenderFlags.size() + 1> kAllFlags = [] {
@@ -64,7 +66,8 @@ Json override_value(const RenderOverride& override_flag) {
     size_t start = 0;
     while (!text.empty() && start <= text.size()) {
       const size_t comma = std::min(text.find(',', start), text.size());
-      items.push_back(text.substr(start, comma - start));
+      const std::string item = text.substr(start, comma - start);
+      items.push_back(f->numbers ? override_value(RenderOverride{"", item}) : Json(item));
       start = comma + 1;
     }
     return items;

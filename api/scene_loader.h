@@ -9,6 +9,7 @@
 #include <string_view>
 #include <vector>
 
+#include "api/animation.h"
 #include "api/asset_path.h"
 #include "renderer/scene/scene_input.h"
 
@@ -40,6 +41,10 @@ struct Limits {
   int max_lights = 10'000;
   int max_json_depth = 64;
   double max_time_limit = 24 * 3600.0;  // seconds
+  // Animations (docs/animation-and-windows.md): frames in one scene's range, and how far from 0
+  // a frame number may lie (frame / fps stays exact enough in the camera's float times).
+  int64_t max_frames = 100'000;
+  int64_t max_frame_number = 1'000'000;
   // Textures (docs/scene-format.md): width x height of any one image, read from its header
   // before a pixel is decoded; and the decoded size of all of a scene's distinct images (each
   // file once per colorspace, at most 4 channels of 1 byte for 8-bit images, else 4-byte
@@ -69,6 +74,9 @@ struct SceneRequest {
   // the scene lies. Add it back to recover JSON coordinates.
   glm::dvec3 world_origin{0.0};
   std::vector<AssetUse> assets;  // in the order the scene names them
+  // The scene's "animation" (api/animation.h). With one, `scene` is set to its first frame;
+  // select_frame chooses another.
+  std::optional<Animation> animation;
 };
 
 struct LoadResult {

@@ -4,9 +4,11 @@
 #include <cmath>
 #include <iterator>
 
+#include "api/animation_parser.h"
 #include "api/environment_parser.h"
 #include "api/material_parser.h"
 #include "api/object_parser.h"
+#include "api/render_window.h"
 #include "api/texture_parser.h"
 
 namespace penumbra::api {
@@ -107,6 +109,12 @@ void parse_render(const Json* value, const Limits& limits, RenderSettings& setti
     else
       r.error("denoise", "must be true or false");
   }
+  if (const Json* window = r.get("window")) parse_render_window(*window, r.pointer_of("window"), settings, diag);
+  // The denoiser looks at a neighbourhood of every pixel: denoised apart, windows would not join
+  // into the image denoised whole. Merge first, then denoise (penumbra merge --denoise).
+  if (settings.window && settings.denoise)
+    r.error("denoise", "a window of the image cannot be denoised alone: render the windows without "
+                       "denoise and denoise the merged image (penumbra merge --denoise)");
   r.report_unknown_keys();
 }
 
@@ -243,9 +251,22 @@ std::optional<SceneRequest> parse_scene(const Json& document, const Limits& limi
   TextureSet textures(limits, assets);
   ParsedMaterials materials =
       parse_materials(root.get("materials"), "/materials", limits, textures, diag);
+  if (const Json* animation = root.get("animation")) {
+    const Json* camera_json = root.get("camera");
+    const bool camera_shutter = camera_json && camera_json->is_object() && camera_json->contains("shutter");
+    request.animation = parse_animation(*animation, limits, camera_shutter, diag);
+    // Consumers that know nothing of frames render the first one.
+    if (request.animation) {
+      const FrameShutter first = frame_shutter(*request.animation, request.animation->first_frame);
+      request.scene.camera.shutter_open = float(first.open);
+      request.scene.camera.shutter_close = float(first.close);
+    }
+  }
   const auto& camera = request.scene.camera;
+  // Motion is checked over every frame's shutter, so any frame chosen later is in range.
   const double shutter_extent =
-      std::max(std::abs(double(camera.shutter_open)), std::abs(double(camera.shutter_close)));
+      request.animation ? animation_time_extent(*request.animation)
+                        : std::max(std::abs(double(camera.shutter_open)), std::abs(double(camera.shutter_close)));
   ParsedObjects objects =
       parse_objects(root.get("objects"), "/objects", materials, shutter_extent, origin, limits,
                     assets, textures, diag);

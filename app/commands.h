@@ -3,6 +3,7 @@
 // and returns the process exit code.
 namespace penumbra::app {
 int run_render(int argc, char** argv);
+int run_merge(int argc, char** argv);
 int run_validate(int argc, char** argv);
 int run_info(int argc, char** argv);
 int run_bench(int argc, char** argv);

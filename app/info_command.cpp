@@ -115,6 +115,15 @@ int print_scene(const std::string& file) {
   std::printf("%s: %s %d x %d pixels, %d spp\n", file.c_str(),
               is_gltf(file) ? "glTF asset, rendered at" : "scene,", settings.width, settings.height,
               settings.spp);
+  if (settings.window)
+    std::printf("  window      [%d, %d, %d, %d): %d x %d pixels\n", settings.window->x0, settings.window->y0,
+                settings.window->x1, settings.window->y1, settings.window->width(), settings.window->height());
+  if (request.animation)
+    std::printf("  animation   frames %lld to %lld (%lld), %g fps, shutter %g of a frame\n",
+                static_cast<long long>(request.animation->first_frame),
+                static_cast<long long>(request.animation->last_frame),
+                static_cast<long long>(request.animation->frame_count()), request.animation->fps,
+                request.animation->shutter);
   std::printf(
       "  objects     %zu: %s; %lld emitting\n", scene.objects.size() + scene.instances.size(),
       list_counts({{"sphere", "spheres", spheres},

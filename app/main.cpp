@@ -17,6 +17,7 @@ void print_usage(std::FILE* out) {
                "\n"
                "commands:\n"
                "  render SCENE.json -o OUT.{png,exr}   render a scene to an image\n"
+               "  merge PART.exr... -o OUT.exr         join windows of a frame rendered apart (render --window)\n"
                "  validate SCENE.json...               check scenes, print every error with its JSON pointer\n"
                "  info FILE...                         what a scene or mesh file contains, and its memory\n"
 #ifdef PENUMBRA_HAVE_SERVER
@@ -37,6 +38,7 @@ int main(int argc, char** argv) {
   const std::string command = argv[1];
   try {
     if (command == "render") return penumbra::app::run_render(argc - 1, argv + 1);
+    if (command == "merge") return penumbra::app::run_merge(argc - 1, argv + 1);
     if (command == "validate") return penumbra::app::run_validate(argc - 1, argv + 1);
     if (command == "info") return penumbra::app::run_info(argc - 1, argv + 1);
     if (command == "bench") return penumbra::app::run_bench(argc - 1, argv + 1);

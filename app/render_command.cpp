@@ -1,12 +1,14 @@
-// penumbra render SCENE.json -o OUT.{png,exr} [overrides]
+// penumbra render SCENE.json -o OUT.{png,exr} [overrides] [--window x0,y0,x1,y1] [--frame N | --frames]
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <optional>
 #include <string>
 #include <vector>
 #include <unistd.h>
 
+#include "api/animation_parser.h"
 #include "api/scene_loader.h"
 #include "api/version.h"
 #include "app/commands.h"
@@ -45,9 +47,20 @@ const char* kUsage =
     "  --denoise                denoise the image with Intel Open Image Denoise, guided by\n"
     "                           albedo and normal; the image as rendered (unbiased) is kept\n"
     "                           as the layer noisy (docs/denoising.md)\n"
+    "  --window X0,Y0,X1,Y1     render only pixels X0..X1-1, Y0..Y1-1 of the image (a part of\n"
+    "                           a frame split across machines): .exr keeps them as the data\n"
+    "                           window of the whole frame, .png holds the window's pixels;\n"
+    "                           join the parts with penumbra merge (docs/animation-and-windows.md)\n"
+    "  --frame N                render frame N of the scene's \"animation\"\n"
+    "  --frames                 render every frame of the animation, one file each: OUT must\n"
+    "                           hold a # pattern, out_####.exr -> out_0017.exr\n"
     "  -q, --quiet              no progress bar\n";
 
 enum class Layout { kPlain, kBlender, kSeparate };
+
+int render_one(const std::string& scene_path, const std::string& output, ImageFormat format,
+               Layout layout, bool quiet, const api::SceneRequest& request,
+               std::optional<int64_t> frame);
 
 std::string format_duration(double s) {
   char buf[32];
@@ -62,6 +75,8 @@ std::string format_duration(double s) {
 int run_render(int argc, char** argv) {
   std::string scene_path, output;
   bool quiet = false;
+  std::optional<int64_t> frame;
+  bool all_frames = false;
   std::string layout_name = "plain";
   std::vector<api::RenderOverride> overrides;
   OptionParser p(argc, argv);
@@ -73,6 +88,12 @@ int run_render(int argc, char** argv) {
       if (!p.value(&output)) return p.fail(kUsage);
     } else if (p.is("--layout")) {
       if (!p.value(&layout_name)) return p.fail(kUsage);
+    } else if (p.is("--frame")) {
+      long long n = 0;
+      if (!p.int_value(-1'000'000'000, 1'000'000'000, &n)) return p.fail(kUsage);
+      frame = n;
+    } else if (p.is("--frames")) {
+      all_frames = true;
     } else if (p.is("-q") || p.is("--quiet")) {
       quiet = true;
     } else if (parse_render_override(p, overrides)) {
@@ -86,6 +107,9 @@ int run_render(int argc, char** argv) {
   }
   if (scene_path.empty() || output.empty())
     return p.fail(kUsage, scene_path.empty() ? "no scene given" : "no output given (-o)");
+  if (frame && all_frames) return p.fail(kUsage, "--frame and --frames exclude each other");
+  if (all_frames && !api::has_frame_pattern(output))
+    return p.fail(kUsage, "--frames writes one file per frame: give -o a # pattern (out_####.exr)");
   // Reject an unsupported output name or layout before spending time on the render.
   ImageFormat format;
   try {
@@ -105,10 +129,49 @@ int run_render(int argc, char** argv) {
 
   api::LoadResult loaded = api::load_scene_file(scene_path, {}, overrides);
   if (!report_load_problems(scene_path, loaded)) return 1;
-  const RenderSettings& settings = loaded.request->settings;
+  api::SceneRequest& request = *loaded.request;
+
+  // Which frames: --frame N, --frames (all), or none (a scene with an animation renders its
+  // first frame, as load_scene left it).
+  std::vector<int64_t> frames;
+  if (frame) {
+    frames.push_back(*frame);
+  } else if (all_frames) {
+    if (!request.animation) {
+      std::fprintf(stderr, "%s: --frames: the scene has no \"animation\": there are no frames to render\n",
+                   scene_path.c_str());
+      return 1;
+    }
+    for (int64_t f = request.animation->first_frame; f <= request.animation->last_frame; ++f) frames.push_back(f);
+  }
+  if (frames.empty()) {
+    const int64_t f = request.animation ? request.animation->first_frame : 0;
+    const std::string path = request.animation ? api::frame_path(output, f) : output;
+    return render_one(scene_path, path, format, layout, quiet, request,
+                      request.animation ? std::optional<int64_t>(f) : std::nullopt);
+  }
+  for (const int64_t f : frames) {
+    api::Diagnostics diag;
+    if (!api::select_frame(request, f, diag, frame ? "--frame" : "--frames")) {
+      for (const api::Diagnostic& d : diag.take_errors())
+        std::fprintf(stderr, "%s: %s\n", scene_path.c_str(), d.to_string().c_str());
+      return 1;
+    }
+    if (const int rc = render_one(scene_path, api::frame_path(output, f), format, layout, quiet, request, f))
+      return rc;
+  }
+  return 0;
+}
+
+namespace {
+
+int render_one(const std::string& scene_path, const std::string& output, ImageFormat format,
+               Layout layout, bool quiet, const api::SceneRequest& request,
+               std::optional<int64_t> frame) {
+  const RenderSettings& settings = request.settings;
 
   const auto build_start = std::chrono::steady_clock::now();
-  const auto scene = Scene::build(loaded.request->scene);
+  const auto scene = Scene::build(request.scene);
   const double build_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - build_start).count();
 
@@ -142,6 +205,12 @@ int run_render(int argc, char** argv) {
       {"penumbra:integrator", settings.integrator == IntegratorKind::kPath ? "path" : "distributed"},
       {"Software", api::kSoftwareName},
   };
+  if (frame) meta.push_back({"penumbra:frame", std::to_string(*frame)});
+  // A window is written as the data window of the whole frame (EXR; a PNG holds its pixels).
+  const PixelWindow display{0, 0, settings.width, settings.height};
+  const PixelWindow* data_window = settings.window ? &result.window : nullptr;
+  const PixelWindow* display_window = settings.window ? &display : nullptr;
+  const int out_width = result.image.width, out_height = result.image.height;
   if (settings.denoise) {
     meta.push_back({"penumbra:denoised", st.denoised ? "true" : "false"});
     if (!st.denoised)
@@ -150,24 +219,30 @@ int run_render(int argc, char** argv) {
   }
   try {
     if (layout == Layout::kSeparate || (result.layers.empty() && layout == Layout::kPlain)) {
-      write_image_file(output, result.image, meta);
+      if (format == ImageFormat::kExr)
+        write_file_atomically(output, encode_layered_exr(result.image, {}, ExrLayout::kPlain, meta,
+                                                         data_window, display_window));
+      else
+        write_image_file(output, result.image, meta);
       for (const ImageLayer& layer : result.layers)
         write_file_atomically(layer_file_path(output, layer.name),
-                              encode_layer(layer, settings.width, settings.height, format, meta));
+                              encode_layer(layer, out_width, out_height, format, meta, data_window,
+                                           display_window));
     } else {
       write_file_atomically(output, encode_layered_exr(result.image, result.layers,
                                                        layout == Layout::kBlender ? ExrLayout::kBlender
                                                                                   : ExrLayout::kPlain,
-                                                       meta));
+                                                       meta, data_window, display_window));
     }
   } catch (const ImageIoError& e) {
     std::fprintf(stderr, "penumbra render: %s\n", e.what());
     return 1;
   }
   std::fprintf(stderr,
-               "rendered %s -> %s: %dx%d, %.1f spp (min %d, max %d), %.3f s (+%.3f s build), "
+               "rendered %s%s -> %s: %dx%d, %.1f spp (min %d, max %d), %.3f s (+%.3f s build), "
                "%.2f Mrays/s%s%s%s\n",
-               scene_path.c_str(), output.c_str(), settings.width, settings.height, st.spp_mean,
+               scene_path.c_str(), frame ? (" frame " + std::to_string(*frame)).c_str() : "",
+               output.c_str(), out_width, out_height, st.spp_mean,
                st.spp_min, st.spp_max, st.seconds, build_seconds, st.mrays_per_second(),
                st.stopped_by_time_limit ? ", stopped at the time limit" : "",
                st.denoised ? (", denoised in " + std::to_string(st.denoise_seconds).substr(0, 5) +
@@ -178,5 +253,7 @@ int run_render(int argc, char** argv) {
                                     : "");
   return 0;
 }
+
+}  // namespace
 
 }  // namespace penumbra::app

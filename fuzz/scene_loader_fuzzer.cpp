@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <string_view>
 
+#include "api/animation_parser.h"
 #include "api/scene_loader.h"
 #include "renderer/render/render.h"
 #include "renderer/scene/scene.h"
@@ -43,10 +44,19 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (!e.pointer.empty() && e.pointer[0] != '/') std::abort();
   if (!result.ok()) return 0;
 
-  const auto scene = penumbra::Scene::build(result.request->scene);
-  penumbra::RenderSettings s = result.request->settings;
+  // An animated scene renders its last frame: the loader checked motion over every frame's
+  // shutter, so the frame farthest in time must build and render as well as the first.
+  penumbra::api::SceneRequest request = *result.request;
+  if (request.animation) {
+    penumbra::api::Diagnostics diag;
+    if (!penumbra::api::select_frame(request, request.animation->last_frame, diag)) std::abort();
+  }
+  const auto scene = penumbra::Scene::build(request.scene);
+  penumbra::RenderSettings s = request.settings;
   s.width = 4;
   s.height = 4;
+  // A window (checked against the scene's own size) becomes one inside the 4x4 image.
+  if (s.window) s.window = penumbra::PixelWindow{1, 1, 3, 4};
   s.spp = 1;
   s.max_depth = std::min(s.max_depth < 0 ? 4 : s.max_depth, 4);
   s.threads = 1;
@@ -55,5 +65,6 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const penumbra::RenderResult r = penumbra::render(*scene, s);
   for (float v : r.image.rgb)
     if (!std::isfinite(v)) std::abort();
+  if (r.image.width != r.window.width() || r.image.height != r.window.height()) std::abort();
   return 0;
 }

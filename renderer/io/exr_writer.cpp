@@ -39,15 +39,26 @@ class MemoryStream : public Imf::OStream {
 }  // namespace
 
 std::vector<uint8_t> encode_exr_channels(const std::vector<ExrChannel>& channels, int width,
-                                         int height, const ImageMetadata& metadata) {
+                                         int height, const ImageMetadata& metadata,
+                                         const PixelWindow* data, const PixelWindow* display) {
   try {
-    Imf::Header header(width, height);
+    if (data && (data->width() != width || data->height() != height))
+      throw ImageIoError("cannot encode image: the data window is not the image's size");
+    const PixelWindow whole{0, 0, width, height};
+    const PixelWindow& dw = data && display ? *data : whole;
+    const PixelWindow& full = data && display ? *display : whole;
+    // OpenEXR windows are inclusive pixel ranges.
+    Imf::Header header(Imath::Box2i({full.x0, full.y0}, {full.x1 - 1, full.y1 - 1}),
+                       Imath::Box2i({dw.x0, dw.y0}, {dw.x1 - 1, dw.y1 - 1}));
     header.compression() = Imf::ZIP_COMPRESSION;
     for (const ExrChannel& c : channels) header.channels().insert(c.name, Imf::Channel(Imf::FLOAT));
     for (const auto& [key, value] : metadata) header.insert(key, Imf::StringAttribute(value));
     Imf::FrameBuffer frame;
     for (const ExrChannel& c : channels) {
-      char* base = reinterpret_cast<char*>(const_cast<float*>(c.base));
+      // OpenEXR addresses a slice by absolute pixel coordinates: the base is where pixel (0, 0)
+      // would be (its documented convention for data windows not at the origin).
+      char* base = reinterpret_cast<char*>(const_cast<float*>(c.base)) -
+                   (std::ptrdiff_t(dw.x0) + std::ptrdiff_t(dw.y0) * width) * std::ptrdiff_t(c.x_stride);
       frame.insert(c.name, Imf::Slice(Imf::FLOAT, base, c.x_stride, c.x_stride * size_t(width)));
     }
     MemoryStream stream;
@@ -57,6 +68,8 @@ std::vector<uint8_t> encode_exr_channels(const std::vector<ExrChannel>& channels
       file.writePixels(height);
     }
     return stream.take();
+  } catch (const ImageIoError&) {
+    throw;
   } catch (const std::exception& e) {
     throw ImageIoError(std::string("cannot encode image: ") + e.what());
   }

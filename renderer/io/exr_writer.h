@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "renderer/core/image.h"
+#include "renderer/core/pixel_window.h"
 
 namespace penumbra {
 
@@ -23,7 +24,12 @@ struct ExrChannel {
 };
 // Any number of channels in one scan-line part (OpenEXR's multi-layer convention: "layer.channel"
 // names; readers group them by the text before the last dot). Throws ImageIoError.
+// With `display`, the width x height pixels are the data window `data` of a display window of
+// display.width() x display.height() (a crop of a bigger frame, as Nuke and Blender write them;
+// data's size must be width x height); without, data and display window are the whole image.
 std::vector<uint8_t> encode_exr_channels(const std::vector<ExrChannel>& channels, int width,
-                                         int height, const ImageMetadata& metadata);
+                                         int height, const ImageMetadata& metadata,
+                                         const PixelWindow* data = nullptr,
+                                         const PixelWindow* display = nullptr);
 
 }  // namespace penumbra

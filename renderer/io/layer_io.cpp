@@ -55,7 +55,8 @@ std::vector<std::string> exr_channel_names(const ImageLayer& layer, ExrLayout la
 }
 
 std::vector<uint8_t> encode_layered_exr(const Image& beauty, const std::vector<ImageLayer>& layers,
-                                        ExrLayout layout, const ImageMetadata& metadata) {
+                                        ExrLayout layout, const ImageMetadata& metadata,
+                                        const PixelWindow* data_window, const PixelWindow* display_window) {
   const int w = beauty.width, h = beauty.height;
   const size_t pixels = size_t(w) * size_t(h);
   std::vector<std::vector<float>> data;  // finite copies, alive until encoded
@@ -81,11 +82,12 @@ std::vector<uint8_t> encode_layered_exr(const Image& beauty, const std::vector<I
   ImageMetadata meta = metadata;
   // Blender writes this attribute into its own multi-layer files and looks for it on reading.
   if (layout == ExrLayout::kBlender) meta.emplace_back("BlenderMultiChannel", "Blender V2.55.1 and newer");
-  return encode_exr_channels(channels, w, h, meta);
+  return encode_exr_channels(channels, w, h, meta, data_window, display_window);
 }
 
 std::vector<uint8_t> encode_layer(const ImageLayer& layer, int width, int height,
-                                  ImageFormat format, const ImageMetadata& metadata) {
+                                  ImageFormat format, const ImageMetadata& metadata,
+                                  const PixelWindow* data_window, const PixelWindow* display_window) {
   const size_t pixels = size_t(width) * size_t(height);
   if (layer.data.size() != pixels * size_t(layer.channels))
     throw ImageIoError("cannot encode image: layer " + layer.name + " has the wrong size");
@@ -95,7 +97,7 @@ std::vector<uint8_t> encode_layer(const ImageLayer& layer, int width, int height
     std::vector<ExrChannel> channels;
     for (int c = 0; c < layer.channels; ++c)
       channels.push_back({names[size_t(c)], data.data() + c, size_t(layer.channels) * sizeof(float)});
-    return encode_exr_channels(channels, width, height, metadata);
+    return encode_exr_channels(channels, width, height, metadata, data_window, display_window);
   }
   std::vector<uint8_t> bytes(pixels * 3);
   switch (layer.kind) {

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "renderer/core/image.h"
+#include "renderer/core/pixel_window.h"
 #include "renderer/io/image_io.h"
 
 namespace penumbra {
@@ -23,8 +24,12 @@ enum class ExrLayout { kPlain, kBlender };
 std::vector<std::string> exr_channel_names(const ImageLayer& layer, ExrLayout layout);
 
 // Beauty and layers in one EXR. Non-finite values are written as 0. Throws ImageIoError.
+// With `data_window` and `display_window` (both or neither), the images are that data window
+// of that display window (encode_exr_channels).
 std::vector<uint8_t> encode_layered_exr(const Image& beauty, const std::vector<ImageLayer>& layers,
-                                        ExrLayout layout, const ImageMetadata& metadata = {});
+                                        ExrLayout layout, const ImageMetadata& metadata = {},
+                                        const PixelWindow* data_window = nullptr,
+                                        const PixelWindow* display_window = nullptr);
 
 // One layer as its own image. EXR: linear float, the layer's plain channel names without
 // prefix (R, G, B; X, Y, Z; Z). PNG, 8 bits: albedo sRGB-encoded like the beauty image; normal
@@ -32,7 +37,9 @@ std::vector<uint8_t> encode_layered_exr(const Image& beauty, const std::vector<I
 // (d - near) / (far - near) over the pixels that saw a surface (near black, far white), the
 // background white, also as data. Throws ImageIoError.
 std::vector<uint8_t> encode_layer(const ImageLayer& layer, int width, int height,
-                                  ImageFormat format, const ImageMetadata& metadata = {});
+                                  ImageFormat format, const ImageMetadata& metadata = {},
+                                  const PixelWindow* data_window = nullptr,
+                                  const PixelWindow* display_window = nullptr);
 
 // The file a layer goes to beside the beauty image's: "out.png" -> "out.albedo.png"
 // (the layer's name before the extension; appended when there is no extension).

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <mutex>
 #include <optional>
+#include <stdexcept>
 
 #include "renderer/render/adaptive_sampling.h"
 #include "renderer/render/film.h"
@@ -20,8 +21,9 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// The image's pixels tile by tile (row-major inside each tile), and where each tile starts in
-// that order: a pass's work items are ranges of it.
+// The rendered pixels tile by tile (row-major inside each tile), and where each tile starts in
+// that order: a pass's work items are ranges of it. Indices are into the film, which covers the
+// render's window (the whole image without one).
 struct PixelOrder {
   std::vector<uint32_t> pixels;
   std::vector<size_t> tile_starts;  // one per tile, plus the end
@@ -78,7 +80,10 @@ std::vector<int> make_passes(int spp) {
   return passes;
 }
 
-// Adaptive sampling: re-estimates every pixel's sample limit from the samples so far.
+// Adaptive sampling: re-estimates every pixel's sample limit from the samples so far. With a
+// window the film is the window: the allocation's mean and the 3x3 neighbourhoods are taken over
+// its pixels alone, so a window's limits never depend on pixels another machine renders (each
+// window aims at the threshold by itself; docs/animation-and-windows.md).
 void update_limits(const Film& film, const AdaptiveLimits& limits, std::vector<uint32_t>* out) {
   const int w = film.width(), h = film.height();
   std::vector<double> deviation(size_t(w) * h);
@@ -93,8 +98,14 @@ void update_limits(const Film& film, const AdaptiveLimits& limits, std::vector<u
 RenderResult render(const Scene& scene, const RenderSettings& settings,
                     const RenderControl& control) {
   const auto start = Clock::now();
-  const int width = settings.width, height = settings.height;
-  const ThinLensCamera camera(scene.camera(), width, height);
+  // The camera sees the whole image; the films hold only the window's pixels, film pixel
+  // (fx, fy) being image pixel (window.x0 + fx, window.y0 + fy). The sampler and the camera are
+  // keyed on image coordinates, so a pixel's samples do not depend on the window.
+  const PixelWindow window = settings.window.value_or(PixelWindow{0, 0, settings.width, settings.height});
+  if (!window.fits(settings.width, settings.height))
+    throw std::invalid_argument("render: the pixel window is empty or not inside the image");
+  const ThinLensCamera camera(scene.camera(), settings.width, settings.height);
+  const int width = window.width(), height = window.height();
   const IntegrateFn integrate = select_integrator(settings.integrator, scene.features());
   const IntegratorSettings isettings{settings.max_depth, settings.rr_depth};
   const bool sample_lens = scene.features().lens;
@@ -179,7 +190,8 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
           uint64_t item_samples = 0, item_nonfinite = 0;
           for (size_t k = items[item]; k < items[item + 1]; ++k) {
             const uint32_t pi = order.pixels[k];
-            const int x = int(pi % uint32_t(width)), y = int(pi / uint32_t(width));
+            const int fx = int(pi % uint32_t(width)), fy = int(pi / uint32_t(width));
+            const int x = window.x0 + fx, y = window.y0 + fy;
             const uint32_t n0 = taken[pi], n1 = std::min(n0 + uint32_t(s1 - s0), limit[pi]);
             if (n0 >= n1) continue;
             taken[pi] = n1;
@@ -191,8 +203,8 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
               const CameraRay cr = camera.generate_ray(film_pos, lens, time);
               const Spectrum L =
                   integrate(scene, isettings, Ray{cr.origin, cr.direction, cr.time}, sampler, counters, first);
-              if (!film.add_sample(x, y, L)) ++item_nonfinite;
-              if (first) layer_film->add_sample(x, y, first_hit);
+              if (!film.add_sample(fx, fy, L)) ++item_nonfinite;
+              if (first) layer_film->add_sample(fx, fy, first_hit);
               ++item_samples;
             }
           }
@@ -213,6 +225,7 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
   }
 
   RenderResult result;
+  result.window = window;
   result.image = film.resolve();
   result.variance = film.resolve_variance();
   if (layer_film) result.layers = layer_film->resolve();

@@ -46,6 +46,9 @@ struct RenderStats {
 };
 
 struct RenderResult {
+  // The pixels of the settings' width x height image that image, variance and layers hold: the
+  // settings' window, else the whole image. Statistics count these pixels only.
+  PixelWindow window;
   Image image;     // mean radiance per pixel
   Image variance;  // per pixel and channel: estimated variance of that mean (sample variance / n)
   // The output layers RenderSettings::outputs asked for, in OutputLayerBit order (empty if none),

@@ -10,6 +10,7 @@
 
 #include "renderer/materials/material_params.h"
 #include "renderer/core/math.h"
+#include "renderer/core/pixel_window.h"
 #include "renderer/scene/instance_input.h"
 #include "renderer/textures/texture_desc.h"
 
@@ -129,6 +130,11 @@ struct RenderSettings {
   // Denoise the finished image with Open Image Denoise, guided by albedo and normal layers
   // (rendered for it whether or not `outputs` asks for them); renderer/denoise/oidn_denoiser.h.
   bool denoise = false;
+  // Render only these pixels of the width x height image (a tile of a frame split across
+  // machines). Each pixel gets exactly the values the full render gives it with uniform
+  // sampling; adaptive sampling decides within the window (docs/animation-and-windows.md).
+  // Unset: the whole image. Must fit inside the image (api/ checks it).
+  std::optional<PixelWindow> window;
 };
 
 }  // namespace penumbra

@@ -46,11 +46,11 @@ TEST(Schema, DocumentsEveryField) {
   const Json s = schema();
   const Json& defs = s["$defs"];
   expect_documented(s["properties"],
-                    {"version", "render", "camera", "environment", "materials", "objects", "lights"},
+                    {"version", "render", "camera", "animation", "environment", "materials", "objects", "lights"},
                     "root");
   expect_documented(defs["render"]["properties"],
                     {"width", "height", "spp", "max_depth", "rr_depth", "integrator", "seed",
-                     "noise_threshold", "time_limit", "outputs"},
+                     "noise_threshold", "time_limit", "outputs", "window"},
                     "render");
   expect_documented(defs["camera"]["properties"],
                     {"position", "look_at", "up", "fov", "aperture_radius", "focus_distance",
