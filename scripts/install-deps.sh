@@ -9,6 +9,8 @@
 #   scripts/install-deps.sh --browser also Chromium, its WebDriver and a venv with Selenium for the
 #                                     dashboard's browser test (ctest label "browser";
 #                                     scripts/setup-browser-venv.sh)
+# libpq-dev: the PostgreSQL store of the render farm (server/farm/); postgresql and
+# postgresql-client: the real database the ctest label "farm" starts (scripts/farm-postgres.sh).
 # Flags combine: scripts/test.sh passes --schemathesis --browser.
 set -euo pipefail
 want() { local f; for f in "${ARGS[@]}"; do [ "$f" = "$1" ] && return 0; done; return 1; }
@@ -21,6 +23,7 @@ PKGS=(
   libcpp-httplib-dev nlohmann-json3-dev libtbb-dev libsqlite3-dev
   libgtest-dev libgmock-dev libbenchmark-dev libtinyobjloader-dev libtinygltf-dev libpng-dev
   libopenexr-dev libssl-dev
+  libpq-dev postgresql postgresql-client
 )
 if want --fuzz; then PKGS+=(clang libclang-rt-14-dev); fi
 # Debian's chromium and chromium-driver (the same version), fonts for readable screenshots.

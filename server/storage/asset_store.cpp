@@ -87,14 +87,15 @@ bool AssetUpload::write(const char* data, std::size_t size) {
   return true;
 }
 
-AssetStore::AssetStore(const std::string& data_dir, AssetStoreLimits limits)
+AssetStore::AssetStore(const std::string& data_dir, AssetStoreLimits limits, bool shared)
     : root_((fs::path(data_dir) / "assets").string()), limits_(limits) {
   const fs::path root(root_);
   fs::create_directories(root / "sha256");
   fs::create_directories(root / "tmp");
   fs::create_directories(root / "jobs");
   // Interrupted uploads: never visible under a hash, gone at start.
-  for (const auto& e : fs::directory_iterator(root / "tmp")) fs::remove_all(e.path());
+  if (!shared)
+    for (const auto& e : fs::directory_iterator(root / "tmp")) fs::remove_all(e.path());
   for (const auto& e : fs::directory_iterator(root / "sha256")) {
     const std::string name = e.path().filename().string();
     struct stat st {};

@@ -81,7 +81,9 @@ struct JobLinkResult {
 
 class AssetStore {
  public:
-  AssetStore(const std::string& data_dir, AssetStoreLimits limits);
+  // `shared`: the folder is a farm's volume that other nodes write too; interrupted uploads in
+  // its tmp/ may be theirs, under way, and are left alone.
+  AssetStore(const std::string& data_dir, AssetStoreLimits limits, bool shared = false);
 
   // Which jobs still need their folder (queued or running); folders of others are removed by
   // sweep_job_folders() and before anything is evicted. Unset: every folder is kept.
