@@ -362,7 +362,34 @@ def test_max_attempts(farm):
     print("max_attempts: failed after %d lost attempts: %s" % (farm.max_attempts, detail))
 
 
+def test_assets_across_nodes(farm):
+    # Uploaded through one API node, named by a job submitted through another, rendered by a
+    # worker: the shared volume holds the files, every node's index learns them on first use.
+    import hashlib
+    a, b = farm.start("api"), farm.start("api")
+    farm.start("worker")
+    with open(os.path.join(REPO, "scenes", "meshes", "trefoil.ply"), "rb") as f:
+        mesh = f.read()
+    h = hashlib.sha256(mesh).hexdigest()
+    status, _, _ = request(b["base"], "POST", "/v1/assets/missing", {"hashes": ["sha256:" + h]})
+    check(status == 200, "missing answered")
+    req = urllib.request.Request(a["base"] + "/v1/assets/" + h, data=mesh, method="PUT")
+    req.add_header("Content-Type", "application/octet-stream")
+    with urllib.request.urlopen(req, timeout=30) as r:
+        check(r.status in (200, 201), "uploaded to the first node")
+    status, raw, _ = request(b["base"], "POST", "/v1/assets/missing", {"hashes": ["sha256:" + h]})
+    check(status == 200 and json.loads(raw)["missing"] == [], "the second node has it: %s" % raw)
+    with open(os.path.join(REPO, "scenes", "mesh_file.json")) as f:
+        s = json.load(f)
+    s["render"].update({"width": 16, "height": 16, "spp": 1})
+    job = submit(b["base"], {"scene": s, "assets": {"meshes/trefoil.ply": "sha256:" + h}})
+    states = wait_states(a["base"], [job], 60)
+    check(states[job] == "succeeded", "rendered: %s" % states[job])
+    print("assets_across_nodes: uploaded to one API node, submitted to the other, rendered")
+
+
 TESTS = {
+    "assets_across_nodes": (test_assets_across_nodes, {}),
     "exactly_once": (test_exactly_once, {}),
     "worker_kill": (test_worker_kill, {"lease": 3.0, "heartbeat": 0.5}),
     "api_kill": (test_api_kill, {}),
