@@ -1,8 +1,10 @@
 #include "server/farm/farm_service.h"
 
 #include <cstdio>
+#include <filesystem>
 #include <unordered_map>
 
+#include "renderer/io/image_io.h"
 #include "server/farm/farm_job_row.h"
 #include "server/jobs/submission_check.h"
 #include "server/jobs/unix_time.h"
@@ -20,6 +22,7 @@ constexpr const char* kLiveStates = "('queued','running')";
 FarmService::FarmService(const ServerConfig& config, PgPool& pool, FileResultStore& results,
                          Metrics& metrics, AssetStore* assets)
     : config_(config), pool_(pool), results_(results), metrics_(metrics), assets_(assets) {
+  std::filesystem::create_directories(std::filesystem::path(config_.data_dir) / "previews");
   if (assets_) {
     // An asset may be evicted only when no queued or running job of the farm names it.
     assets_->set_job_liveness([this](const std::string& id) {
@@ -245,9 +248,21 @@ DeleteOutcome FarmService::cancel_or_delete(const std::string& id, std::chrono::
                                                    : DeleteOutcome::kCancelling;
 }
 
-std::shared_ptr<const Image> FarmService::preview(const std::string&) const {
-  // The progressive image stays on the worker that renders it (docs/scale-out.md).
-  return nullptr;
+std::string farm_preview_path(const std::string& data_dir, const std::string& job_id) {
+  return (std::filesystem::path(data_dir) / "previews" / (job_id + ".exr")).string();
+}
+
+std::shared_ptr<const Image> FarmService::preview(const std::string& id) const {
+  if (!is_valid_job_id(id)) return nullptr;
+  const std::string path = farm_preview_path(config_.data_dir, id);
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) return nullptr;
+  try {
+    // Written whole (temporary name, rename) by the worker: a reader sees one image or none.
+    return std::make_shared<const Image>(read_image_file(path));
+  } catch (const std::exception&) {
+    return nullptr;  // removed meanwhile (the task ended): as if there were none yet
+  }
 }
 
 std::optional<StoredResult> FarmService::open_result(const std::string& id,

@@ -20,6 +20,10 @@ namespace penumbra::server {
 inline constexpr const char* kTaskChannel = "penumbra_tasks";
 inline constexpr const char* kJobChannel = "penumbra_jobs";
 
+// Where the worker rendering a job writes its progressive image (at heartbeats) on the shared
+// volume, for GET /v1/jobs/{id}/result?preview=true on any API node; removed when the task ends.
+std::string farm_preview_path(const std::string& data_dir, const std::string& job_id);
+
 class FarmService final : public JobBackend {
  public:
   FarmService(const ServerConfig& config, PgPool& pool, FileResultStore& results,

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <random>
 
+#include "renderer/io/image_io.h"
 #include "server/farm/farm_job_row.h"
 #include "server/farm/farm_service.h"
 #include "server/jobs/unix_time.h"
@@ -44,8 +45,9 @@ FarmWorker::FarmWorker(const ServerConfig& config, FileResultStore& results, Met
     : config_(config), results_(results), metrics_(metrics) {
   char host[256] = {};
   ::gethostname(host, sizeof host - 1);
+  host_ = host;
   // Unique across restarts and hosts; readable in GET /v1/workers.
-  id_ = std::string(host) + "-" + std::to_string(::getpid()) + "-" + random_hex(6);
+  id_ = host_ + "-" + std::to_string(::getpid()) + "-" + random_hex(6);
 }
 
 FarmWorker::~FarmWorker() {
@@ -57,7 +59,7 @@ void FarmWorker::start() {
   PgConnection db(config_.store);
   db.exec(
       "INSERT INTO workers (id, host, pid, slots, render_threads) VALUES ($1, $2, $3, $4, $5)",
-      {id_, id_.substr(0, id_.find('-')), std::to_string(::getpid()),
+      {id_, host_, std::to_string(::getpid()),
        std::to_string(config_.workers), std::to_string(config_.threads_per_job())});
   for (int i = 0; i < config_.workers; ++i) slots_.emplace_back([this] { slot_loop(); });
 }
@@ -130,11 +132,13 @@ std::optional<FarmWorker::Claim> FarmWorker::claim(PgConnection& db) {
     enum class Step { kNone, kClaimed, kExhausted } step = Step::kNone;
     Claim c;
     db.transaction([&] {
-      // Run order as on one node; SKIP LOCKED: concurrent claimers each take a different task.
+      // Run order as on one node; SKIP LOCKED: concurrent claimers each take a different task,
+      // and a job an API node is cancelling (its row locked) is passed over, never waited on:
+      // a claimer holds no lock while it waits, so it can take part in no deadlock.
       PgRows rows = db.exec(
           "SELECT t.id, t.job_id, t.attempts, t.last_error, j.scene_json FROM tasks t "
           "JOIN jobs j ON j.id = t.job_id WHERE t.state = 'queued' "
-          "ORDER BY t.priority DESC, t.job_seq, t.id LIMIT 1 FOR UPDATE OF t SKIP LOCKED");
+          "ORDER BY t.priority DESC, t.job_seq, t.id LIMIT 1 FOR UPDATE OF t, j SKIP LOCKED");
       if (rows.size() == 0) return;
       c.task = rows.int_value(0, "id");
       c.job = rows.value(0, "job_id");
@@ -182,6 +186,8 @@ std::optional<FarmWorker::Claim> FarmWorker::claim(PgConnection& db) {
 void FarmWorker::heartbeat_loop(const Claim& c, JobRuntime& runtime, std::atomic<bool>& done,
                                 std::atomic<bool>& lease_lost) {
   std::unique_ptr<PgConnection> db;
+  std::shared_ptr<const Image> written;  // the preview last written
+  const std::string preview_path = farm_preview_path(config_.data_dir, c.job);
   const auto period = std::chrono::duration<double>(config_.heartbeat_seconds);
   auto next = std::chrono::steady_clock::now() + period;
   while (!done) {
@@ -208,6 +214,14 @@ void FarmWorker::heartbeat_loop(const Claim& c, JobRuntime& runtime, std::atomic
       db->exec("UPDATE jobs SET progress_json = $2 WHERE id = $1 AND state = 'running'",
                {c.job, progress_to_json(runtime.progress())});
       db->exec("UPDATE workers SET heartbeat_at = now() WHERE id = $1", {id_});
+      if (auto image = runtime.preview(); image && image != written) {
+        try {
+          write_image_file(preview_path, *image);
+          written = image;
+        } catch (const std::exception& e) {
+          std::fprintf(stderr, "penumbra serve: worker %s: preview: %s\n", id_.c_str(), e.what());
+        }
+      }
     } catch (const StoreError& e) {
       // The database is away: the render goes on; the commit decides whether it still counts.
       std::fprintf(stderr, "penumbra serve: worker %s: heartbeat: %s\n", id_.c_str(), e.what());
@@ -273,6 +287,8 @@ void FarmWorker::run(PgConnection& db, const Claim& c) {
   }
   done = true;
   heartbeat.join();
+  std::error_code ignored;
+  std::filesystem::remove(farm_preview_path(config_.data_dir, c.job), ignored);
   {
     std::lock_guard lock(runtimes_mutex_);
     runtimes_.erase(std::find(runtimes_.begin(), runtimes_.end(), runtime));

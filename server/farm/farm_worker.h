@@ -54,7 +54,7 @@ class FarmWorker {
   const ServerConfig config_;
   FileResultStore& results_;
   Metrics& metrics_;
-  std::string id_;
+  std::string host_, id_;
   std::atomic<bool> stopping_{false};
   std::mutex runtimes_mutex_;
   std::vector<std::shared_ptr<JobRuntime>> runtimes_;

@@ -80,25 +80,39 @@ void PgConnection::ensure_open() {
 
 PgRows PgConnection::exec(const std::string& sql, const std::vector<PgParam>& params) {
   ensure_open();
-  std::vector<const char*> values;
-  values.reserve(params.size());
-  for (const PgParam& p : params) values.push_back(p ? p->c_str() : nullptr);
-  // Without parameters: the simple protocol, which also takes several statements (migrations).
-  PGresult* r = params.empty() ? PQexec(conn_, sql.c_str())
-                               : PQexecParams(conn_, sql.c_str(), int(params.size()), nullptr,
-                                              values.data(), nullptr, nullptr, 0);
-  const ExecStatusType status = PQresultStatus(r);
-  if (status == PGRES_COMMAND_OK || status == PGRES_TUPLES_OK) return PgRows(r);
-  std::string why = r ? PQresultErrorMessage(r) : PQerrorMessage(conn_);
-  const char* state = r ? PQresultErrorField(r, PG_DIAG_SQLSTATE) : nullptr;
-  PQclear(r);
-  while (!why.empty() && (why.back() == '\n' || why.back() == ' ')) why.pop_back();
-  if (PQstatus(conn_) != CONNECTION_OK) {
-    // Reopened by the next call; LISTENs are renewed then.
-    PQfinish(conn_);
-    conn_ = nullptr;
+  // A connection the server closed (a restart) still looks open until it is used. A statement
+  // that has no effect of its own (a read, or BEGIN) outside a transaction is sent once more on
+  // a new connection; anything else fails, and its caller decides (a write may have been applied
+  // before the connection broke).
+  const bool retry_safe = PQtransactionStatus(conn_) == PQTRANS_IDLE &&
+                          (sql.rfind("SELECT", 0) == 0 || sql == "BEGIN");
+  for (int attempt = 0;; ++attempt) {
+    std::vector<const char*> values;
+    values.reserve(params.size());
+    for (const PgParam& p : params) values.push_back(p ? p->c_str() : nullptr);
+    // Without parameters: the simple protocol, which also takes several statements (migrations).
+    PGresult* r = params.empty() ? PQexec(conn_, sql.c_str())
+                                 : PQexecParams(conn_, sql.c_str(), int(params.size()), nullptr,
+                                                values.data(), nullptr, nullptr, 0);
+    const ExecStatusType status = PQresultStatus(r);
+    if (status == PGRES_COMMAND_OK || status == PGRES_TUPLES_OK) return PgRows(r);
+    std::string why = r ? PQresultErrorMessage(r) : PQerrorMessage(conn_);
+    const char* state = r ? PQresultErrorField(r, PG_DIAG_SQLSTATE) : nullptr;
+    const std::string sqlstate = state ? state : "";
+    PQclear(r);
+    while (!why.empty() && (why.back() == '\n' || why.back() == ' ')) why.pop_back();
+    const bool broken = PQstatus(conn_) != CONNECTION_OK;
+    if (broken) {
+      // Reopened by the next call; LISTENs are renewed then.
+      PQfinish(conn_);
+      conn_ = nullptr;
+    }
+    if (broken && retry_safe && attempt == 0) {
+      ensure_open();
+      continue;
+    }
+    throw StoreError("PostgreSQL" + (sqlstate.empty() ? "" : " " + sqlstate) + ": " + why);
   }
-  throw StoreError(std::string("PostgreSQL") + (state ? std::string(" ") + state : "") + ": " + why);
 }
 
 void PgConnection::rollback_quietly() {

@@ -216,6 +216,21 @@ def test_exactly_once(farm):
         for api in apis:
             status, raw, headers = request(api["base"], "GET", "/v1/jobs/%s/result" % i)
             check(status == 200 and raw[:4] == b"\x89PNG", "result of %s from %s" % (i, api["base"]))
+    # Listing pages through every job on either node, newest first.
+    listed, token = [], None
+    while True:
+        path = "/v1/jobs?limit=30" + ("&page_token=" + token if token else "")
+        status, page = get_json(apis[len(listed) // 30 % 2]["base"], path)
+        check(status == 200, "list answered %d" % status)
+        listed += [j["id"] for j in page["jobs"]]
+        token = page.get("next_page_token")
+        if not token:
+            break
+    check(sorted(listed) == sorted(ids) and len(listed) == 100, "listed %d jobs" % len(listed))
+    status, page = get_json(apis[0]["base"], "/v1/jobs?state=succeeded&limit=5")
+    check(status == 200 and len(page["jobs"]) == 5, "filtered by state")
+    status, page = get_json(apis[0]["base"], "/v1/jobs?state=queued")
+    check(status == 200 and page["jobs"] == [], "nothing queued")
     workers = [w for w in get_json(apis[0]["base"], "/v1/workers")[1]["workers"]]
     done = sorted(w["tasks_succeeded"] for w in workers)
     check(len(workers) == 3 and sum(done) == 100, "3 workers did the 100 tasks: %s" % done)
@@ -331,12 +346,20 @@ def test_cancel_running(farm):
     deadline = time.time() + 30
     while time.time() < deadline and not running_owner(farm, job):
         time.sleep(0.05)
+    # The worker writes its progressive image at heartbeats; any API node serves it.
+    preview = None
+    while time.time() < deadline and preview is None:
+        status, raw, headers = request(api["base"], "GET", "/v1/jobs/%s/result?preview=true" % job)
+        if status == 200:
+            preview = raw
+        time.sleep(0.2)
+    check(preview is not None and preview[:4] == b"\x89PNG", "a preview of the running job")
     t0 = time.time()
     status, _, _ = request(api["base"], "DELETE", "/v1/jobs/" + job)
     check(status in (200, 202, 204), "cancel answered %d" % status)
     states = wait_states(api["base"], [job], 30)
     check(states[job] == "cancelled", "cancelled: %s" % states[job])
-    print("cancel_running: cancelled %.2f s after DELETE" % (time.time() - t0))
+    print("cancel_running: preview served; cancelled %.2f s after DELETE" % (time.time() - t0))
 
 
 def test_max_attempts(farm):
@@ -388,7 +411,33 @@ def test_assets_across_nodes(farm):
     print("assets_across_nodes: uploaded to one API node, submitted to the other, rendered")
 
 
+def test_events_stream(farm):
+    # Submitted through one API node, watched through the other: the stream of state changes
+    # comes from the jobs' version column (and NOTIFY), whichever worker renders.
+    a, b = farm.start("api"), farm.start("api")
+    farm.start("worker")
+    blocker = submit(a["base"], scene(64, 64, 2048))
+    job = submit(a["base"], scene(32, 32, 256))
+    req = urllib.request.Request(b["base"] + "/v1/jobs/%s/events" % job)
+    req.add_header("Accept", "text/event-stream")
+    seen = []
+    with urllib.request.urlopen(req, timeout=120) as stream:
+        for line in stream:
+            line = line.decode().strip()
+            if line.startswith("event: "):
+                state = line[len("event: "):]
+                if not seen or seen[-1] != state:
+                    seen.append(state)
+                if state in ("succeeded", "failed", "cancelled"):
+                    break
+    check(seen[:1] == ["queued"] and "running" in seen and seen[-1] == "succeeded",
+          "states streamed: %s" % seen)
+    wait_states(a["base"], [blocker], 120)
+    print("events_stream: %s" % " -> ".join(seen))
+
+
 TESTS = {
+    "events_stream": (test_events_stream, {}),
     "assets_across_nodes": (test_assets_across_nodes, {}),
     "exactly_once": (test_exactly_once, {}),
     "worker_kill": (test_worker_kill, {"lease": 3.0, "heartbeat": 0.5}),
