@@ -9,9 +9,10 @@
 #   scripts/install-deps.sh --browser also Chromium, its WebDriver and a venv with Selenium for the
 #                                     dashboard's browser test (ctest label "browser";
 #                                     scripts/setup-browser-venv.sh)
-# libpq-dev: the PostgreSQL store of the render farm (server/farm/); postgresql and
-# postgresql-client: the real database the ctest label "farm" starts (scripts/farm-postgres.sh).
-# Flags combine: scripts/test.sh passes --schemathesis --browser.
+#   scripts/install-deps.sh --farm    also PostgreSQL's server and client: the throwaway database
+#                                     the ctest label "farm" starts (scripts/farm-postgres.sh)
+# libpq-dev (always): the PostgreSQL store of the render farm (server/farm/, docs/scale-out.md).
+# Flags combine: scripts/test.sh passes --schemathesis --browser --farm.
 set -euo pipefail
 want() { local f; for f in "${ARGS[@]}"; do [ "$f" = "$1" ] && return 0; done; return 1; }
 ARGS=("$@")
@@ -23,8 +24,9 @@ PKGS=(
   libcpp-httplib-dev nlohmann-json3-dev libtbb-dev libsqlite3-dev
   libgtest-dev libgmock-dev libbenchmark-dev libtinyobjloader-dev libtinygltf-dev libpng-dev
   libopenexr-dev libssl-dev
-  libpq-dev postgresql postgresql-client
+  libpq-dev
 )
+if want --farm; then PKGS+=(postgresql postgresql-client); fi
 if want --fuzz; then PKGS+=(clang libclang-rt-14-dev); fi
 # Debian's chromium and chromium-driver (the same version), fonts for readable screenshots.
 if want --browser; then PKGS+=(chromium chromium-driver fonts-dejavu-core python3-venv); fi

@@ -3,8 +3,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 # --schemathesis: also the pinned Python venv (.venv-schemathesis) of the "schemathesis" label;
-# --browser: Debian's chromium and chromium-driver and the Selenium venv of the "browser" label.
-./scripts/install-deps.sh --schemathesis --browser
+# --browser: Debian's chromium and chromium-driver and the Selenium venv of the "browser" label;
+# --farm: PostgreSQL for the "farm" label.
+./scripts/install-deps.sh --schemathesis --browser --farm
 ./scripts/build.sh
 BUILD_DIR=${BUILD_DIR:-build}
 # Open Image Denoise beside the binary (the pinned PyPI wheel's libraries; denoising tests).
