@@ -286,20 +286,43 @@ def test_worker_kill(farm):
 def test_api_kill(farm):
     a, b = farm.start("api"), farm.start("api")
     farm.start("worker")
-    keys = ["key-%d" % n for n in range(40)]
+    keys = ["key-%d" % n for n in range(60)]
     ids = {}
-    killer = threading.Timer(0.4, lambda: a["proc"].send_signal(signal.SIGKILL))
-    killer.start()
-    for n, key in enumerate(keys):
-        body = scene(seed=n)
-        try:
-            ids[key] = submit(a["base"], body, key)
-        except (AssertionError, urllib.error.URLError, ConnectionError, socket.timeout):
-            # The node died mid-request: the client retries elsewhere with the same key.
-            ids[key] = submit(b["base"], body, key, retries=5)
-    killer.join()
+    lock = threading.Lock()
+    retried = []
+    # A request surely under way at the kill: its head and half its body sent, the rest never.
+    half = socket.create_connection(("127.0.0.1", int(a["base"].rsplit(":", 1)[1])))
+    body = json.dumps(scene(seed=999)).encode()
+    half.sendall(b"POST /v1/jobs HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\n"
+                 b"Idempotency-Key: key-half\r\nContent-Length: %d\r\n\r\n" % len(body)
+                 + body[:len(body) // 2])
+
+    def client(k):
+        for n in range(k, len(keys), 4):
+            key = keys[n]
+            try:
+                i = submit(a["base"], scene(seed=n), key)
+            except (AssertionError, urllib.error.URLError, ConnectionError, socket.timeout):
+                # The node died mid-request: the client retries elsewhere with the same key.
+                i = submit(b["base"], scene(seed=n), key, retries=5)
+                with lock:
+                    retried.append(key)
+            with lock:
+                ids[key] = i
+
+    threads = [threading.Thread(target=client, args=(k,)) for k in range(4)]
+    for t in threads:
+        t.start()
+    time.sleep(0.3)
+    a["proc"].send_signal(signal.SIGKILL)
+    for t in threads:
+        t.join()
+    half.close()
     check(a["proc"].wait(5) == -signal.SIGKILL, "the first API node was killed")
-    check(len(set(ids.values())) == len(keys), "one job per key")
+    check(len(ids) == len(keys) and len(set(ids.values())) == len(keys), "one job per key")
+    # The half-sent request was never accepted: no job has its key.
+    check(farm.psql("SELECT count(*) FROM jobs WHERE idempotency_key = 'key-half'") == [["0"]],
+          "the unfinished request made no job")
     # A client that cannot tell which requests got through sends them all again, to the node
     # still up: every one is a replay of the job its key made.
     for n, key in enumerate(keys):
@@ -311,7 +334,8 @@ def test_api_kill(farm):
     check(count == len(keys), "no duplicate job in the store: %d" % count)
     states = wait_states(b["base"], list(ids.values()), 120)
     check(all(s == "succeeded" for s in states.values()), "all finished: %s" % states)
-    print("api_kill: %d jobs, one per key, all finished" % len(keys))
+    print("api_kill: %d jobs from 4 clients, %d retried on the other node after the kill, "
+          "one job per key, all finished" % (len(keys), len(retried)))
 
 
 def test_postgres_restart(farm):
