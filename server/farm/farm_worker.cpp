@@ -118,6 +118,11 @@ int FarmWorker::reap_expired(PgConnection& db) {
       "UPDATE tasks t SET state = 'queued', lease_token = NULL, lease_expires = NULL, "
       "  last_error = 'the worker ' || e.lease_owner || ' stopped renewing its lease' "
       "FROM expired e WHERE t.id = e.id RETURNING t.id");
+  // Workers silent for ten leases are gone (kill -9, lost host): off /v1/workers and /metrics.
+  db.exec(
+      "UPDATE workers SET stopped_at = now() WHERE stopped_at IS NULL AND heartbeat_at < now() - "
+      "make_interval(secs => $1)",
+      {seconds(10 * config_.lease_seconds)});
   if (rows.size() > 0) {
     std::fprintf(stderr, "penumbra serve: worker %s: %d task(s) of lost workers queued again\n",
                  id_.c_str(), rows.size());
