@@ -152,8 +152,8 @@ JobView FarmService::make_view(const PgRows& rows, int row, PgConnection& db) co
   if (v.record.state == JobState::kQueued) {
     // Jobs ahead of it in run order: higher priority, or the same and submitted earlier.
     PgRows ahead = db.exec(
-        "SELECT count(*) AS n FROM jobs WHERE state = 'queued' AND (priority > $1 OR (priority = "
-        "$1 AND seq < $2))",
+        "SELECT count(*) AS n FROM jobs WHERE state = 'queued' AND (priority > $1::bigint OR "
+        "(priority = $1::bigint AND seq < $2::bigint))",
         {param(v.record.priority), param(v.record.seq)});
     v.queue_position = std::size_t(ahead.int_value(0, "n"));
   }
@@ -173,8 +173,8 @@ std::vector<JobView> FarmService::list(std::optional<JobState> state, int64_t be
   auto db = pool_.acquire();
   PgRows rows = db->exec(
       std::string("SELECT ") + kJobColumns +
-          " FROM jobs WHERE state <> 'deleted' AND ($1::text IS NULL OR state = $1) AND ($2 = 0 "
-          "OR seq < $2) ORDER BY seq DESC LIMIT $3",
+          " FROM jobs WHERE state <> 'deleted' AND ($1::text IS NULL OR state = $1) AND "
+          "($2::bigint = 0 OR seq < $2::bigint) ORDER BY seq DESC LIMIT $3::bigint",
       {state ? PgParam(to_string(*state)) : std::nullopt, param(before_seq), param(limit)});
   std::vector<JobView> out;
   for (int i = 0; i < rows.size(); ++i) out.push_back(make_view(rows, i, *db));
@@ -185,8 +185,9 @@ std::vector<JobView> FarmService::list_queued(std::optional<RunKey> after, int l
   auto db = pool_.acquire();
   PgRows rows = db->exec(
       std::string("SELECT ") + kJobColumns +
-          " FROM jobs WHERE state = 'queued' AND ($1::boolean IS NOT TRUE OR priority < $2 OR "
-          "(priority = $2 AND seq > $3)) ORDER BY priority DESC, seq LIMIT $4",
+          " FROM jobs WHERE state = 'queued' AND ($1::boolean IS NOT TRUE OR priority < "
+          "$2::bigint OR (priority = $2::bigint AND seq > $3::bigint)) ORDER BY priority DESC, "
+          "seq LIMIT $4::bigint",
       {after ? "true" : "false", param(after ? after->priority : 0), param(after ? after->seq : 0),
        param(limit)});
   std::vector<JobView> out;
