@@ -1,5 +1,6 @@
 #include "server/farm/farm_service.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <unordered_map>
@@ -14,6 +15,8 @@ namespace penumbra::server {
 namespace {
 
 std::string param(int64_t v) { return std::to_string(v); }
+// Unix seconds with their fraction (std::to_string keeps 6 decimals).
+std::string seconds_text(double s) { return std::to_string(s); }
 
 constexpr const char* kLiveStates = "('queued','running')";
 
@@ -44,7 +47,43 @@ FarmService::~FarmService() {
   stop();
 }
 
-void FarmService::start() { event_thread_ = std::thread([this] { event_loop(); }); }
+void FarmService::start() {
+  event_thread_ = std::thread([this] { event_loop(); });
+  reaper_ = std::thread([this] { reaper_loop(); });
+}
+
+void FarmService::expire_now() {
+  auto db = pool_.acquire();
+  PgRows gone = db->exec(
+      "DELETE FROM jobs WHERE state IN ('succeeded', 'failed', 'cancelled', 'deleted') AND "
+      "finished_at > 0 AND finished_at < $1 RETURNING id, result_token",
+      {seconds_text(unix_now() - config_.retention_seconds)});
+  // Rows first, then files: a crash in between leaves files nobody serves, never a record
+  // whose image is gone.
+  for (int i = 0; i < gone.size(); ++i) {
+    const std::string id = gone.value(i, "id");
+    const std::string token = gone.value(i, "result_token");
+    if (!token.empty()) results_.remove(id + "." + token);
+    events_.forget(id);
+    if (assets_) assets_->remove_job_folder(id);
+  }
+}
+
+void FarmService::reaper_loop() {
+  const auto period = std::chrono::duration<double>(
+      std::clamp(config_.retention_seconds / 4, 0.05, 60.0));
+  auto next = std::chrono::steady_clock::now();
+  while (!stopping_) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    if (std::chrono::steady_clock::now() < next) continue;
+    next += std::chrono::duration_cast<std::chrono::steady_clock::duration>(period);
+    try {
+      expire_now();
+    } catch (const StoreError& e) {
+      std::fprintf(stderr, "penumbra serve: expiry: %s\n", e.what());
+    }
+  }
+}
 
 void FarmService::begin_shutdown() {
   stopping_ = true;
@@ -53,6 +92,7 @@ void FarmService::begin_shutdown() {
 
 void FarmService::stop() {
   if (event_thread_.joinable()) event_thread_.join();
+  if (reaper_.joinable()) reaper_.join();
 }
 
 SubmitOutcome FarmService::submit(std::string_view body, const std::string& idempotency_key) {

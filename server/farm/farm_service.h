@@ -59,6 +59,10 @@ class FarmService final : public JobBackend {
  private:
   JobView make_view(const PgRows& rows, int row, PgConnection& db) const;
   void event_loop();
+  // Erases finished jobs older than --retention (rows, result files, asset folders); any API
+  // node may do it: each expired row is deleted, and its files removed, by one of them.
+  void reaper_loop();
+  void expire_now();
 
   const ServerConfig config_;
   PgPool& pool_;
@@ -68,6 +72,7 @@ class FarmService final : public JobBackend {
   JobEvents events_;
   std::atomic<bool> stopping_{false};
   std::thread event_thread_;
+  std::thread reaper_;
 };
 
 }  // namespace penumbra::server

@@ -461,7 +461,26 @@ def test_events_stream(farm):
     print("events_stream: %s" % " -> ".join(seen))
 
 
+def test_retention(farm):
+    # Finished jobs expire after --retention on the farm too: record, result files and all.
+    api = farm.start("api", ["--retention", "2s"])
+    farm.start("worker")
+    job = submit(api["base"], scene())
+    check(wait_states(api["base"], [job], 60)[job] == "succeeded", "rendered")
+    check(any(f.startswith(job) for f in result_files(farm)), "its result is on the volume")
+    deadline = time.time() + 10
+    status = 200
+    while time.time() < deadline and status != 404:
+        status, _ = get_json(api["base"], "/v1/jobs/" + job)
+        time.sleep(0.2)
+    check(status == 404, "expired: %d" % status)
+    check(not any(f.startswith(job) for f in result_files(farm)), "its files are gone")
+    check(farm.psql("SELECT count(*) FROM jobs") == [["0"]], "its row is gone")
+    print("retention: the job, its row and its files went after --retention 2s")
+
+
 TESTS = {
+    "retention": (test_retention, {}),
     "events_stream": (test_events_stream, {}),
     "assets_across_nodes": (test_assets_across_nodes, {}),
     "exactly_once": (test_exactly_once, {}),
