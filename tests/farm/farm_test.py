@@ -287,7 +287,7 @@ def test_worker_kill(farm):
 def test_api_kill(farm):
     a, b = farm.start("api"), farm.start("api")
     farm.start("worker")
-    keys = ["key-%d" % n for n in range(60)]
+    keys = ["key-%d" % n for n in range(120)]
     ids = {}
     lock = threading.Lock()
     retried = []
@@ -314,7 +314,12 @@ def test_api_kill(farm):
     threads = [threading.Thread(target=client, args=(k,)) for k in range(4)]
     for t in threads:
         t.start()
-    time.sleep(0.3)
+    # Killed once the clients are under way (some requests surely in flight besides the half one).
+    while True:
+        with lock:
+            if len(ids) >= 10:
+                break
+        time.sleep(0.005)
     a["proc"].send_signal(signal.SIGKILL)
     for t in threads:
         t.join()
@@ -335,6 +340,7 @@ def test_api_kill(farm):
     check(count == len(keys), "no duplicate job in the store: %d" % count)
     states = wait_states(b["base"], list(ids.values()), 120)
     check(all(s == "succeeded" for s in states.values()), "all finished: %s" % states)
+    check(retried, "some submissions were cut by the kill and retried")
     print("api_kill: %d jobs from 4 clients, %d retried on the other node after the kill, "
           "one job per key, all finished" % (len(keys), len(retried)))
 
