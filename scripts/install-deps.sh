@@ -11,7 +11,10 @@
 #                                     scripts/setup-browser-venv.sh)
 #   scripts/install-deps.sh --blender also Debian's Blender 3.4 for the add-on's test (ctest label
 #                                     "blender"; scripts/blender-test.sh)
-# Flags combine: scripts/test.sh passes --schemathesis --browser --blender.
+#   scripts/install-deps.sh --farm    also PostgreSQL's server and client: the throwaway database
+#                                     the ctest label "farm" starts (scripts/farm-postgres.sh)
+# libpq-dev (always): the PostgreSQL store of the render farm (server/farm/, docs/scale-out.md).
+# Flags combine: scripts/test.sh passes --schemathesis --browser --blender --farm.
 set -euo pipefail
 want() { local f; for f in "${ARGS[@]}"; do [ "$f" = "$1" ] && return 0; done; return 1; }
 ARGS=("$@")
@@ -23,7 +26,9 @@ PKGS=(
   libcpp-httplib-dev nlohmann-json3-dev libtbb-dev libsqlite3-dev
   libgtest-dev libgmock-dev libbenchmark-dev libtinyobjloader-dev libtinygltf-dev libpng-dev
   libopenexr-dev libssl-dev
+  libpq-dev
 )
+if want --farm; then PKGS+=(postgresql postgresql-client); fi
 if want --fuzz; then PKGS+=(clang libclang-rt-14-dev); fi
 # Debian's chromium and chromium-driver (the same version), fonts for readable screenshots.
 if want --browser; then PKGS+=(chromium chromium-driver fonts-dejavu-core python3-venv); fi

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Fuzzes the running service against /v1/openapi.json with every schemathesis check, twice:
-# a server without a token, and one with a token (called with it, and without it: every route
-# but /healthz must then answer the documented 401). Bounded: a fixed number of examples per
+# Fuzzes the running service against /v1/openapi.json with every schemathesis check: a server
+# without a token, one with a token (called with it, and without it: every route but /healthz
+# must then answer the documented 401), and a render farm node on a throwaway PostgreSQL. Bounded: a fixed number of examples per
 # operation and a fixed seed, a few minutes on 2 cores. Exit 0 only with 0 failures.
 #
 #   scripts/schemathesis.sh PENUMBRA_BINARY [VENV_DIR] [EXAMPLES]
@@ -27,6 +27,7 @@ pids=()
 cleanup() {
   for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done
   wait 2>/dev/null || true
+  if declare -F stop_pg >/dev/null; then stop_pg; fi
   rm -rf "$work"
 }
 trap cleanup EXIT
@@ -75,7 +76,24 @@ run "no token configured" "$schema_file" "http://127.0.0.1:$open_port" \
 run "token configured, sent" "$schema_file" "http://127.0.0.1:$auth_port" \
   -H "Authorization: Bearer $token" || status=1
 run "token configured, not sent" "$schema_file" "http://127.0.0.1:$auth_port" || status=1
-for name in open auth; do
+names="open auth"
+# A render farm node (--store postgres://..., docs/scale-out.md) answers the same document: once
+# more against one on a throwaway PostgreSQL, when its server is installed (install-deps --farm).
+if ls /usr/lib/postgresql/*/bin/initdb >/dev/null 2>&1; then
+  pg_port="$(python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1",0)); print(s.getsockname()[1])')"
+  chmod 755 "$work"
+  pg_url="$("$repo_root/scripts/farm-postgres.sh" start "$work/pg" "$pg_port")"
+  stop_pg() { "$repo_root/scripts/farm-postgres.sh" stop "$work/pg" immediate || true; }
+  start_server farm --store "$pg_url" --role all --render-threads 1
+  farm_port="$PORT"
+  run "farm node (PostgreSQL store)" "$schema_file" "http://127.0.0.1:$farm_port" \
+    --exclude-checks ignored_auth || status=1
+  names="open auth farm"
+elif [ "${CI:-}" = "true" ]; then
+  echo "schemathesis.sh: no PostgreSQL server for the farm node (scripts/install-deps.sh --farm)" >&2
+  status=1
+fi
+for name in $names; do
   if grep -q "internal error" "$work/$name.log"; then
     echo "schemathesis.sh: the $name server logged an internal error:" >&2
     grep "internal error" "$work/$name.log" >&2

@@ -5,7 +5,8 @@ cd "$(dirname "$0")/.."
 # --schemathesis: also the pinned Python venv (.venv-schemathesis) of the "schemathesis" label;
 # --browser: Debian's chromium and chromium-driver and the Selenium venv of the "browser" label;
 # --blender: Debian's Blender for the add-on's test (label "blender").
-./scripts/install-deps.sh --schemathesis --browser --blender
+# --farm: PostgreSQL for the "farm" label.
+./scripts/install-deps.sh --schemathesis --browser --blender --farm
 ./scripts/build.sh
 BUILD_DIR=${BUILD_DIR:-build}
 # Open Image Denoise beside the binary (the pinned PyPI wheel's libraries; denoising tests).

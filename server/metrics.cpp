@@ -115,6 +115,7 @@ std::string Metrics::render_text(const Gauges& g) const {
     o << "penumbra_http_requests_total{method=\"" << method << "\",route=\"" << route
       << "\",status=\"" << status << "\"} " << n << "\n";
   }
+  o << g.extra_text;
   return o.str();
 }
 

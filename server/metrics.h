@@ -37,6 +37,7 @@ class Metrics {
     bool ready = false;
     int64_t webhooks_pending = 0;  // deliveries scheduled or under way
     int64_t event_streams = 0;     // GET /v1/jobs/{id}/events streams open
+    std::string extra_text;        // more series in the exposition format (the farm's)
   };
   std::string render_text(const Gauges& gauges) const;
 

@@ -10,6 +10,10 @@
 #include <thread>
 #include <unistd.h>
 
+#include "server/farm/farm_schema.h"
+#include "server/farm/farm_service.h"
+#include "server/farm/farm_worker.h"
+#include "server/farm/pg_pool.h"
 #include "server/http/http_server.h"
 #include "server/jobs/job_service.h"
 #include "server/loopback.h"
@@ -71,19 +75,56 @@ int run_serve(int argc, char** argv) {
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
 
   std::filesystem::create_directories(config.data_dir);
-  SqliteJobStore store((std::filesystem::path(config.data_dir) / "jobs.db").string());
-  FileResultStore files(config.data_dir);
+  FileResultStore files(config.data_dir, /*shared=*/config.farm());
   Metrics metrics;
-  AssetStore assets(config.data_dir, {config.max_asset_bytes, config.max_asset_store_bytes});
-  JobService jobs(config, store, files, metrics, &assets);
-  HttpServer http(config, jobs, metrics);
+  AssetStore assets(config.data_dir, {config.max_asset_bytes, config.max_asset_store_bytes},
+                    /*shared=*/config.farm());
+  // One node (SQLite in --data-dir) or a farm node (PostgreSQL, --data-dir shared): the routes
+  // see a JobBackend either way.
+  std::unique_ptr<SqliteJobStore> sqlite;
+  std::unique_ptr<JobService> local;
+  std::unique_ptr<PgPool> pool;
+  std::unique_ptr<FarmService> farm;
+  std::unique_ptr<FarmWorker> farm_worker;
+  JobBackend* backend = nullptr;
+  if (config.farm()) {
+    try {
+      PgConnection db(config.store);
+      const int version = migrate_farm_schema(db);
+      std::printf("store %s, schema version %d, role %s\n", redact_url(config.store).c_str(),
+                  version, config.role.c_str());
+    } catch (const StoreError& e) {
+      std::fprintf(stderr, "penumbra serve: %s\n", e.what());
+      return 1;
+    }
+    pool = std::make_unique<PgPool>(config.store, 8);
+    farm = std::make_unique<FarmService>(config, *pool, files, metrics, &assets);
+    if (config.renders()) farm_worker = std::make_unique<FarmWorker>(config, files, metrics);
+    backend = farm.get();
+  } else {
+    sqlite = std::make_unique<SqliteJobStore>((std::filesystem::path(config.data_dir) / "jobs.db").string());
+    local = std::make_unique<JobService>(config, *sqlite, files, metrics, &assets);
+    backend = local.get();
+  }
+  HttpServer http(config, *backend, metrics);
   const int port = http.bind();
   if (port <= 0) {
     std::fprintf(stderr, "penumbra serve: cannot listen on %s:%d\n", config.host.c_str(), config.port);
     return 1;
   }
   if (open_without_token && !http.bound_to_loopback()) return refuse_open();
-  jobs.start();
+  if (local) local->start();
+  if (farm) {
+    farm->start();
+    if (farm_worker) {
+      try {
+        farm_worker->start();
+      } catch (const StoreError& e) {
+        std::fprintf(stderr, "penumbra serve: %s\n", e.what());
+        return 1;
+      }
+    }
+  }
 
   std::atomic<bool> shutting_down{false};
   std::atomic<bool> listen_returned{false};
@@ -94,8 +135,15 @@ int run_serve(int argc, char** argv) {
     const auto start = std::chrono::steady_clock::now();
     std::fprintf(stderr, "penumbra serve: %s: shutting down\n", sig == SIGINT ? "SIGINT" : "SIGTERM");
     http.set_ready(false);
-    jobs.begin_shutdown();
-    if (!jobs.stop(start + kShutdownBudget)) {
+    if (farm) {
+      // Running renders stop and their tasks go back to the queue for other workers.
+      farm->begin_shutdown();
+      if (farm_worker) farm_worker->begin_shutdown();
+      if (farm_worker) farm_worker->join();
+      farm->stop();
+    }
+    if (local) local->begin_shutdown();
+    if (local && !local->stop(start + kShutdownBudget)) {
       // A render that does not stop (e.g. inside a long scene build): its job is still
       // 'running' in the store and runs again after the restart.
       std::fprintf(stderr, "penumbra serve: a render did not stop in time; exiting anyway\n");

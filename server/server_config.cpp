@@ -170,6 +170,27 @@ std::vector<Setting> settings() {
                        &ServerConfig::webhook_retry_seconds),
       int_setting("--max-event-streams", "PENUMBRA_MAX_EVENT_STREAMS", 1, 16384,
                   &ServerConfig::max_event_streams),
+      {"--store", "PENUMBRA_STORE", true,
+       [](ServerConfig& c, const std::string& v) -> std::string {
+         if (v == "sqlite") {
+           c.store.clear();
+           return "";
+         }
+         if (v.rfind("postgres://", 0) != 0 && v.rfind("postgresql://", 0) != 0)
+           return bad("--store", "(hidden)", "sqlite or a postgres://... URL");
+         c.store = v;
+         return "";
+       }},
+      {"--role", "PENUMBRA_ROLE", true,
+       [](ServerConfig& c, const std::string& v) -> std::string {
+         if (v != "api" && v != "worker" && v != "all") return bad("--role", v, "api, worker or all");
+         c.role = v;
+         return "";
+       }},
+      duration_setting("--lease-seconds", "PENUMBRA_LEASE_SECONDS", 1.0,
+                       &ServerConfig::lease_seconds),
+      duration_setting("--heartbeat", "PENUMBRA_HEARTBEAT", 0.05, &ServerConfig::heartbeat_seconds),
+      int_setting("--max-attempts", "PENUMBRA_MAX_ATTEMPTS", 1, 100, &ServerConfig::max_attempts),
   };
 }
 
@@ -283,6 +304,15 @@ ConfigParse parse_server_config(const std::vector<std::string>& args,
       return out;
     }
   }
+  if (config.role != "all" && !config.farm()) {
+    out.error = "--role " + config.role + " needs a shared store (--store postgres://...)";
+    return out;
+  }
+  if (config.farm() && config.heartbeat_seconds * 2 > config.lease_seconds) {
+    out.error = "--heartbeat must be at most half of --lease-seconds, so one late heartbeat "
+                "does not lose the lease";
+    return out;
+  }
   out.config = config;
   return out;
 }
@@ -358,6 +388,19 @@ const char* serve_usage() {
          "                           [PENUMBRA_MAX_JOB_FILES]\n"
          "  --max-image-pixels N     width x height of one texture, read from its header\n"
          "                           before decoding (default 67108864) [PENUMBRA_MAX_IMAGE_PIXELS]\n"
+         "\n"
+         "Render farm (docs/scale-out.md):\n"
+         "  --store URL              sqlite (default: jobs.db in --data-dir) or postgres://... :\n"
+         "                           jobs and tasks in PostgreSQL, --data-dir the shared volume\n"
+         "                           of assets and results [PENUMBRA_STORE]\n"
+         "  --role ROLE              api (HTTP only), worker (renders tasks) or all (default)\n"
+         "                           [PENUMBRA_ROLE]\n"
+         "  --lease-seconds DUR      a claimed task's lease past each heartbeat (default 30s)\n"
+         "                           [PENUMBRA_LEASE_SECONDS]\n"
+         "  --heartbeat DUR          lease renewal, progress and cancellation check (default 5s;\n"
+         "                           at most half the lease) [PENUMBRA_HEARTBEAT]\n"
+         "  --max-attempts N         a task failing (or losing its lease) this often fails its\n"
+         "                           job with the reason (default 3) [PENUMBRA_MAX_ATTEMPTS]\n"
          "\n"
          "Durations: 90, 90s, 15m, 24h, 7d, 250ms.\n";
 }

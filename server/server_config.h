@@ -58,6 +58,18 @@ struct ServerConfig {
   int max_job_files = 1000;                                      // manifest entries per job
   int64_t max_image_pixels = int64_t(8192) * 8192;  // one texture, from its header
 
+  // The render farm (docs/scale-out.md). Empty store: one node, SQLite in --data-dir (the
+  // default). "postgres://..." or "postgresql://...": the jobs and the task queue live in that
+  // PostgreSQL database and --data-dir is the shared volume of assets and results.
+  std::string store;
+  // What this process does with a PostgreSQL store: "api" answers HTTP only, "worker" renders
+  // tasks (its HTTP port answers the same API and the probes), "all" both.
+  std::string role = "all";
+  double lease_seconds = 30.0;     // a claimed task is the worker's this long past a heartbeat
+  double heartbeat_seconds = 5.0;  // lease renewal, progress and the cancellation check
+  int max_attempts = 3;            // a task that failed (or lost its lease) this often fails its job
+  bool farm() const { return !store.empty(); }
+  bool renders() const { return role != "api"; }
   // The per-scene caps handed to the scene loader.
   api::Limits scene_limits() const;
   // Threads one job renders with (render_threads resolved against the core count).

@@ -69,13 +69,13 @@ std::optional<uint64_t> parse_event_id(const std::string& text, bool& bad) {
 }
 
 struct Stream {
-  Stream(JobService& jobs, const GuardedServer* server, std::string id)
+  Stream(JobBackend& jobs, const GuardedServer* server, std::string id)
       : jobs(jobs), server(server), id(std::move(id)) {}
   ~Stream() { jobs.events().close_stream(); }
   Stream(const Stream&) = delete;
   Stream& operator=(const Stream&) = delete;
 
-  JobService& jobs;
+  JobBackend& jobs;
   const GuardedServer* server;
   std::string id;
   int sock = -1;

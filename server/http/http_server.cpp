@@ -50,7 +50,7 @@ std::string library_error_detail(int status) {
 
 }  // namespace
 
-HttpServer::HttpServer(const ServerConfig& config, JobService& jobs, Metrics& metrics)
+HttpServer::HttpServer(const ServerConfig& config, JobBackend& jobs, Metrics& metrics)
     : config_(config),
       metrics_(metrics),
       auth_(config.token),
@@ -162,6 +162,16 @@ void HttpServer::install_handlers() {
         std::string what = "unknown exception";
         try {
           if (ep) std::rethrow_exception(ep);
+        } catch (const StoreError& e) {
+          // The job store did not answer (farm: PostgreSQL down or restarting): worth a retry.
+          std::fprintf(stderr, "penumbra serve: %s %s: store unavailable: %s\n",
+                       req.method.c_str(), route_template(req.path).c_str(), e.what());
+          res.headers.clear();
+          Problem p = make_problem(503, "store-unavailable", "Job store unavailable",
+                                   "the job store does not answer; retry shortly");
+          p.retry_after_seconds = 2;
+          send_problem(res, req, p);
+          return;
         } catch (const std::exception& e) {
           what = e.what();
         } catch (...) {

@@ -22,7 +22,7 @@ namespace penumbra::server {
 
 class HttpServer {
  public:
-  HttpServer(const ServerConfig& config, JobService& jobs, Metrics& metrics);
+  HttpServer(const ServerConfig& config, JobBackend& jobs, Metrics& metrics);
   ~HttpServer();
   // Binds host:port (port 0 = ephemeral); returns the bound port, or -1.
   int bind();

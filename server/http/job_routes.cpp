@@ -54,7 +54,7 @@ void list(const RouteContext& c, const httplib::Request& req, httplib::Response&
   std::vector<JobView> jobs =
       run_order ? c.jobs.list_queued(
                       q.before_seq > 0
-                          ? std::optional<JobService::RunKey>(
+                          ? std::optional<JobBackend::RunKey>(
                                 {run_order_from_token(q.before_seq).first,
                                  run_order_from_token(q.before_seq).second})
                           : std::nullopt,

@@ -11,6 +11,7 @@
 #include "api/json_document.h"
 #include "api/render_overrides.h"
 #include "server/http/json_response.h"
+#include "server/jobs/submission_check.h"
 #include "server/http/multipart.h"
 #include "server/text_util.h"
 

@@ -11,7 +11,7 @@
 
 namespace penumbra::server {
 
-bool send_result(httplib::Response& res, const JobService& jobs, const std::string& id,
+bool send_result(httplib::Response& res, const JobBackend& jobs, const std::string& id,
                  ImageFormat format, const std::optional<std::string>& range,
                  const std::string& variant) {
   const std::string key = variant.empty() ? std::string(file_extension(format))

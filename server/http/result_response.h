@@ -18,7 +18,7 @@ namespace penumbra::server {
 // range handling is off (request_guard clears the parsed ranges).
 // `variant` names which of the job's result files (server/storage/result_files.h): "" the
 // beauty image, "blender" the Blender-layout EXR, or an output layer's name.
-bool send_result(httplib::Response& res, const JobService& jobs, const std::string& id,
+bool send_result(httplib::Response& res, const JobBackend& jobs, const std::string& id,
                  ImageFormat format, const std::optional<std::string>& range,
                  const std::string& variant = "");
 

@@ -1,8 +1,8 @@
 #pragma once
-// What every route group's handlers reach: they translate HTTP to JobService calls and back.
+// What every route group's handlers reach: they translate HTTP to JobBackend calls (jobs/job_backend.h) and back.
 #include <atomic>
 
-#include "server/jobs/job_service.h"
+#include "server/jobs/job_backend.h"
 #include "server/metrics.h"
 #include "server/server_config.h"
 
@@ -14,7 +14,7 @@ namespace penumbra::server {
 
 struct RouteContext {
   const ServerConfig& config;
-  JobService& jobs;
+  JobBackend& jobs;
   Metrics& metrics;
   const std::atomic<bool>& ready;  // false once shutdown has begun
 };

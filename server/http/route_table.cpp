@@ -31,7 +31,7 @@ std::string route_template(const std::string& path) {
     return is_dashboard_file_name(path.substr(11)) ? "/dashboard/{file}" : "other";
   for (const char* fixed :
        {"/healthz", "/readyz", "/metrics", "/v1/openapi.json", "/v1/jobs", "/v1/render",
-        "/v1/assets/missing"})
+        "/v1/assets/missing", "/v1/workers"})
     if (path == fixed) return fixed;
   constexpr std::string_view kAssets = "/v1/assets/";
   if (path.compare(0, kAssets.size(), kAssets) == 0 && path.size() == kAssets.size() + 64 &&

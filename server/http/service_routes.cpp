@@ -1,4 +1,4 @@
-// GET /healthz, /readyz, /metrics, /v1/openapi.json: the service itself, no job.
+// GET /healthz, /readyz, /metrics, /v1/openapi.json, /v1/workers: the service itself, no job.
 #include <httplib.h>
 
 #include "api/embedded_documents.h"
@@ -30,6 +30,11 @@ void add_service_routes(httplib::Server& s, const RouteContext& c) {
     Metrics::Gauges g = c.jobs.gauges();
     g.ready = g.ready && c.ready;
     res.set_content(c.metrics.render_text(g), "text/plain; version=0.0.4; charset=utf-8");
+  });
+  // The render workers, their heartbeats and current tasks (farm: every worker process of the
+  // store; one node: its own render threads).
+  s.Get("/v1/workers", [&c](const httplib::Request&, httplib::Response& res) {
+    send_json(res, 200, {{"workers", c.jobs.workers()}});
   });
   s.Get("/v1/openapi.json", [](const httplib::Request& req, httplib::Response& res) {
     const std::string* doc = api::embedded_document("openapi.json");

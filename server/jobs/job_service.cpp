@@ -10,70 +10,11 @@
 #include "api/diagnostics.h"
 #include "api/job_submission.h"
 #include "server/jobs/retry_estimate.h"
+#include "server/jobs/submission_check.h"
 #include "server/jobs/unix_time.h"
 #include "server/storage/disk_space.h"
 
 namespace penumbra::server {
-namespace {
-
-std::string new_job_id() {
-  static thread_local std::random_device rd;  // /dev/urandom: ids are unguessable
-  static const char* kHex = "0123456789abcdef";
-  std::string id;
-  for (int i = 0; i < 6; ++i) {
-    const uint32_t v = rd();
-    for (int k = 0; k < 4; ++k) id += kHex[(v >> (k * 4)) & 15];
-  }
-  return id;
-}
-
-nlohmann::json diagnostics_json(const std::vector<api::Diagnostic>& ds) {
-  nlohmann::json a = nlohmann::json::array();
-  for (const auto& d : ds) a.push_back({{"pointer", d.pointer}, {"detail", d.message}});
-  return a;
-}
-
-}  // namespace
-
-api::ManifestLimits manifest_limits(const ServerConfig& config) {
-  api::ManifestLimits m;
-  m.max_files = config.max_job_files;
-  return m;
-}
-
-std::optional<SubmitOutcome> JobService::link_assets(
-    const std::string& job_id, const std::vector<api::ManifestEntry>& manifest) {
-  SubmitOutcome out;
-  out.kind = SubmitOutcome::Kind::kInvalid;
-  std::uint64_t total = 0;
-  for (const api::ManifestEntry& m : manifest) total += assets_->size_of(m.hash).value_or(0);
-  if (total > config_.max_job_asset_bytes) {
-    out.errors.push_back({"/assets", "the files add up to " + std::to_string(total) +
-                                         " bytes; the limit is " +
-                                         std::to_string(config_.max_job_asset_bytes) +
-                                         " (--max-job-assets)"});
-    return out;
-  }
-  JobLinkResult linked;
-  try {
-    linked = assets_->link_job_folder(job_id, manifest);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "penumbra serve: linking the assets of a new job failed: %s\n", e.what());
-    out.kind = SubmitOutcome::Kind::kStoreFailed;
-    out.retry_after_seconds = 5;
-    return out;
-  }
-  if (linked.ok()) return std::nullopt;
-  for (const std::string& name : linked.missing) {
-    const auto it = std::find_if(manifest.begin(), manifest.end(),
-                                 [&](const api::ManifestEntry& m) { return m.name == name; });
-    out.errors.push_back({api::child_pointer("/assets", name),
-                          "no asset sha256:" + it->hash +
-                              " is stored; upload it first with PUT /v1/assets/" + it->hash +
-                              " (POST /v1/assets/missing lists what to upload)"});
-  }
-  return out;
-}
 
 bool JobService::job_is_live(const std::string& id) const {
   const auto entry = table_.find(id);
@@ -186,71 +127,19 @@ SubmitOutcome JobService::submit(std::string_view body, const std::string& idemp
     return out;
   };
   if (!accepting_) return refuse_shutting_down();
-  const api::Limits limits = config_.scene_limits();
-  // "priority" and "notify" are the job's, not the scene's (job_options.h): taken off the top
-  // level of a bare scene or of an envelope first.
-  SplitSubmission split = split_job_options(body, config_.webhook_hosts(), limits.max_json_depth);
-  // A bare scene, or {"scene": ..., "assets": {name: "sha256:..."}} (api/job_submission.h).
-  api::JobSubmission submission = api::parse_job_submission(
-      split.scene_text, limits.max_json_depth, manifest_limits(config_));
-  if (!submission.ok()) {
-    out.kind = submission.kind == api::LoadErrorKind::kSyntax ? SubmitOutcome::Kind::kSyntax
-                                                              : SubmitOutcome::Kind::kInvalid;
-    out.errors = std::move(split.errors);
-    out.errors.insert(out.errors.end(), submission.errors.begin(), submission.errors.end());
-    return out;
-  }
-  const std::string job_id = new_job_id();
-  // The job's folder of hard links (asset_store.h) exists from here; it is removed on every
-  // way out but acceptance.
-  struct FolderGuard {
-    AssetStore* assets = nullptr;
-    std::string id;
-    ~FolderGuard() {
-      if (assets) assets->remove_job_folder(id);
-    }
-  } folder_guard;
-  api::AssetFolder folder;
-  folder.max_file_bytes = int64_t(config_.max_asset_bytes);
-  folder.missing_hint = "; name it in the job's \"assets\" manifest ({\"scene\": ..., "
-                        "\"assets\": {\"NAME\": \"sha256:...\"}}) after uploading it with PUT "
-                        "/v1/assets/{sha256}";
-  if (!submission.assets.empty()) {
-    if (!assets_) {
-      out.kind = SubmitOutcome::Kind::kInvalid;
-      out.errors.push_back({"/assets", "this server keeps no assets"});
-      return out;
-    }
-    if (std::optional<SubmitOutcome> refused = link_assets(job_id, submission.assets)) return *refused;
-    folder_guard.assets = assets_;
-    folder_guard.id = job_id;
-    folder.root = assets_->job_folder(job_id);
-  }
-  api::LoadResult loaded = api::load_scene(submission.scene_text, limits, {}, folder);
-  if (submission.enveloped) {
-    api::rebase_scene_diagnostics(loaded.errors);
-    api::rebase_scene_diagnostics(loaded.warnings);
-  }
-  out.warnings = loaded.warnings;
-  if (!loaded.ok() || !split.errors.empty()) {
-    out.kind = loaded.kind == api::LoadErrorKind::kSyntax ? SubmitOutcome::Kind::kSyntax
-                                                          : SubmitOutcome::Kind::kInvalid;
-    out.errors = std::move(split.errors);
-    out.errors.insert(out.errors.end(), loaded.errors.begin(), loaded.errors.end());
-    return out;
-  }
-  const JobOptions& options = split.options;
-  // What the worker renders: the scene (or envelope) without the job's options.
-  const std::string scene_json = std::move(split.scene_text);
+  PreparedSubmission prepared = prepare_submission(config_, assets_, body, idempotency_key);
+  if (prepared.refusal) return std::move(*prepared.refusal);
+  out.warnings = std::move(prepared.warnings);
+  const std::string& scene_json = prepared.scene_json;
+  JobRecord r = std::move(prepared.record);
   std::lock_guard submit_lock(submit_mutex_);
   if (!idempotency_key.empty()) {
     if (auto existing = table_.find_by_key(idempotency_key)) {
       // Read from the store: the table keeps no scenes. A submission may wait on a commit here.
       const auto stored_scene = store_.scene(existing->id);
-      const bool same = stored_scene == scene_json &&
-                        existing->priority == options.priority &&
-                        existing->notify.url == options.notify_url &&
-                        existing->notify.secret == options.notify_secret;
+      const bool same = stored_scene == scene_json && existing->priority == r.priority &&
+                        existing->notify.url == r.notify.url &&
+                        existing->notify.secret == r.notify.secret;
       out.record = std::move(*existing);
       out.kind = same ? SubmitOutcome::Kind::kReplayed : SubmitOutcome::Kind::kKeyReused;
       return out;
@@ -262,13 +151,12 @@ SubmitOutcome JobService::submit(std::string_view body, const std::string& idemp
     out.retry_after_seconds = retry_after_for_queue();
     return out;
   }
-  const RenderSettings& s = loaded.request->settings;
   // Room for this job's images, the scene, the images promised to jobs already accepted, and the
   // margin; checked before anything is written (under submit_mutex_, so two submissions cannot
   // both take the last room).
   if (const auto available = available_bytes(config_.data_dir)) {
-    const std::uint64_t needed = worst_case_result_bytes(s.width, s.height, s.outputs) + body.size() +
-                                 reserved_bytes() + config_.min_free_bytes;
+    const std::uint64_t needed =
+        prepared.worst_case_bytes + body.size() + reserved_bytes() + config_.min_free_bytes;
     if (*available < needed) {
       out.kind = SubmitOutcome::Kind::kNoSpace;
       out.bytes_needed = needed;
@@ -276,19 +164,7 @@ SubmitOutcome JobService::submit(std::string_view body, const std::string& idemp
       return out;
     }
   }
-  JobRecord r;
-  r.id = job_id;
   r.seq = last_seq_ + 1;
-  r.idempotency_key = idempotency_key;
-  r.created_at = unix_now();
-  r.width = s.width;
-  r.height = s.height;
-  r.spp = s.spp;
-  r.samples_total = uint64_t(s.width) * uint64_t(s.height) * uint64_t(s.spp);
-  r.priority = options.priority;
-  r.notify.url = options.notify_url;
-  r.notify.secret = options.notify_secret;
-  if (!out.warnings.empty()) r.warnings_json = diagnostics_json(out.warnings).dump();
   // Committed (fsync'd) before anyone hears 202. Nobody knows the id yet, so no other change
   // of this job can be queued before its insert.
   try {
@@ -302,22 +178,32 @@ SubmitOutcome JobService::submit(std::string_view body, const std::string& idemp
                    ? SubmitOutcome::Kind::kNoSpace
                    : SubmitOutcome::Kind::kStoreFailed;
     out.bytes_available = available.value_or(0);
-    out.bytes_needed = worst_case_result_bytes(s.width, s.height, s.outputs) + body.size() +
-                       config_.min_free_bytes;
+    out.bytes_needed = prepared.worst_case_bytes + body.size() + config_.min_free_bytes;
     out.retry_after_seconds = 5;
     return out;
   }
   last_seq_ = r.seq;
   table_.add(r);
-  if (folder_guard.assets) {
-    assets_->commit_job_folder(r.id);  // now the table says the job is queued: the folder stays
-    folder_guard.assets = nullptr;
-  }
+  // Now the table says the job is queued: the folder stays.
+  if (prepared.folder) prepared.folder->commit();
   queue_.push(r.id, r.priority, r.seq, /*force=*/true);  // capacity checked under submit_mutex_
   metrics_.count_submitted();
   out.record = std::move(r);
   out.kind = SubmitOutcome::Kind::kAccepted;
   return out;
+}
+
+nlohmann::json JobService::workers() const {
+  nlohmann::json all = nlohmann::json::array();
+  nlohmann::json running = nlohmann::json::array();
+  for (const JobEntry& e : table_.list(JobState::kRunning, 0, config_.workers + 1))
+    running.push_back({{"kind", "job"}, {"job", e.record.id}});
+  all.push_back({{"id", "local"},
+                 {"role", "all"},
+                 {"render_threads", config_.threads_per_job()},
+                 {"slots", config_.workers},
+                 {"current_tasks", running}});
+  return all;
 }
 
 JobView JobService::make_view(JobEntry entry) const {

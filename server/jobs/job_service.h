@@ -23,6 +23,7 @@
 
 #include "api/job_submission.h"
 #include "api/scene_loader.h"
+#include "server/jobs/job_backend.h"
 #include "server/jobs/job_events.h"
 #include "server/jobs/job_queue.h"
 #include "server/jobs/job_table.h"
@@ -39,45 +40,7 @@
 
 namespace penumbra::server {
 
-struct SubmitOutcome {
-  enum class Kind {
-    kAccepted,      // new job, committed
-    kReplayed,      // same idempotency key and scene: the existing job
-    kSyntax,        // not JSON (400)
-    kInvalid,       // not a valid scene (422)
-    kKeyReused,     // idempotency key used for another scene (422)
-    kQueueFull,     // 429
-    kNotAccepting,  // shutting down (503)
-    kNoSpace,       // the data directory cannot hold the job's worst case (507)
-    kStoreFailed,   // the job could not be stored for another reason (503)
-  };
-  Kind kind = Kind::kAccepted;
-  JobRecord record;
-  std::vector<api::Diagnostic> errors;
-  std::vector<api::Diagnostic> warnings;
-  double retry_after_seconds = 0;
-  std::uint64_t bytes_needed = 0;     // kNoSpace
-  std::uint64_t bytes_available = 0;  // kNoSpace
-};
-
-struct JobView {
-  JobRecord record;
-  std::optional<RenderProgress> progress;     // while running
-  std::optional<std::size_t> queue_position;  // while queued
-  bool stop_requested = false;
-};
-
-enum class DeleteOutcome {
-  kNotFound,    // never existed (or expired)
-  kCancelled,   // was queued or running, now cancelled
-  kCancelling,  // running; the render has been told to stop but has not yet
-  kDeleted,     // was finished; record and result removed
-};
-
-// The serve flags that bound a job's manifest.
-api::ManifestLimits manifest_limits(const ServerConfig& config);
-
-class JobService {
+class JobService final : public JobBackend {
  public:
   // `assets` (may be null: then jobs cannot name files) holds the uploaded files jobs name.
   JobService(const ServerConfig& config, JobStore& store, ResultStore& results, Metrics& metrics,
@@ -86,39 +49,36 @@ class JobService {
 
   // Loads the jobs from the store (interrupted ones run again) and starts the threads.
   void start();
-  SubmitOutcome submit(std::string_view body, const std::string& idempotency_key);
-  std::optional<JobView> view(const std::string& id) const;
-  std::vector<JobView> list(std::optional<JobState> state, int64_t before_seq, int limit) const;
-  // Queued jobs in run order (priority, then seq), starting after the job with run key
-  // `after` (nullopt: from the first to run).
-  struct RunKey {
-    int priority = 0;
-    int64_t seq = 0;
-  };
-  std::vector<JobView> list_queued(std::optional<RunKey> after, int limit) const;
+  SubmitOutcome submit(std::string_view body, const std::string& idempotency_key) override;
+  std::optional<JobView> view(const std::string& id) const override;
+  std::vector<JobView> list(std::optional<JobState> state, int64_t before_seq, int limit) const override;
+  std::vector<JobView> list_queued(std::optional<RunKey> after, int limit) const override;
   // State changes and progress for GET /v1/jobs/{id}/events.
-  JobEvents& events() { return events_; }
+  JobEvents& events() override { return events_; }
   // The JSON a webhook POSTs for a job (the HTTP layer's job document); set before start().
-  void set_webhook_body(std::function<std::string(const JobRecord&)> body) {
+  void set_webhook_body(std::function<std::string(const JobRecord&)> body) override {
     webhook_body_ = std::move(body);
   }
-  bool stopping() const { return stopping_.load(); }
+  bool stopping() const override { return stopping_.load(); }
   // Cancels a queued/running job, deletes a finished one. Waits up to `wait` for a running
   // render to stop.
-  DeleteOutcome cancel_or_delete(const std::string& id, std::chrono::milliseconds wait);
-  std::shared_ptr<const Image> preview(const std::string& id) const;
-  std::optional<StoredResult> open_result(const std::string& id, const std::string& format) const {
+  DeleteOutcome cancel_or_delete(const std::string& id, std::chrono::milliseconds wait) override;
+  std::shared_ptr<const Image> preview(const std::string& id) const override;
+  std::optional<StoredResult> open_result(const std::string& id,
+                                          const std::string& format) const override {
     return results_.open(id, format);
   }
   // Blocks until the job is finished, the deadline passes or shutdown begins.
   std::optional<JobRecord> wait_finished(const std::string& id,
-                                         std::chrono::steady_clock::time_point deadline) const;
+                                         std::chrono::steady_clock::time_point deadline) const override;
 
-  bool accepting() const { return accepting_.load(); }
+  bool accepting() const override { return accepting_.load(); }
   // The asset store (null when the server keeps none).
-  AssetStore* assets() const { return assets_; }
+  AssetStore* assets() const override { return assets_; }
+  // One node: its own render threads are its only worker.
+  nlohmann::json workers() const override;
   // False while the data directory has less than --min-free-space available (/readyz).
-  bool storage_ok() const;
+  bool storage_ok() const override;
   // Stops taking jobs; running renders are put back in the queue, except one that will be done
   // within a few seconds, which is finished.
   void begin_shutdown();
@@ -128,18 +88,14 @@ class JobService {
   // Removes finished jobs older than the retention now (the reaper thread does it periodically).
   void expire_now();
 
-  Metrics::Gauges gauges() const;
-  double retry_after_for_queue() const;
+  Metrics::Gauges gauges() const override;
+  double retry_after_for_queue() const override;
   // The worst case of every queued and running job's images: space already promised.
   std::uint64_t reserved_bytes() const;
 
  private:
   void reaper_loop();
   void observe(const JobEntry& entry);  // the job table's observer (under its lock)
-  // Links the manifest's files into the job's folder; a refusal (missing hashes: 422, over
-  // --max-job-assets: 422, storage failure: 503) or nullopt.
-  std::optional<SubmitOutcome> link_assets(const std::string& job_id,
-                                           const std::vector<api::ManifestEntry>& manifest);
   // Queued or running: its asset folder is still needed.
   bool job_is_live(const std::string& id) const;
   JobView make_view(JobEntry entry) const;

@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <chrono>
 
+#include <nlohmann/json.hpp>
+
 #include "api/job_submission.h"
+#include "api/version.h"
 
 namespace {
 // What follows the sampling, per pixel: resolving the film and its variance, encoding the EXR and
@@ -82,6 +85,38 @@ RenderOutcome run_render_job(const std::string& scene_json, const RenderJobOptio
   out.kind =
       result.stats.cancelled ? RenderOutcome::Kind::kStopped : RenderOutcome::Kind::kSucceeded;
   return out;
+}
+
+std::string render_stats_json(const RenderOutcome& o, int threads) {
+  const RenderStats& s = o.stats;
+  nlohmann::ordered_json j{{"seconds", s.seconds},
+                                {"build_seconds", o.build_seconds},
+                                {"rays", s.rays},
+                                {"mrays_per_second", s.mrays_per_second()},
+                                {"spp_mean", s.spp_mean},
+                                {"spp_min", s.spp_min},
+                                {"spp_max", s.spp_max},
+                                {"camera_samples", s.camera_samples},
+                                {"stopped_by_time_limit", s.stopped_by_time_limit},
+                                {"threads", threads}};
+  // render.denoise: whether the result is denoised, and if not, why (the job still succeeds).
+  if (s.denoised || !s.denoise_error.empty()) {
+    j["denoised"] = s.denoised;
+    j["denoise_seconds"] = s.denoise_seconds;
+    if (!s.denoise_error.empty()) j["denoise_error"] = s.denoise_error;
+  }
+  return j.dump();
+}
+
+ImageMetadata result_metadata(const std::string& job_id, const RenderOutcome& o) {
+  return {
+      {"penumbra:job", job_id},
+      {"penumbra:spp", std::to_string(o.settings.spp)},
+      {"penumbra:spp_mean", std::to_string(o.stats.spp_mean)},
+      {"penumbra:render_seconds", std::to_string(o.stats.seconds)},
+      {"penumbra:seed", std::to_string(o.settings.seed)},
+      {"Software", api::kSoftwareName},
+  };
 }
 
 }  // namespace penumbra::server

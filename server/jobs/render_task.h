@@ -6,6 +6,7 @@
 
 #include "api/scene_loader.h"
 #include "renderer/core/image.h"
+#include "renderer/io/image_io.h"
 #include "renderer/render/render.h"
 #include "server/jobs/job_runtime.h"
 
@@ -36,6 +37,11 @@ struct RenderOutcome {
   double build_seconds = 0;
   std::string error;  // when failed
 };
+
+// The job's "stats" object (render statistics, denoising) as JSON text.
+std::string render_stats_json(const RenderOutcome& outcome, int threads);
+// The metadata written into a job's result images.
+ImageMetadata result_metadata(const std::string& job_id, const RenderOutcome& outcome);
 
 RenderOutcome run_render_job(const std::string& scene_json, const RenderJobOptions& options,
                              JobRuntime& runtime);

@@ -26,27 +26,6 @@ std::string error_json(const std::string& detail) {
   return nlohmann::ordered_json{{"detail", detail}}.dump();
 }
 
-std::string stats_json(const RenderOutcome& o, int threads) {
-  const RenderStats& s = o.stats;
-  nlohmann::ordered_json j{{"seconds", s.seconds},
-                                {"build_seconds", o.build_seconds},
-                                {"rays", s.rays},
-                                {"mrays_per_second", s.mrays_per_second()},
-                                {"spp_mean", s.spp_mean},
-                                {"spp_min", s.spp_min},
-                                {"spp_max", s.spp_max},
-                                {"camera_samples", s.camera_samples},
-                                {"stopped_by_time_limit", s.stopped_by_time_limit},
-                                {"threads", threads}};
-  // render.denoise: whether the result is denoised, and if not, why (the job still succeeds).
-  if (s.denoised || !s.denoise_error.empty()) {
-    j["denoised"] = s.denoised;
-    j["denoise_seconds"] = s.denoise_seconds;
-    if (!s.denoise_error.empty()) j["denoise_error"] = s.denoise_error;
-  }
-  return j.dump();
-}
-
 // A running (or, when `from_queued`, a queued) job ends in `state`.
 std::function<bool(JobEntry&)> settle(JobState state, double now, std::string stats,
                                       std::string error, bool from_queued = false) {
@@ -186,18 +165,11 @@ void RenderWorkers::finish_job(const std::string& id, const RenderOutcome& outco
   const double now = unix_now();
   switch (outcome.kind) {
     case RenderOutcome::Kind::kSucceeded: {
-      const ImageMetadata meta = {
-          {"penumbra:job", id},
-          {"penumbra:spp", std::to_string(outcome.settings.spp)},
-          {"penumbra:spp_mean", std::to_string(outcome.stats.spp_mean)},
-          {"penumbra:render_seconds", std::to_string(outcome.stats.seconds)},
-          {"penumbra:seed", std::to_string(outcome.settings.seed)},
-          {"Software", api::kSoftwareName},
-      };
+      const ImageMetadata meta = result_metadata(id, outcome);
       // Files first, then the record: a crash in between reruns the job, never serves a
       // missing file.
       write_results(results_, id, outcome.image, outcome.layers, meta);
-      table_.modify(id, settle(JobState::kSucceeded, now, stats_json(outcome, threads), ""));
+      table_.modify(id, settle(JobState::kSucceeded, now, render_stats_json(outcome, threads), ""));
       metrics_.observe_render("succeeded", outcome.stats.seconds, outcome.stats.rays);
       if (outcome.stats.stopped_by_time_limit) metrics_.count_stopped_early("time_limit");
       const double total = outcome.stats.seconds + outcome.build_seconds;
@@ -206,7 +178,7 @@ void RenderWorkers::finish_job(const std::string& id, const RenderOutcome& outco
       break;
     }
     case RenderOutcome::Kind::kStopped:
-      table_.modify(id, settle(JobState::kCancelled, now, stats_json(outcome, threads), ""));
+      table_.modify(id, settle(JobState::kCancelled, now, render_stats_json(outcome, threads), ""));
       metrics_.observe_render("cancelled", outcome.stats.seconds, outcome.stats.rays);
       break;
     case RenderOutcome::Kind::kFailed:

@@ -87,14 +87,15 @@ bool AssetUpload::write(const char* data, std::size_t size) {
   return true;
 }
 
-AssetStore::AssetStore(const std::string& data_dir, AssetStoreLimits limits)
-    : root_((fs::path(data_dir) / "assets").string()), limits_(limits) {
+AssetStore::AssetStore(const std::string& data_dir, AssetStoreLimits limits, bool shared)
+    : root_((fs::path(data_dir) / "assets").string()), limits_(limits), shared_(shared) {
   const fs::path root(root_);
   fs::create_directories(root / "sha256");
   fs::create_directories(root / "tmp");
   fs::create_directories(root / "jobs");
   // Interrupted uploads: never visible under a hash, gone at start.
-  for (const auto& e : fs::directory_iterator(root / "tmp")) fs::remove_all(e.path());
+  if (!shared)
+    for (const auto& e : fs::directory_iterator(root / "tmp")) fs::remove_all(e.path());
   for (const auto& e : fs::directory_iterator(root / "sha256")) {
     const std::string name = e.path().filename().string();
     struct stat st {};
@@ -123,13 +124,24 @@ std::string AssetStore::job_folder(const std::string& job_id) const {
   return root_ + "/jobs/" + job_id;
 }
 
+void AssetStore::adopt_locked(const std::string& hash) const {
+  if (!shared_ || index_.count(hash) || !api::is_sha256_hex(hash)) return;
+  struct stat st {};
+  // Files appear under their hash only whole (renamed from tmp/ after fsync, put()).
+  if (::lstat(asset_path(hash).c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return;
+  index_[hash] = Entry{std::uint64_t(st.st_size), mtime_ns(st)};
+  stored_bytes_ += std::uint64_t(st.st_size);
+}
+
 bool AssetStore::contains(const std::string& hash) const {
   std::lock_guard lock(mutex_);
+  adopt_locked(hash);
   return index_.count(hash) > 0;
 }
 
 std::optional<std::uint64_t> AssetStore::size_of(const std::string& hash) const {
   std::lock_guard lock(mutex_);
+  adopt_locked(hash);
   const auto it = index_.find(hash);
   if (it == index_.end()) return std::nullopt;
   return it->second.size;
@@ -138,6 +150,7 @@ std::optional<std::uint64_t> AssetStore::size_of(const std::string& hash) const 
 std::vector<std::string> AssetStore::missing(const std::vector<std::string>& hashes) const {
   std::lock_guard lock(mutex_);
   std::vector<std::string> out;
+  for (const std::string& h : hashes) adopt_locked(h);
   for (const std::string& h : hashes)
     if (!index_.count(h) && std::find(out.begin(), out.end(), h) == out.end()) out.push_back(h);
   return out;
@@ -156,6 +169,7 @@ std::size_t AssetStore::stored_count() const {
 std::optional<std::pair<std::shared_ptr<std::ifstream>, std::uint64_t>> AssetStore::open(
     const std::string& hash) const {
   std::lock_guard lock(mutex_);
+  adopt_locked(hash);
   const auto it = index_.find(hash);
   if (it == index_.end()) return std::nullopt;
   auto stream = std::make_shared<std::ifstream>(asset_path(hash), std::ios::binary);
@@ -215,6 +229,7 @@ PutResult AssetStore::finish_upload(std::unique_ptr<AssetUpload> upload) {
   }
   upload->fd_ = -1;
   std::lock_guard lock(mutex_);
+  adopt_locked(out.actual_hash);
   if (index_.count(out.actual_hash)) {
     out.status = PutStatus::kAlreadyStored;
     return out;
@@ -266,6 +281,7 @@ JobLinkResult AssetStore::link_job_folder(const std::string& job_id,
   JobLinkResult out;
   std::lock_guard lock(mutex_);
   for (const api::ManifestEntry& m : manifest) {
+    adopt_locked(m.hash);
     const auto it = index_.find(m.hash);
     if (it == index_.end()) out.missing.push_back(m.name);
     else out.total_bytes += it->second.size;

@@ -81,7 +81,9 @@ struct JobLinkResult {
 
 class AssetStore {
  public:
-  AssetStore(const std::string& data_dir, AssetStoreLimits limits);
+  // `shared`: the folder is a farm's volume that other nodes write too; interrupted uploads in
+  // its tmp/ may be theirs, under way, and are left alone.
+  AssetStore(const std::string& data_dir, AssetStoreLimits limits, bool shared = false);
 
   // Which jobs still need their folder (queued or running); folders of others are removed by
   // sweep_job_folders() and before anything is evicted. Unset: every folder is kept.
@@ -132,12 +134,17 @@ class AssetStore {
   // Evicts unreferenced assets, oldest first, until `incoming` more bytes fit; false if they
   // cannot.
   bool make_room_locked(std::uint64_t incoming);
+  // Shared store: an asset another node stored since this one indexed the folder is taken into
+  // the index when it is first asked for. The index, not the file, is what is asked here.
+  void adopt_locked(const std::string& hash) const;
 
   const std::string root_;
   const AssetStoreLimits limits_;
   mutable std::mutex mutex_;
-  std::map<std::string, Entry> index_;
-  std::uint64_t stored_bytes_ = 0;
+  const bool shared_;
+  // Mutable for adopt_locked (a lookup of a shared store learns what other nodes stored).
+  mutable std::map<std::string, Entry> index_;
+  mutable std::uint64_t stored_bytes_ = 0;
   std::set<std::string> pending_jobs_;
   std::function<bool(const std::string&)> is_live_;
 };

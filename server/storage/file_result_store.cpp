@@ -24,9 +24,10 @@ void fsync_dir(const std::string& dir) {
 }
 }  // namespace
 
-FileResultStore::FileResultStore(const std::string& data_dir)
+FileResultStore::FileResultStore(const std::string& data_dir, bool shared)
     : dir_((fs::path(data_dir) / "results").string()) {
   fs::create_directories(dir_);
+  if (shared) return;
   for (const auto& entry : fs::directory_iterator(dir_))
     if (entry.path().filename().string().find(".tmp") != std::string::npos)
       fs::remove(entry.path());

@@ -9,8 +9,9 @@ namespace penumbra::server {
 
 class FileResultStore final : public ResultStore {
  public:
-  explicit FileResultStore(
-      const std::string& data_dir);  // creates DIR/results, removes stale temp files
+  // Creates DIR/results and removes stale temp files, unless `shared` (a farm's volume: the
+  // temp files may be another node's writes under way; each attempt's names are its own).
+  explicit FileResultStore(const std::string& data_dir, bool shared = false);
   void write(const std::string& id, const std::string& format,
              const std::vector<uint8_t>& bytes) override;
   std::optional<StoredResult> open(const std::string& id, const std::string& format) const override;

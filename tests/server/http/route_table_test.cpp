@@ -23,6 +23,8 @@ TEST(Routes, TemplatesBoundTheMetricLabels) {
   EXPECT_EQ(route_template("/v1/jobs/0123456789abcdef01234567/events"), "/v1/jobs/{id}/events");
   EXPECT_EQ(route_template("/v1/jobs/0123456789abcdef01234567/events/"), "other");
   EXPECT_EQ(route_template("/v1/jobs/"), "other");
+  EXPECT_EQ(route_template("/v1/workers"), "/v1/workers");
+  EXPECT_EQ(route_template("/v1/workers/"), "other");
 }
 
 TEST(Routes, AllowedMethodsForA405) {
