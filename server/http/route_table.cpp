@@ -22,7 +22,7 @@ bool is_dashboard_file_name(std::string_view name) {
 }
 
 bool is_public_route(const std::string& path) {
-  return path == "/healthz" || path == "/" || path.rfind("/dashboard/", 0) == 0;
+  return path == "/healthz" || path == "/readyz" || path == "/" || path.rfind("/dashboard/", 0) == 0;
 }
 
 std::string route_template(const std::string& path) {

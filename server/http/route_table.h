@@ -20,7 +20,8 @@ inline const std::string kAssetRoute = "/v1/assets/([^/]+)";
 bool is_dashboard_file_name(std::string_view name);
 inline const std::string kDashboardRoute = R"(/dashboard/([A-Za-z0-9_-]+\.[a-z]+))";
 
-// Paths served without a token: /healthz (orchestrators probe it without credentials) and the
+// Paths served without a token: /healthz and /readyz (orchestrators probe them without
+// credentials; they tell only whether the node is alive and ready) and the
 // dashboard's static files (/, /dashboard/...), which hold no data.
 bool is_public_route(const std::string& path);
 // The route template of a path ("/v1/jobs/{id}"), or "other": a bounded set of labels.

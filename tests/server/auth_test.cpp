@@ -20,8 +20,10 @@ TEST(Auth, TokenRequiredOnEveryRouteButHealthz) {
   auto anonymous = server.client();
   auto wrong = server.client("battery-staple");
   auto right = server.client("correct-horse");
+  // Probes (a kubelet, a load balancer) carry no token: /healthz and /readyz need none.
   EXPECT_EQ(anonymous->Get("/healthz")->status, 200);
-  for (const char* path : {"/readyz", "/metrics", "/v1/jobs", "/v1/openapi.json",
+  EXPECT_EQ(anonymous->Get("/readyz")->status, 200);
+  for (const char* path : {"/metrics", "/v1/jobs", "/v1/openapi.json",
                            "/v1/jobs/0123456789abcdef01234567"}) {
     auto res = anonymous->Get(path);
     EXPECT_EQ(res->status, 401) << path;

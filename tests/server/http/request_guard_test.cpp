@@ -45,9 +45,11 @@ TEST(RequestGuard, TokenOnEveryRouteButHealthz) {
   const GuardSettings s{100};
   httplib::Request req;
   req.method = "GET";
-  req.path = "/healthz";
-  EXPECT_FALSE(guard_request(req, s, auth));
-  for (const char* path : {"/readyz", "/metrics", "/v1/jobs", "/v1/openapi.json", "/nowhere"}) {
+  for (const char* path : {"/healthz", "/readyz"}) {
+    req.path = path;
+    EXPECT_FALSE(guard_request(req, s, auth)) << path;
+  }
+  for (const char* path : {"/metrics", "/v1/jobs", "/v1/openapi.json", "/nowhere"}) {
     req.path = path;
     const auto p = guard_request(req, s, auth);
     ASSERT_TRUE(p) << path;
