@@ -242,7 +242,7 @@ TEST(EnvironmentMap, OneTexelMapIsConstant) {
 // One hot texel (a sun of one pixel) on a black map, on the seam and on a pole row: every sample
 // lands next to it with a finite weight, and the density still integrates to 1.
 TEST(EnvironmentMap, OneHotTexelIsSampledWithFiniteWeights) {
-  for (const auto [hx, hy] : {std::pair{10, 7}, std::pair{63, 12}, std::pair{5, 0}}) {
+  for (const auto& [hx, hy] : {std::pair{10, 7}, std::pair{63, 12}, std::pair{5, 0}}) {
     const auto desc = make_map(64, 32, [&](int x, int y) { return x == hx && y == hy ? 1e6f : 0.f; });
     const EnvironmentMap map(desc);
     Rng rng(17);
