@@ -163,6 +163,7 @@ RenderOutcome run_render_job(const std::string& scene_json, const RenderJobOptio
     map.mean_frame_seconds = out.frames_rendered > 0
                                  ? (out.stats.seconds + out.build_seconds) / out.frames_rendered
                                  : 0.0;
+    runtime.clear_preview();
     // A time limit (the scene's, the server's) is per frame, as `penumbra render --frames`.
     RenderOutcome frame_out =
         render_one(request, options, std::chrono::steady_clock::now(), runtime, map);

@@ -211,52 +211,5 @@ TEST(SqliteJobStore, OrphanSceneFilesGoAtLoad) {
   EXPECT_TRUE(fs::exists(fs::path(dir.path()) / "scenes" / (record(1).id + ".json")));
 }
 
-// An animation's frame range is stored at insert, frames_done by every update: a restart resumes
-// from it. A still keeps first 0, last -1.
-TEST(SqliteJobStore, AnimationFramesSurviveReopening) {
-  TempDir dir;
-  JobRecord still = record(1);
-  JobRecord anim = record(2);
-  anim.frame_first = -3;
-  anim.frame_last = 44;
-  {
-    SqliteJobStore store(dir.path() + "/jobs.db");
-    store.apply({InsertJob{still, "{}"}, InsertJob{anim, "{}"}});
-    anim.state = JobState::kRunning;
-    anim.frames_done = 17;
-    store.apply({UpdateJob{anim}});
-  }
-  SqliteJobStore store(dir.path() + "/jobs.db");
-  const server::StoredJobs loaded = store.load();
-  ASSERT_EQ(loaded.records.size(), 2u);
-  for (const JobRecord& r : loaded.records) expect_same(r, r.id == anim.id ? anim : still);
-  for (const JobRecord& r : loaded.records)
-    EXPECT_EQ(r.frame_count(), r.id == anim.id ? 48 : 0);
-}
-
-// A database of the version before animations (no frame columns) gains them: its jobs are stills.
-TEST(SqliteJobStore, AnOlderDatabaseGainsTheFrameColumns) {
-  TempDir dir;
-  JobRecord r = record(1);
-  {
-    SqliteJobStore store(dir.path() + "/jobs.db");
-    store.apply({InsertJob{r, "{}"}});
-  }
-  {
-    sqlite3* db = nullptr;
-    ASSERT_EQ(sqlite3_open((dir.path() + "/jobs.db").c_str(), &db), SQLITE_OK);
-    for (const char* column : {"frame_first", "frame_last", "frames_done"})
-      ASSERT_EQ(sqlite3_exec(db, (std::string("ALTER TABLE jobs DROP COLUMN ") + column).c_str(),
-                             nullptr, nullptr, nullptr),
-                SQLITE_OK);
-    sqlite3_close(db);
-  }
-  SqliteJobStore store(dir.path() + "/jobs.db");
-  const server::StoredJobs loaded = store.load();
-  ASSERT_EQ(loaded.records.size(), 1u);
-  expect_same(loaded.records[0], r);
-  EXPECT_EQ(loaded.records[0].frame_count(), 0);
-}
-
 }  // namespace
 }  // namespace penumbra::test
