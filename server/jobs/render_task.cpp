@@ -138,7 +138,10 @@ RenderOutcome run_render_job(const std::string& scene_json, const RenderJobOptio
     return out;
   }
   api::SceneRequest& request = *loaded.request;
-  if (!request.animation) return render_one(request, options, options.started, runtime, {});
+  // A still, or a caller that stores no frames (no on_frame: the farm's whole-job task, until
+  // it has frame tasks): one image, an animation's first frame (load_scene set its shutter).
+  if (!request.animation || !options.on_frame)
+    return render_one(request, options, options.started, runtime, {});
 
   // An animation: its frames one after another. Not several at once: the renderer already
   // spreads one frame over all of the job's threads (tiles), so concurrent frames would only

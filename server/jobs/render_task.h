@@ -28,6 +28,7 @@ struct RenderJobOptions {
   // `resume_frame` (nullopt: the first) to the last, and each finished frame is handed to
   // `on_frame` before the next starts; it stores the frame durably (and throws if it cannot,
   // which fails the job). Frames before resume_frame were finished by an earlier attempt.
+  // Without on_frame an animation renders its first frame only, as a still.
   std::optional<int> resume_frame;
   std::function<void(int frame, const struct RenderOutcome& frame_outcome)> on_frame;
 };
