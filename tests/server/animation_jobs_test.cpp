@@ -5,6 +5,7 @@
 // for byte the per-frame results; bad frame parameters answer problem JSON naming `frame`.
 #include <gtest/gtest.h>
 #include <sys/stat.h>
+#include <sys/statvfs.h>
 
 #include <csignal>
 #include <cstdlib>
@@ -339,6 +340,37 @@ TEST(AnimationJobs, BadFrameParametersNameTheParameter) {
   ASSERT_EQ(over->status, 422) << over->body;
   EXPECT_EQ(problem(over)["errors"][0]["pointer"], "/animation/frames") << over->body;
   EXPECT_EQ(post_json(*c, "/v1/jobs", animation_scene(1, 8, 8, 1).dump())->status, 202);
+}
+
+// The disk space check (507) counts every frame: an animation whose frames would not fit is
+// refused before anything is written, though one of its frames alone would fit, and a short
+// animation of the same frames is accepted.
+TEST(AnimationJobs, DiskSpaceCheckCountsEveryFrame) {
+  TempDir dir;
+  ServerProcess server(dir.path(), {"--max-frames", "100000"});
+  auto c = server.client();
+  struct statvfs fs {};
+  ASSERT_EQ(::statvfs(dir.path().c_str(), &fs), 0);
+  const double available = double(fs.f_bavail) * double(fs.f_frsize);
+  // A 4096^2 frame's worst case is its float EXR and 8-bit PNG: more than 20 bytes a pixel.
+  const double frame_bytes = 4096.0 * 4096.0 * 20.0;
+  const int frames = int(available / frame_bytes) + 2;
+  ASSERT_LT(frames, 100000) << "the disk is too large for this test";
+  ASSERT_GT(available, 3 * frame_bytes + (64 << 20)) << "the disk is too full for this test";
+  const auto cancel_if_accepted = [&](const httplib::Result& res) {
+    if (res && res->status == 202) c->Delete(("/v1/jobs/" + problem(res)["id"].get<std::string>()).c_str());
+  };
+  auto big = post_json(*c, "/v1/jobs", animation_scene(1, frames, 4096, 1).dump());
+  ASSERT_TRUE(big);
+  cancel_if_accepted(big);
+  ASSERT_EQ(big->status, 507) << big->body;
+  const Json p = problem(big);
+  EXPECT_EQ(p["type"], "urn:penumbra:problem:insufficient-storage");
+  EXPECT_GT(p["bytes_needed"].get<double>(), frames * frame_bytes) << p.dump();
+  auto small = post_json(*c, "/v1/jobs", animation_scene(1, 2, 4096, 1).dump());
+  ASSERT_TRUE(small);
+  cancel_if_accepted(small);
+  EXPECT_EQ(small->status, 202) << small->body;
 }
 
 }  // namespace
