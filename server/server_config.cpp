@@ -93,6 +93,7 @@ std::vector<Setting> settings() {
       int_setting("--max-pixels", "PENUMBRA_MAX_PIXELS", 1, int64_t(1) << 40,
                   &ServerConfig::max_pixels),
       int_setting("--max-spp", "PENUMBRA_MAX_SPP", 1, 1 << 20, &ServerConfig::max_spp),
+      int_setting("--max-frames", "PENUMBRA_MAX_FRAMES", 1, 100'000, &ServerConfig::max_frames),
       int_setting("--max-triangles", "PENUMBRA_MAX_TRIANGLES", 0, int64_t(1) << 32,
                   &ServerConfig::max_triangles),
       duration_setting("--max-render-time", "PENUMBRA_MAX_RENDER_TIME", 0.001,
@@ -200,6 +201,7 @@ api::Limits ServerConfig::scene_limits() const {
   api::Limits limits;
   limits.max_pixels = max_pixels;
   limits.max_spp = max_spp;
+  limits.max_frames = max_frames;
   limits.max_triangles = max_triangles;
   limits.max_time_limit = max_render_seconds;
   limits.max_texture_pixels = max_image_pixels;
@@ -335,6 +337,7 @@ const char* serve_usage() {
          "  --max-body SIZE          request body limit, e.g. 512k, 16M (default 16M) [PENUMBRA_MAX_BODY]\n"
          "  --max-pixels N           width x height limit (default 16777216) [PENUMBRA_MAX_PIXELS]\n"
          "  --max-spp N              samples per pixel limit (default 65536) [PENUMBRA_MAX_SPP]\n"
+         "  --max-frames N           frames of one animation job (default 1000) [PENUMBRA_MAX_FRAMES]\n"
          "  --max-triangles N        triangles per scene (default 2000000) [PENUMBRA_MAX_TRIANGLES]\n"
          "  --max-render-time DUR    render time per job; longer renders stop there and keep\n"
          "                           their image (default 10m) [PENUMBRA_MAX_RENDER_TIME]\n"

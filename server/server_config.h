@@ -23,6 +23,9 @@ struct ServerConfig {
   std::size_t max_body_bytes = 16u << 20;
   int64_t max_pixels = int64_t(4096) * 4096;
   int max_spp = 65536;
+  // Frames of one animation job (422 at /animation/frames beyond): a job is a shot (1000 frames
+  // is 42 s at 24 fps); a longer sequence is several jobs, each with its own retry and archive.
+  int max_frames = 1000;
   int64_t max_triangles = 2'000'000;
   double max_render_seconds = 600.0;  // wall-clock budget per job; renders stop there, image kept
   double retention_seconds = 24 * 3600.0;

@@ -307,7 +307,9 @@ std::shared_ptr<const Image> FarmService::preview(const std::string& id) const {
 }
 
 std::optional<StoredResult> FarmService::open_result(const std::string& id,
-                                                     const std::string& format) const {
+                                                     const std::string& format,
+                                                     std::optional<int> frame) const {
+  if (frame) return std::nullopt;  // frames of an animation: the farm's frame tasks (to come)
   std::string token;
   {
     auto db = pool_.acquire();

@@ -45,8 +45,8 @@ class FarmService final : public JobBackend {
   bool stopping() const override { return stopping_.load(); }
   DeleteOutcome cancel_or_delete(const std::string& id, std::chrono::milliseconds wait) override;
   std::shared_ptr<const Image> preview(const std::string& id) const override;
-  std::optional<StoredResult> open_result(const std::string& id,
-                                          const std::string& format) const override;
+  std::optional<StoredResult> open_result(const std::string& id, const std::string& format,
+                                          std::optional<int> frame) const override;
   std::optional<JobRecord> wait_finished(
       const std::string& id, std::chrono::steady_clock::time_point deadline) const override;
   bool accepting() const override { return !stopping_.load(); }

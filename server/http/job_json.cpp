@@ -82,6 +82,14 @@ nlohmann::ordered_json job_json(const JobView& v) {
     if (r.state == JobState::kCancelled && r.samples_total > 0)
       progress = std::min(1.0, double(samples_done) / double(r.samples_total));  // how far it got
   }
+  const int frame_count = r.frame_count();
+  if (frame_count > 0 && !v.progress) {
+    // An animation not rendering now: the frames it finished are what it has (a running one's
+    // progress already counts frames, server/jobs/render_task.cpp).
+    progress = r.state == JobState::kSucceeded ? 1.0 : double(r.frames_done) / frame_count;
+    samples_done = r.samples_total / uint64_t(frame_count) * uint64_t(r.frames_done);
+    samples_total = r.samples_total;
+  }
   j["progress"] = progress;
   j["samples_done"] = samples_done;
   j["samples_total"] = samples_total;
@@ -94,6 +102,19 @@ nlohmann::ordered_json job_json(const JobView& v) {
   j["finished_at"] = time_or_null(r.finished_at);
   j["attempts"] = r.attempts;
   j["render"] = {{"width", r.width}, {"height", r.height}, {"spp", r.spp}};
+  if (frame_count > 0) {
+    // The animation's frames (both ends rendered) and how many are finished, in order: frames
+    // first .. first + done - 1 are at /result?frame=N. While it renders, the frame under way
+    // and how far it is.
+    json frames = {{"first", r.frame_first}, {"last", r.frame_last}, {"done", r.frames_done}};
+    if (r.state == JobState::kRunning && r.frames_done < frame_count) {
+      frames["current"] = r.frame_first + r.frames_done;
+      frames["current_progress"] =
+          v.progress ? std::clamp(v.progress->fraction * frame_count - r.frames_done, 0.0, 1.0)
+                     : 0.0;
+    }
+    j["frames"] = frames;
+  }
   // A render cut by its time limit says so at the top, with the samples per pixel it reached,
   // so a client need not read the stats to learn that the image is less converged than asked.
   if (stats.is_object() && stats.value("stopped_by_time_limit", false)) {
@@ -110,6 +131,7 @@ nlohmann::ordered_json job_json(const JobView& v) {
                 {"result_png", self + "/result?format=png"},
                 {"result_exr", self + "/result?format=exr"},
                 {"preview", self + "/result?preview=true"}};
+  if (frame_count > 0) j["links"]["frames"] = self + "/frames.tar";
   return j;
 }
 

@@ -6,6 +6,7 @@
 
 #include "server/http/accept_negotiation.h"
 #include "server/http/byte_range.h"
+#include "server/http/frame_archive.h"
 #include "server/http/job_json.h"
 #include "server/http/problem.h"
 
@@ -13,15 +14,24 @@ namespace penumbra::server {
 
 bool send_result(httplib::Response& res, const JobBackend& jobs, const std::string& id,
                  ImageFormat format, const std::optional<std::string>& range,
-                 const std::string& variant) {
+                 const std::string& variant, std::optional<int> frame) {
   const std::string key = variant.empty() ? std::string(file_extension(format))
                                           : variant + "." + file_extension(format);
-  auto stored = jobs.open_result(id, key);
+  auto stored = jobs.open_result(id, key, frame);
   if (!stored) return false;
   const std::uint64_t size = stored->size;
   std::string tag = key;
   std::replace(tag.begin(), tag.end(), '.', '-');
-  res.set_header("Content-Disposition", std::string("inline; filename=\"") + id + "." + key + "\"");
+  std::string file = id + "." + key;
+  if (frame) {
+    // As in the frames' archive (frame_archive.h), after the job's id.
+    file = id + "." + frame_file_name(*frame, 4, key);
+    std::string frame_tag = "f";  // built by appends: g++ 12 warns (wrongly) on "f" + ...
+    frame_tag.append(std::to_string(*frame)).append("-").append(tag);
+    tag = std::move(frame_tag);
+  }
+  res.set_header("Content-Disposition", std::string("inline; filename=\"") + file + "\"");
+  if (frame) res.set_header("Penumbra-Frame", std::to_string(*frame));
   res.set_header("ETag", "\"" + id + "-" + tag + "\"");
   res.set_header("Cache-Control", "private, max-age=3600");
   res.set_header("Accept-Ranges", "bytes");

@@ -18,8 +18,10 @@ namespace penumbra::server {
 // range handling is off (request_guard clears the parsed ranges).
 // `variant` names which of the job's result files (server/storage/result_files.h): "" the
 // beauty image, "blender" the Blender-layout EXR, or an output layer's name.
+// `frame`: a frame of an animation job (nullopt: a still's image, or an animation's first frame);
+// its file is named <id>.frame_0017.<key> in Content-Disposition.
 bool send_result(httplib::Response& res, const JobBackend& jobs, const std::string& id,
                  ImageFormat format, const std::optional<std::string>& range,
-                 const std::string& variant = "");
+                 const std::string& variant = "", std::optional<int> frame = std::nullopt);
 
 }  // namespace penumbra::server

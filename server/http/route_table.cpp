@@ -47,6 +47,7 @@ std::string route_template(const std::string& path) {
   if (rest.empty()) return "/v1/jobs/{id}";
   if (rest == kResult) return "/v1/jobs/{id}/result";
   if (rest == "/events") return "/v1/jobs/{id}/events";
+  if (rest == "/frames.tar") return "/v1/jobs/{id}/frames.tar";
   return "other";
 }
 

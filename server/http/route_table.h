@@ -12,6 +12,7 @@ namespace penumbra::server {
 inline const std::string kJobRoute = "/v1/jobs/([0-9a-f]{24})";
 inline const std::string kResultRoute = kJobRoute + "/result";
 inline const std::string kEventsRoute = kJobRoute + "/events";
+inline const std::string kFramesArchiveRoute = kJobRoute + "/frames\\.tar";
 // Any last segment: a malformed hash gets a 400 naming it rather than a bare 404.
 inline const std::string kAssetRoute = "/v1/assets/([^/]+)";
 

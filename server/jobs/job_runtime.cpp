@@ -29,4 +29,9 @@ std::shared_ptr<const Image> JobRuntime::preview() const {
   return preview_;
 }
 
+void JobRuntime::clear_preview() {
+  std::lock_guard lock(mutex_);
+  preview_ = nullptr;
+}
+
 }  // namespace penumbra::server

@@ -22,6 +22,9 @@ class JobRuntime {
   RenderProgress progress() const;
   void set_preview(const Image& image);
   std::shared_ptr<const Image> preview() const;
+  // No preview until the next pass (an animation's next frame starts: the last one's image is
+  // not this frame's).
+  void clear_preview();
 
  private:
   std::atomic<bool> cancel_{false};

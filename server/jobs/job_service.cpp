@@ -13,6 +13,7 @@
 #include "server/jobs/submission_check.h"
 #include "server/jobs/unix_time.h"
 #include "server/storage/disk_space.h"
+#include "server/storage/result_files.h"
 
 namespace penumbra::server {
 
@@ -110,7 +111,9 @@ std::uint64_t JobService::reserved_bytes() const {
   const int limit = config_.max_queue + config_.workers + 1;
   for (const JobState state : {JobState::kQueued, JobState::kRunning})
     for (const JobEntry& e : table_.list(state, 0, limit))
-      total += worst_case_result_bytes(e.record.width, e.record.height);
+      // An animation still to write its frames from frames_done on (written ones are on disk).
+      total += worst_case_result_bytes(e.record.width, e.record.height) *
+               std::uint64_t(std::max(1, e.record.frame_count() - e.record.frames_done));
   return total;
 }
 
@@ -306,6 +309,19 @@ DeleteOutcome JobService::cancel_or_delete(const std::string& id, std::chrono::m
       [](const JobRecord& r) { return r.state != JobState::kRunning; }, [] { return false; });
   return !after || after->state != JobState::kRunning ? DeleteOutcome::kCancelled
                                                       : DeleteOutcome::kCancelling;
+}
+
+std::optional<StoredResult> JobService::open_result(const std::string& id,
+                                                    const std::string& format,
+                                                    std::optional<int> frame) const {
+  const auto entry = table_.find(id);
+  if (!entry || entry->record.state == JobState::kDeleted) return std::nullopt;
+  const JobRecord& r = entry->record;
+  if (r.frame_count() == 0) return frame ? std::nullopt : results_.open(id, format);
+  // An animation: only frames counted done (their files were stored before the count).
+  const int f = frame.value_or(r.frame_first);
+  if (f < r.frame_first || f >= r.frame_first + r.frames_done) return std::nullopt;
+  return results_.open(id, frame_result_key(f, format));
 }
 
 std::shared_ptr<const Image> JobService::preview(const std::string& id) const {

@@ -1,7 +1,10 @@
 #pragma once
-// Renders one job: scene JSON -> validated request -> Embree scene -> progressive render.
+// Renders one job: scene JSON -> validated request -> Embree scene -> progressive render; an
+// animation renders each of its frames so, one after another (docs/animation-and-windows.md).
 // Called on the service's own worker threads, never on HTTP threads.
 #include <chrono>
+#include <functional>
+#include <optional>
 #include <string>
 
 #include "api/scene_loader.h"
@@ -21,6 +24,13 @@ struct RenderJobOptions {
   // When the job started (marked running): a time limit counts from here, so reading the scene,
   // building it and writing the images fit in it too, not only the sampling.
   std::chrono::steady_clock::time_point started = std::chrono::steady_clock::now();
+  // An animation (the scene's "animation"): frames are rendered one after another from
+  // `resume_frame` (nullopt: the first) to the last, and each finished frame is handed to
+  // `on_frame` before the next starts; it stores the frame durably (and throws if it cannot,
+  // which fails the job). Frames before resume_frame were finished by an earlier attempt.
+  // Without on_frame an animation renders its first frame only, as a still.
+  std::optional<int> resume_frame;
+  std::function<void(int frame, const struct RenderOutcome& frame_outcome)> on_frame;
 };
 
 // Seconds to encode and store a job's EXR and PNG of this many pixels, as measured here
@@ -36,6 +46,12 @@ struct RenderOutcome {
   RenderSettings settings;
   double build_seconds = 0;
   std::string error;  // when failed
+  // An animation: the frames were handed to on_frame as they finished (image and layers stay
+  // empty); stats add up the frames this attempt rendered.
+  bool animation = false;
+  int frames_rendered = 0;                // by this attempt
+  std::optional<int> first_frame_rendered;  // by this attempt
+  std::optional<int> frame;                 // a single frame's outcome (on_frame): which
 };
 
 // The job's "stats" object (render statistics, denoising) as JSON text.

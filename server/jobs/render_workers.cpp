@@ -110,6 +110,7 @@ void RenderWorkers::run_job(const std::string& id) {
   const double started = unix_now();
   const auto started_steady = std::chrono::steady_clock::now();
   int exhausted_attempts = 0;
+  std::optional<int> resume_frame;  // an animation: the first frame not yet finished
   const auto ticket = table_.modify(id, [&](JobEntry& e) {
     // Cancelled meanwhile, or shutdown began after the pop: it stays queued for the restart.
     if (e.record.state != JobState::kQueued || stopping_) return false;
@@ -122,6 +123,7 @@ void RenderWorkers::run_job(const std::string& id) {
     }
     e.record.state = JobState::kRunning;
     e.record.started_at = started;
+    if (e.record.frame_count() > 0) resume_frame = e.record.frame_first + e.record.frames_done;
     ++e.record.attempts;
     e.runtime = runtime;
     return true;
@@ -145,6 +147,19 @@ void RenderWorkers::run_job(const std::string& id) {
   options.assets.max_file_bytes = int64_t(config_.max_asset_bytes);
   if (std::error_code ec; !std::filesystem::is_directory(options.assets.root, ec))
     options.assets.root.clear();  // a job that names no files
+  options.resume_frame = resume_frame;
+  options.on_frame = [this, &id](int frame, const RenderOutcome& frame_outcome) {
+    // Files first, then frames_done, durable before the next frame starts: a kill -9 from here
+    // on resumes after this frame, and a frame counted done always has its files.
+    write_results(results_, id, frame_outcome.image, frame_outcome.layers,
+                  result_metadata(id, frame_outcome), frame);
+    const auto done = table_.modify(id, [frame](JobEntry& e) {
+      if (e.record.state != JobState::kRunning) return false;
+      e.record.frames_done = std::max(e.record.frames_done, frame - e.record.frame_first + 1);
+      return true;
+    });
+    if (done) writer_.wait_durable(*done);
+  };
   const RenderOutcome outcome = run_render_job(*scene, options, *runtime);
   if (outcome.kind == RenderOutcome::Kind::kStopped &&
       runtime->stop_reason() == JobRuntime::StopReason::kShutdown) {
@@ -168,7 +183,8 @@ void RenderWorkers::finish_job(const std::string& id, const RenderOutcome& outco
       const ImageMetadata meta = result_metadata(id, outcome);
       // Files first, then the record: a crash in between reruns the job, never serves a
       // missing file.
-      write_results(results_, id, outcome.image, outcome.layers, meta);
+      // An animation's frames were each stored as they finished (options.on_frame).
+      if (!outcome.animation) write_results(results_, id, outcome.image, outcome.layers, meta);
       table_.modify(id, settle(JobState::kSucceeded, now, render_stats_json(outcome, threads), ""));
       metrics_.observe_render("succeeded", outcome.stats.seconds, outcome.stats.rays);
       if (outcome.stats.stopped_by_time_limit) metrics_.count_stopped_early("time_limit");

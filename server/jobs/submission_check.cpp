@@ -152,11 +152,18 @@ PreparedSubmission prepare_submission(const ServerConfig& config, AssetStore* as
   r.height = s.height;
   r.spp = s.spp;
   r.samples_total = uint64_t(s.width) * uint64_t(s.height) * uint64_t(s.spp);
+  if (const auto& animation = loaded.request->animation) {
+    // Every frame is rendered (and kept): the totals count them all.
+    r.frame_first = int(animation->first_frame);
+    r.frame_last = int(animation->last_frame);
+    r.samples_total *= uint64_t(r.frame_count());
+  }
   r.priority = options.priority;
   r.notify.url = options.notify_url;
   r.notify.secret = options.notify_secret;
   if (!prepared.warnings.empty()) r.warnings_json = diagnostics_json(prepared.warnings).dump();
-  prepared.worst_case_bytes = worst_case_result_bytes(s.width, s.height, s.outputs);
+  prepared.worst_case_bytes = worst_case_result_bytes(s.width, s.height, s.outputs) *
+                              uint64_t(std::max(1, r.frame_count()));
   // What the worker renders: the scene (or envelope) without the job's options.
   prepared.scene_json = std::move(split.scene_text);
   return prepared;

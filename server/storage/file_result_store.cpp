@@ -28,13 +28,26 @@ FileResultStore::FileResultStore(const std::string& data_dir, bool shared)
     : dir_((fs::path(data_dir) / "results").string()) {
   fs::create_directories(dir_);
   if (shared) return;
+  const auto remove_temporaries = [](const fs::path& dir) {
+    for (const auto& entry : fs::directory_iterator(dir))
+      if (entry.path().filename().string().find(".tmp") != std::string::npos)
+        fs::remove(entry.path());
+  };
+  remove_temporaries(dir_);
   for (const auto& entry : fs::directory_iterator(dir_))
-    if (entry.path().filename().string().find(".tmp") != std::string::npos)
-      fs::remove(entry.path());
+    if (entry.is_directory()) remove_temporaries(entry.path());  // an animation's frames
 }
 
 std::string FileResultStore::path(const std::string& id, const std::string& format) const {
+  // An animation's frame keys ("frames/17.png") live in one folder per job, DIR/<id>.frames/, so
+  // a job of 1000 frames is removed as one folder and the results folder stays short.
+  if (format.rfind(kFramesKeyPrefix, 0) == 0)
+    return (fs::path(frames_dir(id)) / format.substr(std::string(kFramesKeyPrefix).size())).string();
   return (fs::path(dir_) / (id + "." + format)).string();
+}
+
+std::string FileResultStore::frames_dir(const std::string& id) const {
+  return (fs::path(dir_) / (id + ".frames")).string();
 }
 
 std::optional<StoredResult> FileResultStore::open(const std::string& id,
@@ -52,6 +65,12 @@ void FileResultStore::write(const std::string& id, const std::string& format,
                             const std::vector<uint8_t>& bytes) {
   const std::string final_path = path(id, format);
   const std::string tmp = final_path + ".tmp";
+  const std::string parent = fs::path(final_path).parent_path().string();
+  if (parent != dir_ && !fs::is_directory(parent)) {
+    // The job's frames folder, made durable with its first frame: its entry in dir_ is fsync'd.
+    fs::create_directories(parent);
+    fsync_dir(dir_);
+  }
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) throw std::runtime_error("cannot create " + tmp + ": " + std::strerror(errno));
   std::size_t done = 0;
@@ -76,12 +95,13 @@ void FileResultStore::write(const std::string& id, const std::string& format,
     ::unlink(tmp.c_str());
     throw std::runtime_error("cannot rename " + tmp + ": " + std::strerror(errno));
   }
-  fsync_dir(dir_);
+  fsync_dir(parent);
 }
 
 void FileResultStore::remove(const std::string& id) {
   std::error_code ec;
   for (const std::string& key : all_result_keys()) fs::remove(path(id, key), ec);
+  fs::remove_all(frames_dir(id), ec);
 }
 
 }  // namespace penumbra::server

@@ -1,5 +1,6 @@
 #pragma once
-// Result images as files: DIR/results/<id>.png and .exr, each written to a temporary file,
+// Result images as files: DIR/results/<id>.png and .exr (an animation's frames in
+// DIR/results/<id>.frames/<frame>.png ...), each written to a temporary file,
 // flushed to disk and renamed, so a reader (or a restart after kill -9) sees a whole file or none.
 #include <string>
 
@@ -17,6 +18,8 @@ class FileResultStore final : public ResultStore {
   std::optional<StoredResult> open(const std::string& id, const std::string& format) const override;
   void remove(const std::string& id) override;
   std::string path(const std::string& id, const std::string& format) const;
+  // DIR/results/<id>.frames: an animation's frames (keys "frames/<frame>.<key>", result_files.h).
+  std::string frames_dir(const std::string& id) const;
 
  private:
   std::string dir_;

@@ -22,21 +22,27 @@ const std::vector<std::string>& all_result_keys() {
   return keys;
 }
 
+std::string frame_result_key(int frame, const std::string& key) {
+  return kFramesKeyPrefix + std::to_string(frame) + "." + key;
+}
+
 void write_results(ResultStore& store, const std::string& id, const Image& image,
-                   const std::vector<ImageLayer>& layers, const ImageMetadata& metadata) {
+                   const std::vector<ImageLayer>& layers, const ImageMetadata& metadata,
+                   std::optional<int> frame) {
+  const auto key = [&](const std::string& k) { return frame ? frame_result_key(*frame, k) : k; };
   // Without layers the EXR is exactly what it was before layers existed (R, G, B).
-  store.write(id, "exr",
+  store.write(id, key("exr"),
               layers.empty() ? encode_image(image, ImageFormat::kExr, metadata)
                              : encode_layered_exr(image, layers, ExrLayout::kPlain, metadata));
-  store.write(id, "png", encode_image(image, ImageFormat::kPng, metadata));
+  store.write(id, key("png"), encode_image(image, ImageFormat::kPng, metadata));
   // Only with layers: a job without them would pay a second copy of its EXR on disk for a
   // layout only a compositing or denoising workflow asks for.
   if (!layers.empty())
-    store.write(id, result_key("", true, "exr"),
+    store.write(id, key(result_key("", true, "exr")),
                 encode_layered_exr(image, layers, ExrLayout::kBlender, metadata));
   for (const ImageLayer& layer : layers)
     for (const ImageFormat f : {ImageFormat::kExr, ImageFormat::kPng})
-      store.write(id, result_key(layer.name, false, f == ImageFormat::kExr ? "exr" : "png"),
+      store.write(id, key(result_key(layer.name, false, f == ImageFormat::kExr ? "exr" : "png")),
                   encode_layer(layer, image.width, image.height, f, metadata));
 }
 

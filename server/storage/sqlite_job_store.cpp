@@ -60,7 +60,8 @@ class Statement {
 constexpr const char* kColumns =
     "id, seq, state, idempotency_key, created_at, started_at, finished_at, attempts, width, "
     "height, "
-    "spp, samples_total, stats, error, warnings, priority, notify";
+    "spp, samples_total, stats, error, warnings, priority, notify, frame_first, frame_last, "
+    "frames_done";
 
 // The webhook of a job (JobRecord::Notify) as the text of the notify column; "" when none.
 std::string notify_text(const JobRecord::Notify& n) {
@@ -113,6 +114,9 @@ JobRecord read_record(const Statement& s) {
   r.warnings_json = s.text(14);
   r.priority = int(s.integer(15));
   r.notify = notify_from_text(s.text(16));
+  r.frame_first = int(s.integer(17));
+  r.frame_last = int(s.integer(18));
+  r.frames_done = int(s.integer(19));
   return r;
 }
 
@@ -156,6 +160,10 @@ SqliteJobStore::SqliteJobStore(const std::string& path)
   // their defaults (every old job has priority 0 and no webhook).
   add_column_if_missing("priority", "INTEGER NOT NULL DEFAULT 0");
   add_column_if_missing("notify", "TEXT NOT NULL DEFAULT ''");
+  // Animations (docs/animation-and-windows.md): a still is first 0, last -1 (no frames).
+  add_column_if_missing("frame_first", "INTEGER NOT NULL DEFAULT 0");
+  add_column_if_missing("frame_last", "INTEGER NOT NULL DEFAULT -1");
+  add_column_if_missing("frames_done", "INTEGER NOT NULL DEFAULT 0");
 }
 
 void SqliteJobStore::add_column_if_missing(const std::string& name, const std::string& decl) {
@@ -276,8 +284,8 @@ void SqliteJobStore::apply_one(const JobChange& change,
     Statement s(db_,
                 "INSERT INTO jobs (seq, id, state, scene, idempotency_key, created_at, started_at, "
                 "finished_at, attempts, width, height, spp, samples_total, stats, error, warnings, "
-                "priority, notify) "
-                "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+                "priority, notify, frame_first, frame_last, frames_done) "
+                "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
     s.bind(1, r.seq)
         .bind(2, r.id)
         .bind(3, std::string(to_string(r.state)))
@@ -290,6 +298,8 @@ void SqliteJobStore::apply_one(const JobChange& change,
     s.bind(12, int64_t(r.spp)).bind(13, int64_t(r.samples_total)).bind(14, r.stats_json);
     s.bind(15, r.error_json).bind(16, r.warnings_json);
     s.bind(17, int64_t(r.priority)).bind(18, notify_text(r.notify));
+    s.bind(19, int64_t(r.frame_first)).bind(20, int64_t(r.frame_last));
+    s.bind(21, int64_t(r.frames_done));
     s.step();
   } else if (const auto* update = std::get_if<UpdateJob>(&change)) {
     const JobRecord& r = update->record;
@@ -298,7 +308,8 @@ void SqliteJobStore::apply_one(const JobChange& change,
         db_,
         "UPDATE jobs SET state = ?1, idempotency_key = ?2, started_at = ?3, finished_at = ?4, "
         "attempts = ?5, samples_total = ?6, stats = ?7, error = ?8, warnings = ?9, "
-        "scene = CASE WHEN ?1 = 'deleted' THEN '' ELSE scene END, priority = ?11, notify = ?12 "
+        "scene = CASE WHEN ?1 = 'deleted' THEN '' ELSE scene END, priority = ?11, notify = ?12, "
+        "frames_done = ?13 "
         "WHERE id = ?10");
     s.bind(1, std::string(to_string(r.state)))
         .bind_or_null(2, r.idempotency_key)
@@ -306,6 +317,7 @@ void SqliteJobStore::apply_one(const JobChange& change,
     s.bind(4, r.finished_at).bind(5, int64_t(r.attempts)).bind(6, int64_t(r.samples_total));
     s.bind(7, r.stats_json).bind(8, r.error_json).bind(9, r.warnings_json).bind(10, r.id);
     s.bind(11, int64_t(r.priority)).bind(12, notify_text(r.notify));
+    s.bind(13, int64_t(r.frames_done));
     s.step();
     if (r.state == JobState::kDeleted) remove_after_commit.push_back(scene_path(r.id));
   } else {

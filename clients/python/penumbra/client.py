@@ -5,9 +5,10 @@ from __future__ import annotations
 import http.client
 import json
 import os
+import shutil
 import sys
 import time
-from typing import Any, Callable, Dict, Iterator, Mapping, Optional, Union
+from typing import Any, Callable, Dict, Iterator, List, Mapping, Optional, Union
 from urllib.parse import quote, urlencode, urlsplit
 
 from . import assets as _assets
@@ -305,12 +306,16 @@ class Client:
 
     def result(self, job: JobRef, format: str = "exr", layer: Optional[str] = None,
                as_array: Optional[bool] = None, layout: Optional[str] = None,
-               preview: bool = False):
+               preview: bool = False, frame: Optional[int] = None):
         """The job's image: bytes of the PNG or EXR, or (EXR, when numpy is installed and
         `as_array` is not False) a float32 array of shape (height, width, channels).
         `preview=True`: the progressive image of a running job (a ProblemError with status 409
-        until its first pass is done)."""
+        until its first pass is done). `frame`: one frame of an animation job, available as soon
+        as it is finished (a ProblemError with status 404 naming `frame` before, or outside the
+        animation's frames; 422 for a still)."""
         query: Dict[str, str] = {"format": format}
+        if frame is not None:
+            query["frame"] = str(int(frame))
         if preview:
             query["preview"] = "true"
         if layer:
@@ -338,6 +343,70 @@ class Client:
         if layer and not any(k.startswith(layer + ".") for k in planes):
             return rgb(planes)  # a separate layer download has plain channel names
         return rgb(planes, layer or "")
+
+    def frames_archive(self, job: JobRef, dest, format: str = "exr",
+                       layer: Optional[str] = None, layout: Optional[str] = None) -> int:
+        """Streams the animation job's frames archive (GET /v1/jobs/{id}/frames.tar: a tar of
+        frame_0001.exr ...) into `dest` (a path or a binary file object), 1 MiB at a time, never
+        whole in memory. Returns the bytes written."""
+        query: Dict[str, str] = {"format": format}
+        if layer:
+            query["layer"] = layer
+        if layout:
+            query["layout"] = layout
+        path = f"/v1/jobs/{quote(_job_id(job))}/frames.tar?" + urlencode(query)
+        conn, resp = self._open("GET", path, headers={"Accept": "application/x-tar"})
+        try:
+            if resp.status != 200:
+                data = resp.read()
+                raise problem_error(resp.status, data, resp.getheader("Content-Type", ""),
+                                    resp.getheader("Retry-After"))
+            expected = resp.getheader("Content-Length")
+            out = open(dest, "wb") if isinstance(dest, (str, os.PathLike)) else dest
+            written = 0
+            try:
+                while True:
+                    chunk = resp.read(1 << 20)
+                    if not chunk:
+                        break
+                    out.write(chunk)
+                    written += len(chunk)
+            finally:
+                if out is not dest:
+                    out.close()
+        except (OSError, http.client.HTTPException) as e:
+            raise ConnectionFailed(f"GET {self.url}{path}: {e}") from None
+        finally:
+            conn.close()
+        if expected is not None and written != int(expected):
+            raise ConnectionFailed(f"GET {self.url}{path}: the archive was cut short "
+                                   f"({written} of {expected} bytes)")
+        return written
+
+    def download_frames(self, job: JobRef, directory, format: str = "exr",
+                        layer: Optional[str] = None, layout: Optional[str] = None) -> List[str]:
+        """Every finished frame of an animation job as files in `directory` (made if missing):
+        frame_0001.exr, frame_0002.exr ... as in the archive, streamed through a temporary file
+        and extracted (no member may leave the directory). Returns the paths, in frame order."""
+        import tarfile
+        import tempfile
+
+        os.makedirs(directory, exist_ok=True)
+        with tempfile.TemporaryFile(dir=directory) as tmp:
+            self.frames_archive(job, tmp, format=format, layer=layer, layout=layout)
+            tmp.seek(0)
+            paths = []
+            with tarfile.open(fileobj=tmp, mode="r:") as tar:
+                for member in tar:
+                    name = member.name
+                    if (not member.isfile() or "/" in name or "\\" in name or
+                            name in ("", ".", "..")):
+                        raise ValueError(f"unexpected archive member {name!r}")
+                    target = os.path.join(directory, name)
+                    with tar.extractfile(member) as src, open(target, "wb") as dst:
+                        shutil.copyfileobj(src, dst, 1 << 20)
+                    paths.append(target)
+        return paths
 
     def render(self, scene, assets=None, format: str = "exr", progress: Progress = True,
                **submit_args):

@@ -183,6 +183,50 @@ class JobsTest(ServerTest):
         finally:
             self.client.cancel(job)
 
+    def test_animation_frames_one_by_one_and_as_files(self):
+        """An animation job: result(frame=N) per frame, download_frames extracts the archive,
+        each file byte for byte the frame's result; bad frames raise naming the parameter."""
+        scene = sky_scene(6, 4, 2)
+        scene["materials"] = {"m": {"type": "diffuse", "color": [0.5, 0.5, 0.5]}}
+        scene["objects"] = [{"type": "sphere", "center": [-1, 0, 0], "radius": 0.5,
+                             "material": "m", "velocity": [6, 0, 0]}]
+        scene["animation"] = {"frames": [2, 5], "fps": 24, "shutter": 0.5}
+        job = self.client.submit(scene)
+        final = self.client.wait(job, progress=False, timeout=60)
+        self.assertEqual(final["frames"], {"first": 2, "last": 5, "done": 4})
+        frames = {f: self.client.result(job, format="exr", frame=f, as_array=False)
+                  for f in range(2, 6)}
+        self.assertEqual(len(set(frames.values())), 4, "the sphere moves: every frame differs")
+        with tempfile.TemporaryDirectory() as out:
+            paths = self.client.download_frames(job, os.path.join(out, "frames"))
+            self.assertEqual([os.path.basename(p) for p in paths],
+                             [f"frame_000{f}.exr" for f in range(2, 6)])
+            for f, path in zip(range(2, 6), paths):
+                with open(path, "rb") as fh:
+                    self.assertEqual(fh.read(), frames[f], f"frame {f}")
+            pngs = self.client.download_frames(job, os.path.join(out, "png"), format="png")
+            self.assertEqual(len(pngs), 4)
+            for f, path in zip(range(2, 6), pngs):
+                with open(path, "rb") as fh:
+                    self.assertEqual(fh.read(), self.client.result(job, format="png", frame=f))
+            buf = io.BytesIO()
+            size = self.client.frames_archive(job, buf)
+            self.assertEqual(size, len(buf.getvalue()))
+            self.assertEqual(size % 512, 0)
+        for bad, status in ((1, 404), (6, 404)):
+            with self.assertRaises(penumbra.ProblemError) as caught:
+                self.client.result(job, frame=bad)
+            self.assertEqual(caught.exception.status, status)
+            self.assertEqual(caught.exception.problem["errors"][0]["parameter"], "frame")
+        still = self.client.submit(sky_scene())
+        self.client.wait(still, progress=False, timeout=60)
+        with self.assertRaises(penumbra.ProblemError) as caught:
+            self.client.result(still, frame=1)
+        self.assertEqual(caught.exception.status, 422)
+        with self.assertRaises(penumbra.ProblemError) as caught:
+            self.client.download_frames(still, tempfile.gettempdir())
+        self.assertEqual(caught.exception.status, 404)
+
     def test_progress_callback_sees_the_final_state(self):
         seen = []
         self.client.wait(self.client.submit(sky_scene()), progress=seen.append)

@@ -3,6 +3,7 @@
 #include "server/storage/sqlite_job_store.h"
 
 #include <gtest/gtest.h>
+#include <sqlite3.h>
 
 #include "tests/server/test_support.h"
 
@@ -46,6 +47,9 @@ void expect_same(const JobRecord& a, const JobRecord& b) {
   EXPECT_EQ(a.stats_json, b.stats_json);
   EXPECT_EQ(a.error_json, b.error_json);
   EXPECT_EQ(a.warnings_json, b.warnings_json);
+  EXPECT_EQ(a.frame_first, b.frame_first);
+  EXPECT_EQ(a.frame_last, b.frame_last);
+  EXPECT_EQ(a.frames_done, b.frames_done);
 }
 
 TEST(SqliteJobStore, EveryFieldSurvivesReopening) {
@@ -111,6 +115,53 @@ TEST(SqliteJobStore, TheLastSequenceNumberOutlivesErasedJobs) {
   ASSERT_EQ(loaded.records.size(), 1u);
   EXPECT_EQ(loaded.last_seq, 3) << "a new job must not reuse seq 3: old page tokens would name it";
   EXPECT_FALSE(store.scene(record(3).id));
+}
+
+// An animation's frame range is stored at insert, frames_done by every update: a restart resumes
+// from it. A still keeps first 0, last -1.
+TEST(SqliteJobStore, AnimationFramesSurviveReopening) {
+  TempDir dir;
+  JobRecord still = record(1);
+  JobRecord anim = record(2);
+  anim.frame_first = -3;
+  anim.frame_last = 44;
+  {
+    SqliteJobStore store(dir.path() + "/jobs.db");
+    store.apply({InsertJob{still, "{}"}, InsertJob{anim, "{}"}});
+    anim.state = JobState::kRunning;
+    anim.frames_done = 17;
+    store.apply({UpdateJob{anim}});
+  }
+  SqliteJobStore store(dir.path() + "/jobs.db");
+  const server::StoredJobs loaded = store.load();
+  ASSERT_EQ(loaded.records.size(), 2u);
+  for (const JobRecord& r : loaded.records) expect_same(r, r.id == anim.id ? anim : still);
+  for (const JobRecord& r : loaded.records)
+    EXPECT_EQ(r.frame_count(), r.id == anim.id ? 48 : 0);
+}
+
+// A database of the version before animations (no frame columns) gains them: its jobs are stills.
+TEST(SqliteJobStore, AnOlderDatabaseGainsTheFrameColumns) {
+  TempDir dir;
+  JobRecord r = record(1);
+  {
+    SqliteJobStore store(dir.path() + "/jobs.db");
+    store.apply({InsertJob{r, "{}"}});
+  }
+  {
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open((dir.path() + "/jobs.db").c_str(), &db), SQLITE_OK);
+    for (const char* column : {"frame_first", "frame_last", "frames_done"})
+      ASSERT_EQ(sqlite3_exec(db, (std::string("ALTER TABLE jobs DROP COLUMN ") + column).c_str(),
+                             nullptr, nullptr, nullptr),
+                SQLITE_OK);
+    sqlite3_close(db);
+  }
+  SqliteJobStore store(dir.path() + "/jobs.db");
+  const server::StoredJobs loaded = store.load();
+  ASSERT_EQ(loaded.records.size(), 1u);
+  expect_same(loaded.records[0], r);
+  EXPECT_EQ(loaded.records[0].frame_count(), 0);
 }
 
 }  // namespace
