@@ -113,7 +113,9 @@ TEST(AnimationJobs, EveryFrameEqualsTheCommandLineRenderBitForBit) {
     ASSERT_EQ(served.height, 24);
     EXPECT_TRUE(served.rgb == reference.rgb) << "frame " << frame << " differs from the CLI's";
     if (frame == 1) first_frame = served.rgb;
-    if (frame > 1) EXPECT_FALSE(served.rgb == first_frame) << "frame " << frame << " = frame 1";
+    if (frame > 1) {
+      EXPECT_FALSE(served.rgb == first_frame) << "frame " << frame << " = frame 1";
+    }
     auto png = c->Get(frame_path(id, frame, "png").c_str());
     ASSERT_EQ(png->status, 200);
     EXPECT_EQ(png->get_header_value("Content-Type"), "image/png");
@@ -289,10 +291,12 @@ TEST(AnimationJobs, KillDashNineKeepsFinishedFramesAndResumes) {
   EXPECT_GE(resumed_from, done_at_kill) << job.dump();
   EXPECT_GT(resumed_from, 1) << "resumed from the start: " << job.dump();
   EXPECT_EQ(job["stats"]["frames_rendered"], 7 - resumed_from) << job.dump();
-  for (const auto& [frame, inode] : inodes)
-    if (frame < resumed_from)
+  for (const auto& [frame, inode] : inodes) {
+    if (frame < resumed_from) {
       EXPECT_EQ(inode_of(frames_dir + id + ".frames/" + std::to_string(frame) + ".exr"), inode)
           << "frame " << frame << " was rendered again";
+    }
+  }
   for (int frame = 1; frame <= 6; ++frame)
     EXPECT_EQ(c->Get(frame_path(id, frame, "exr").c_str())->status, 200) << frame;
   EXPECT_EQ(untar(c->Get(("/v1/jobs/" + id + "/frames.tar").c_str())->body).size(), 6u);
