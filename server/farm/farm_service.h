@@ -45,8 +45,8 @@ class FarmService final : public JobBackend {
   bool stopping() const override { return stopping_.load(); }
   DeleteOutcome cancel_or_delete(const std::string& id, std::chrono::milliseconds wait) override;
   std::shared_ptr<const Image> preview(const std::string& id) const override;
-  std::optional<StoredResult> open_result(const std::string& id,
-                                          const std::string& format) const override;
+  std::optional<StoredResult> open_result(const std::string& id, const std::string& format,
+                                          std::optional<int> frame) const override;
   std::optional<JobRecord> wait_finished(
       const std::string& id, std::chrono::steady_clock::time_point deadline) const override;
   bool accepting() const override { return !stopping_.load(); }
@@ -57,6 +57,8 @@ class FarmService final : public JobBackend {
   nlohmann::json workers() const override;
 
  private:
+  // A split job's preview: the tiles' last previews (previews/<id>.w*.exr) placed in one frame.
+  std::shared_ptr<const Image> tiles_preview(const std::string& id) const;
   JobView make_view(const PgRows& rows, int row, PgConnection& db) const;
   void event_loop();
   // Erases finished jobs older than --retention (rows, result files, asset folders); any API

@@ -16,7 +16,7 @@ bool send_result(httplib::Response& res, const JobBackend& jobs, const std::stri
                  const std::string& variant) {
   const std::string key = variant.empty() ? std::string(file_extension(format))
                                           : variant + "." + file_extension(format);
-  auto stored = jobs.open_result(id, key);
+  auto stored = jobs.open_result(id, key, std::nullopt);
   if (!stored) return false;
   const std::uint64_t size = stored->size;
   std::string tag = key;

@@ -72,7 +72,7 @@ void get_result(const RouteContext& c, const httplib::Request& req, httplib::Res
   const JobState state = v->record.state;
   if (state == JobState::kSucceeded) {
     if (send_result(res, c.jobs, id, f, header_value(req, "Range"), which)) return;
-    if (which.empty() || !c.jobs.open_result(id, "png"))
+    if (which.empty() || !c.jobs.open_result(id, "png", std::nullopt))
       return send_problem(res, req, status_problem(404, "the result of job " + id + " is gone"));
     // The Blender EXR is stored for jobs with output layers only (result_files.h).
     Problem p = make_problem(404, "layer-not-rendered", "Layer not rendered",

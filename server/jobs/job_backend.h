@@ -85,8 +85,10 @@ class JobBackend {
   // render to stop.
   virtual DeleteOutcome cancel_or_delete(const std::string& id, std::chrono::milliseconds wait) = 0;
   virtual std::shared_ptr<const Image> preview(const std::string& id) const = 0;
-  virtual std::optional<StoredResult> open_result(const std::string& id,
-                                                  const std::string& format) const = 0;
+  // `frame`: which frame of an animation (nullopt: a still's image; for an animation, its
+  // first frame). nullopt when there is no such result (yet).
+  virtual std::optional<StoredResult> open_result(const std::string& id, const std::string& format,
+                                                  std::optional<int> frame) const = 0;
   // Blocks until the job is finished, the deadline passes or shutdown begins.
   virtual std::optional<JobRecord> wait_finished(
       const std::string& id, std::chrono::steady_clock::time_point deadline) const = 0;

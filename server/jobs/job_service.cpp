@@ -308,6 +308,13 @@ DeleteOutcome JobService::cancel_or_delete(const std::string& id, std::chrono::m
                                                       : DeleteOutcome::kCancelling;
 }
 
+std::optional<StoredResult> JobService::open_result(const std::string& id,
+                                                    const std::string& format,
+                                                    std::optional<int> frame) const {
+  // One node renders an animation's first frame only so far (the "anim" branch adds frames).
+  return frame ? std::nullopt : results_.open(id, format);
+}
+
 std::shared_ptr<const Image> JobService::preview(const std::string& id) const {
   const auto entry = table_.find(id);
   return entry && entry->runtime ? entry->runtime->preview() : nullptr;

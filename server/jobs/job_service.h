@@ -64,10 +64,8 @@ class JobService final : public JobBackend {
   // render to stop.
   DeleteOutcome cancel_or_delete(const std::string& id, std::chrono::milliseconds wait) override;
   std::shared_ptr<const Image> preview(const std::string& id) const override;
-  std::optional<StoredResult> open_result(const std::string& id,
-                                          const std::string& format) const override {
-    return results_.open(id, format);
-  }
+  std::optional<StoredResult> open_result(const std::string& id, const std::string& format,
+                                          std::optional<int> frame) const override;
   // Blocks until the job is finished, the deadline passes or shutdown begins.
   std::optional<JobRecord> wait_finished(const std::string& id,
                                          std::chrono::steady_clock::time_point deadline) const override;

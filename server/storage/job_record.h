@@ -28,6 +28,11 @@ struct JobRecord {
   int attempts = 0;  // times a render started (a kill -9 mid-render leaves it counted)
   int width = 0, height = 0, spp = 0;
   uint64_t samples_total = 0;
+  // An animation's frames (scene "animation": [frame_first, frame_last], both rendered) and how
+  // many have finished; a still has frame_count() == 0.
+  int frame_first = 0, frame_last = -1;
+  int frames_done = 0;
+  int frame_count() const { return frame_last >= frame_first ? frame_last - frame_first + 1 : 0; }
   std::string stats_json;     // "" or a JSON object (render statistics)
   std::string error_json;     // "" or a JSON object (why it failed)
   std::string warnings_json;  // "" or a JSON array of {pointer, detail}

@@ -37,7 +37,7 @@ TEST(JobService, AJobGoesFromQueuedThroughRunningToSucceededOnDisk) {
   EXPECT_GE(done->record.finished_at, done->record.started_at);
   EXPECT_NE(done->record.stats_json.find("\"camera_samples\":128"), std::string::npos)
       << done->record.stats_json;
-  const auto png = s->open_result(o.record.id, "png");
+  const auto png = s->open_result(o.record.id, "png", std::nullopt);
   ASSERT_TRUE(png);
   EXPECT_GT(png->size, 0u);
   s.stop();  // every decided change is written

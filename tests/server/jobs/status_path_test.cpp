@@ -113,8 +113,8 @@ TEST(StatusPath, PollsDoNotWaitForAResultDeletion) {
   EXPECT_LT(times->slowest, kPollBound);
   EXPECT_TRUE(still_deleting);
   EXPECT_EQ(deleting.get(), DeleteOutcome::kDeleted);
-  EXPECT_FALSE(s->open_result(finished, "png"));
-  EXPECT_TRUE(s->open_result(other, "png"));
+  EXPECT_FALSE(s->open_result(finished, "png", std::nullopt));
+  EXPECT_TRUE(s->open_result(other, "png", std::nullopt));
 }
 
 }  // namespace
