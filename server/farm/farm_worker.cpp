@@ -219,7 +219,7 @@ std::optional<FarmWorker::Claim> FarmWorker::claim(PgConnection& db) {
       PgRows rows = db.exec(
           "SELECT t.id, t.job_id, t.attempts, t.last_error, t.kind, t.params::text AS params, "
           "j.width, j.height, j.scene_json FROM tasks t "
-          "JOIN jobs j ON j.id = t.job_id WHERE t.state = 'queued' AND NOT j.cancel_requested "
+          "JOIN jobs j ON j.id = t.job_id WHERE t.state = 'queued' AND NOT j.cancel_requested AND j.state IN ('queued', 'running') "
           "ORDER BY t.priority DESC, t.job_seq, t.id LIMIT 1 FOR UPDATE OF t, j SKIP LOCKED");
       if (rows.size() == 0) return;
       c.task = rows.int_value(0, "id");

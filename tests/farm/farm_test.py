@@ -620,9 +620,8 @@ def test_split_progress_and_preview(farm):
                 if t["kind"] == "tile" and t.get("window"):
                     seen_windows.add(tuple(t["window"]))
         _, j = get_json(api["base"], "/v1/jobs/" + job)
-        p = (j or {}).get("progress") or {}
-        if p.get("fraction"):
-            fractions.append(p["fraction"])
+        if j and j["state"] == "running" and j["progress"] and j["eta_seconds"] is not None:
+            fractions.append(j["progress"])
         status, raw, _ = request(api["base"], "GET", "/v1/jobs/%s/result?preview=true&format=exr" % job)
         if status == 200:
             preview = raw
@@ -666,6 +665,9 @@ def test_split_cancel(farm):
             break
         time.sleep(0.1)
     check(all(s == "cancelled" for s, _ in live), "every tile cancelled: %s" % live)
+    # Only the two tiles under way at the DELETE ever started: the others never ran.
+    attempts = farm.psql("SELECT count(*) FROM task_attempts WHERE job_id = '%s'" % job)
+    check(attempts == [["2"]], "no tile started after the cancel: %s attempts" % attempts)
     time.sleep(farm.heartbeat * 2)
     check(farm.psql("SELECT count(*) FROM tasks WHERE job_id = '%s' AND kind = 'merge'" % job)
           == [["0"]], "no merge")
