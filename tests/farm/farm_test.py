@@ -585,6 +585,16 @@ def split_job(farm, kill_one=False):
     check(left == ([job + "." + "f" * 24 + ".tile.exr"] if kill_one else []),
           "the committed tiles' files are gone after the merge: %s" % left)
     check(j["stats"].get("tasks") == 16, "the job's stats sum its tiles: %s" % j["stats"])
+    # Where the wall time went: tiles (first start to last end), the merge, from the attempt log.
+    (tiles_span, merge_span, tile_sum), = farm.psql(
+        "SELECT extract(epoch FROM max(a.ended_at) FILTER (WHERE t.kind = 'tile') - "
+        "min(a.started_at) FILTER (WHERE t.kind = 'tile')), extract(epoch FROM "
+        "max(a.ended_at) FILTER (WHERE t.kind = 'merge') - min(a.started_at) FILTER (WHERE "
+        "t.kind = 'merge')), extract(epoch FROM sum(a.ended_at - a.started_at) FILTER (WHERE "
+        "t.kind = 'tile' AND a.outcome = 'succeeded')) FROM task_attempts a JOIN tasks t ON "
+        "t.id = a.task_id WHERE a.job_id = '%s'" % job)
+    print("  tiles %.2f s (first start to last end; %.2f s of tile attempts summed), merge and "
+          "results %.2f s" % (float(tiles_span), float(tile_sum), float(merge_span)))
     return job, wall, local_seconds, per
 
 
