@@ -686,6 +686,29 @@ def test_split_cancel(farm):
     print("split_cancel: 16 tiles cancelled %.2f s after DELETE" % (time.time() - t0))
 
 
+def test_split_denoise(farm):
+    # A split job that asks for denoising: the tiles render the guides, the merge denoises the
+    # whole frame (a window cannot be denoised alone); the result equals `penumbra render` of the
+    # scene, denoised image, kept "noisy" layer and requested layers. --tile-pixels is the API
+    # node's: a 128x128 frame in 4 tiles.
+    api = farm.start("api", ["--tile-pixels", "4096"])
+    farm.start("worker")
+    farm.start("worker")
+    s = scene(128, 128, 4, 5)
+    s["render"]["denoise"] = True
+    s["render"]["outputs"] = ["depth"]
+    job = submit(api["base"], s)
+    check(farm.psql("SELECT kind, count(*) FROM tasks WHERE job_id = '%s' GROUP BY kind" % job)
+          == [["tile", "4"]], "4 tiles")
+    check(wait_states(api["base"], [job], 120)[job] == "succeeded", "rendered")
+    _, j = get_json(api["base"], "/v1/jobs/" + job)
+    a = fetch(api["base"], "/v1/jobs/%s/result?format=exr" % job, os.path.join(farm.work, "d.exr"))
+    b = render_locally(farm, s, os.path.join(farm.work, "dl.exr"), ["--threads", "1"])
+    check(same_pixels(a, b), "the denoised merge equals the single-machine denoised render")
+    print("split_denoise: 4 tiles merged then denoised (denoised: %s) == penumbra render"
+          % j["stats"].get("denoised"))
+
+
 def animation_scene(frames=24):
     with open(os.path.join(REPO, "scenes", "motion_blur.json")) as f:
         s = json.load(f)
@@ -752,6 +775,7 @@ TESTS = {
     "split_frame_worker_kill": (test_split_frame_worker_kill, {"lease": 3.0, "heartbeat": 0.5}),
     "split_progress_and_preview": (test_split_progress_and_preview, {}),
     "split_cancel": (test_split_cancel, {}),
+    "split_denoise": (test_split_denoise, {}),
     "animation_frames": (test_animation_frames, {}),
 }
 
