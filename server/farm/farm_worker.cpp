@@ -503,8 +503,10 @@ void FarmWorker::run(PgConnection& db, const Claim& c) {
   };
   // A task of a job of several: the job's row is locked first, so the commits of its tasks take
   // turns and exactly one of them sees the last tile (or frame) done.
+  bool cancel_requested = false;
   const auto lock_job = [&]() -> std::string {
-    PgRows j = db.exec("SELECT state FROM jobs WHERE id = $1 FOR UPDATE", {c.job});
+    PgRows j = db.exec("SELECT state, cancel_requested FROM jobs WHERE id = $1 FOR UPDATE", {c.job});
+    cancel_requested = j.size() && j.value(0, "cancel_requested") == "t";
     return j.size() ? j.value(0, "state") : std::string();
   };
   const auto job_live = [](const std::string& state) {
@@ -546,12 +548,22 @@ void FarmWorker::run(PgConnection& db, const Claim& c) {
       const std::string job_state = c.kind != "job" ? lock_job() : std::string("running");
       switch (outcome.kind) {
         case RenderOutcome::Kind::kSucceeded:
-          if (c.kind != "job" && !job_live(job_state)) {
-            // The job failed or was cancelled meanwhile: this piece counts for nothing.
+          if (c.kind != "job" && (!job_live(job_state) || cancel_requested)) {
+            // The job failed or was cancelled meanwhile: this piece counts for nothing. A cancel
+            // that reached no heartbeat of this task (it finished first) ends the job here,
+            // before a merge could be queued that no claim would take.
             mine = db.exec(std::string(kStillMine), {tid, c.token, "cancelled", ""}).affected() > 0;
             if (!mine) return;
             end_attempt("cancelled");
-            return;
+            if (!job_live(job_state)) return;
+            final_state = "cancelled";
+            db.exec(
+                "UPDATE jobs SET state = 'cancelled', finished_at = $2, progress_json = '' WHERE "
+                "id = $1",
+                {c.job, now});
+            db.exec("UPDATE tasks SET state = 'cancelled' WHERE job_id = $1 AND state = 'queued'",
+                    {c.job});
+            break;
           }
           mine = db.exec(std::string(kStillMine), {tid, c.token, "done", ""}).affected() > 0;
           if (!mine) return;

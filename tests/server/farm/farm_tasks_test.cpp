@@ -2,7 +2,9 @@
 // every pixel once and are close to square; what the submission asks decides tiles or frames.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <map>
+#include <tuple>
 #include <vector>
 
 #include "server/farm/farm_tasks.h"
