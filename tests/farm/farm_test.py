@@ -709,6 +709,28 @@ def test_split_denoise(farm):
           % j["stats"].get("denoised"))
 
 
+def test_split_retention(farm):
+    # A split job expires with every file of it: the result, and a tile file of an attempt that
+    # never committed (planted: what a worker killed between writing and committing leaves).
+    api = farm.start("api", ["--retention", "2s", "--tile-pixels", "4096"])
+    farm.start("worker")
+    job = submit(api["base"], scene(128, 128, 2))
+    orphan = os.path.join(farm.data, "results", job + "." + "e" * 24 + ".tile.exr")
+    with open(orphan, "wb") as f:
+        f.write(b"left by a lost attempt")
+    check(wait_states(api["base"], [job], 60)[job] == "succeeded", "rendered")
+    deadline = time.time() + 10
+    status = 200
+    while time.time() < deadline and status != 404:
+        status, _ = get_json(api["base"], "/v1/jobs/" + job)
+        time.sleep(0.2)
+    check(status == 404, "expired: %d" % status)
+    left = [f for d in ("results", "previews") for f in os.listdir(os.path.join(farm.data, d))
+            if f.startswith(job)]
+    check(not left, "every file of the job is gone: %s" % left)
+    print("split_retention: the split job's result and an orphan tile file went with it")
+
+
 def animation_scene(frames=24):
     with open(os.path.join(REPO, "scenes", "motion_blur.json")) as f:
         s = json.load(f)
@@ -776,6 +798,7 @@ TESTS = {
     "split_progress_and_preview": (test_split_progress_and_preview, {}),
     "split_cancel": (test_split_cancel, {}),
     "split_denoise": (test_split_denoise, {}),
+    "split_retention": (test_split_retention, {}),
     "animation_frames": (test_animation_frames, {}),
 }
 
