@@ -42,7 +42,9 @@ std::vector<PixelWindow> tile_windows(int width, int height, int64_t tile_pixels
   const int64_t wanted = (pixels + tile_pixels - 1) / tile_pixels;
   // Square tiles of side s = sqrt(pixels / wanted) make width / s columns.
   const double columns_exact = std::sqrt(double(wanted) * double(width) / double(height));
-  const int columns = int(std::clamp<int64_t>(std::llround(columns_exact), 1, width));
+  // At most `wanted` columns: a frame thinner than a square tile gets strips, not slivers.
+  const int columns =
+      int(std::clamp<int64_t>(std::llround(columns_exact), 1, std::min<int64_t>(width, wanted)));
   const int rows = int(std::clamp<int64_t>((wanted + columns - 1) / columns, 1, height));
   std::vector<PixelWindow> out;
   out.reserve(std::size_t(columns) * std::size_t(rows));

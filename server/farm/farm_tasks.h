@@ -24,8 +24,9 @@ TaskPiece task_piece_from_params(const std::string& params_json);
 std::string task_params_json(const TaskPiece& piece);
 
 // The windows a width x height frame is cut into: none (an empty list: one task renders it)
-// when it has at most `tile_pixels` pixels; otherwise about ceil(pixels / tile_pixels) windows
-// in a grid of columns x rows chosen so that each window is close to square, edges at
+// when it has at most `tile_pixels` pixels; otherwise n = ceil(pixels / tile_pixels) windows or a
+// few more (fewer than 2n) in a grid of columns x rows chosen so that each window is close to
+// square (strips when the frame is thinner than a square tile), edges at
 // floor(i * width / columns), every pixel in exactly one window.
 std::vector<PixelWindow> tile_windows(int width, int height, int64_t tile_pixels);
 
