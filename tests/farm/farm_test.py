@@ -9,7 +9,10 @@ runs again after its lease expires; the recovery time is printed), api_kill (kil
 node mid-request: retried with the same Idempotency-Key on the other, one job per key),
 postgres_restart (PostgreSQL restarted under load: nothing accepted is lost), cancel_running
 (a cancel reaches the worker at its heartbeat), max_attempts (a task that keeps failing fails
-its job with the reason). Exit 77 (ctest: skipped) without a PostgreSQL server, except with
+its job with the reason), and jobs of several tasks: split_frame (a 1024x1024 frame in 16 tiles
+over 3 workers equals `penumbra render` bit for bit), split_frame_worker_kill (the same with a
+worker killed mid-tile), split_progress_and_preview, split_cancel, split_denoise,
+split_retention, animation_frames (24 frames over 3 workers equal `penumbra render --frame i`). Exit 77 (ctest: skipped) without a PostgreSQL server, except with
 CI=true, where that is a failure.
 """
 import json
