@@ -192,6 +192,8 @@ std::vector<Setting> settings() {
                        &ServerConfig::lease_seconds),
       duration_setting("--heartbeat", "PENUMBRA_HEARTBEAT", 0.05, &ServerConfig::heartbeat_seconds),
       int_setting("--max-attempts", "PENUMBRA_MAX_ATTEMPTS", 1, 100, &ServerConfig::max_attempts),
+      int_setting("--tile-pixels", "PENUMBRA_TILE_PIXELS", 4096, int64_t(1) << 40,
+                  &ServerConfig::tile_pixels),
   };
 }
 
@@ -404,6 +406,10 @@ const char* serve_usage() {
          "                           at most half the lease) [PENUMBRA_HEARTBEAT]\n"
          "  --max-attempts N         a task failing (or losing its lease) this often fails its\n"
          "                           job with the reason (default 3) [PENUMBRA_MAX_ATTEMPTS]\n"
+         "  --tile-pixels N          a frame of more pixels is split into tiles of about N\n"
+         "                           pixels, rendered by any workers and merged bit for bit\n"
+         "                           (default 65536: a 1024x1024 frame is 16 tiles)\n"
+         "                           [PENUMBRA_TILE_PIXELS]\n"
          "\n"
          "Durations: 90, 90s, 15m, 24h, 7d, 250ms.\n";
 }

@@ -71,6 +71,10 @@ struct ServerConfig {
   double lease_seconds = 30.0;     // a claimed task is the worker's this long past a heartbeat
   double heartbeat_seconds = 5.0;  // lease renewal, progress and the cancellation check
   int max_attempts = 3;            // a task that failed (or lost its lease) this often fails its job
+  // A still of more pixels than this is split into windows of about this many pixels, rendered
+  // as separate tasks and merged (docs/scale-out.md, "Tiles"): 256x256, so a 1024x1024 frame is
+  // 16 tiles, about 4 per worker of a 4-worker farm, which evens out slow and fast regions.
+  int64_t tile_pixels = 65536;
   bool farm() const { return !store.empty(); }
   bool renders() const { return role != "api"; }
   // The per-scene caps handed to the scene loader.

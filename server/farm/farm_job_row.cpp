@@ -7,7 +7,7 @@ namespace penumbra::server {
 const char* const kJobColumns =
     "id, seq, state, idempotency_key, created_at, started_at, finished_at, attempts, width, "
     "height, spp, samples_total, stats_json, error_json, warnings_json, priority, "
-    "cancel_requested, progress_json, result_token, version";
+    "cancel_requested, progress_json, result_token, version, frame_first, frame_last, frames_done";
 
 JobRecord job_from_row(const PgRows& rows, int row) {
   JobRecord r;
@@ -27,6 +27,9 @@ JobRecord job_from_row(const PgRows& rows, int row) {
   r.error_json = rows.value(row, "error_json");
   r.warnings_json = rows.value(row, "warnings_json");
   r.priority = int(rows.int_value(row, "priority"));
+  r.frame_first = int(rows.int_value(row, "frame_first"));
+  r.frame_last = int(rows.int_value(row, "frame_last"));
+  r.frames_done = int(rows.int_value(row, "frames_done"));
   return r;
 }
 

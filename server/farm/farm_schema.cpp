@@ -96,6 +96,20 @@ CREATE TABLE workers (
   tasks_failed bigint NOT NULL DEFAULT 0
 );
 )sql",
+    // 2: jobs of several tasks (docs/scale-out.md, "Tasks"). A frame split into windows: tasks of
+    // kind "tile" (params {"window": [x0, y0, x1, y1]}) and, once the last tile commits, one
+    // "merge"; an animation: one task of kind "frame" per frame (params {"frame": i}). Each task
+    // keeps the lease token of its committed attempt (its files' names), its last progress and
+    // its render statistics; a job counts its finished frames.
+    R"sql(
+ALTER TABLE jobs ADD COLUMN frame_first integer NOT NULL DEFAULT 0,
+  ADD COLUMN frame_last integer NOT NULL DEFAULT -1,
+  ADD COLUMN frames_done integer NOT NULL DEFAULT 0;
+ALTER TABLE tasks ADD COLUMN result_token text NOT NULL DEFAULT '',
+  ADD COLUMN progress_json text NOT NULL DEFAULT '',
+  ADD COLUMN stats_json text NOT NULL DEFAULT '';
+CREATE INDEX tasks_job_kind ON tasks (job_id, kind, state);
+)sql",
 };
 
 }  // namespace

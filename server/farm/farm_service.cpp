@@ -7,6 +7,7 @@
 
 #include "renderer/io/image_io.h"
 #include "server/farm/farm_job_row.h"
+#include "server/farm/farm_tasks.h"
 #include "server/jobs/submission_check.h"
 #include "server/jobs/unix_time.h"
 #include "server/storage/disk_space.h"
@@ -56,14 +57,15 @@ void FarmService::expire_now() {
   auto db = pool_.acquire();
   PgRows gone = db->exec(
       "DELETE FROM jobs WHERE state IN ('succeeded', 'failed', 'cancelled', 'deleted') AND "
-      "finished_at > 0 AND finished_at < $1 RETURNING id, result_token",
+      "finished_at > 0 AND finished_at < $1 RETURNING id",
       {seconds_text(unix_now() - config_.retention_seconds)});
   // Rows first, then files: a crash in between leaves files nobody serves, never a record
   // whose image is gone.
   for (int i = 0; i < gone.size(); ++i) {
     const std::string id = gone.value(i, "id");
-    const std::string token = gone.value(i, "result_token");
-    if (!token.empty()) results_.remove(id + "." + token);
+    // Every attempt's files: the result, a split job's tiles, an animation's frames, and those
+    // of attempts that lost their lease between writing and committing.
+    remove_job_files(config_.data_dir, id);
     events_.forget(id);
     if (assets_) assets_->remove_job_folder(id);
   }
@@ -137,6 +139,20 @@ SubmitOutcome FarmService::submit(std::string_view body, const std::string& idem
     o.kind = same ? SubmitOutcome::Kind::kReplayed : SubmitOutcome::Kind::kKeyReused;
     return o;
   };
+  // The job's tasks (farm_tasks.h): an animation's frames, a large still's tiles, or one task.
+  const JobShape shape = read_job_shape(prepared.scene_json, config_.scene_limits().max_json_depth);
+  std::vector<PixelWindow> tiles;
+  if (shape.frames) {
+    r.frame_first = int(shape.frames->first);
+    r.frame_last = int(shape.frames->second);
+    r.samples_total = uint64_t(r.width) * uint64_t(r.height) * uint64_t(r.spp) *
+                      uint64_t(r.frame_count());
+  } else if (shape.splittable) {
+    tiles = tile_windows(r.width, r.height, config_.tile_pixels);
+  }
+  nlohmann::json tile_params = nlohmann::json::array();
+  for (const PixelWindow& w : tiles)
+    tile_params.push_back(nlohmann::json::parse(task_params_json(TaskPiece{std::nullopt, w})));
   try {
     auto db = pool_.acquire();
     std::optional<SubmitOutcome> decided = db->transaction([&]() -> std::optional<SubmitOutcome> {
@@ -151,17 +167,29 @@ SubmitOutcome FarmService::submit(std::string_view body, const std::string& idem
       // ON CONFLICT: another API node inserted the same key since the check above.
       PgRows inserted = db->exec(
           "INSERT INTO jobs (id, state, idempotency_key, created_at, width, height, spp, "
-          "samples_total, warnings_json, priority, scene_json) VALUES ($1, 'queued', $2, $3, $4, "
-          "$5, $6, $7, $8, $9, $10) ON CONFLICT DO NOTHING RETURNING seq",
+          "samples_total, warnings_json, priority, scene_json, frame_first, frame_last) VALUES "
+          "($1, 'queued', $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12) ON CONFLICT DO NOTHING "
+          "RETURNING seq",
           {r.id, r.idempotency_key, std::to_string(r.created_at), param(r.width),
            param(r.height), param(r.spp), std::to_string(r.samples_total), r.warnings_json,
-           param(r.priority), prepared.scene_json});
+           param(r.priority), prepared.scene_json, param(r.frame_first), param(r.frame_last)});
       if (inserted.size() == 0) return existing_by_key(*db);
       r.seq = inserted.int_value(0, "seq");
-      db->exec(
-          "INSERT INTO tasks (job_id, kind, params, priority, job_seq) VALUES ($1, 'job', '{}', "
-          "$2, $3)",
-          {r.id, param(r.priority), param(r.seq)});
+      if (r.frame_count() > 0)
+        db->exec(
+            "INSERT INTO tasks (job_id, kind, params, priority, job_seq) SELECT $1, 'frame', "
+            "jsonb_build_object('frame', f), $2, $3 FROM generate_series($4::int, $5::int) f",
+            {r.id, param(r.priority), param(r.seq), param(r.frame_first), param(r.frame_last)});
+      else if (!tiles.empty())
+        db->exec(
+            "INSERT INTO tasks (job_id, kind, params, priority, job_seq) SELECT $1, 'tile', p, "
+            "$2, $3 FROM jsonb_array_elements($4::jsonb) WITH ORDINALITY AS t(p, n) ORDER BY n",
+            {r.id, param(r.priority), param(r.seq), tile_params.dump()});
+      else
+        db->exec(
+            "INSERT INTO tasks (job_id, kind, params, priority, job_seq) VALUES ($1, 'job', '{}', "
+            "$2, $3)",
+            {r.id, param(r.priority), param(r.seq)});
       // Delivered at commit: an idle worker wakes and claims it.
       db->exec(std::string("NOTIFY ") + kTaskChannel);
       return std::nullopt;
@@ -237,14 +265,12 @@ std::vector<JobView> FarmService::list_queued(std::optional<RunKey> after, int l
 
 DeleteOutcome FarmService::cancel_or_delete(const std::string& id, std::chrono::milliseconds wait) {
   enum class Found { kNothing, kTombstone, kFinished, kQueued, kRunning } found = Found::kNothing;
-  std::string result_token;
   {
     auto db = pool_.acquire();
     db->transaction([&] {
-      PgRows rows = db->exec("SELECT state, result_token FROM jobs WHERE id = $1 FOR UPDATE", {id});
+      PgRows rows = db->exec("SELECT state FROM jobs WHERE id = $1 FOR UPDATE", {id});
       if (rows.size() == 0) return;
       const auto state = job_state_from_string(rows.value(0, "state"));
-      result_token = rows.value(0, "result_token");
       const std::string now = std::to_string(unix_now());
       if (state == JobState::kDeleted) {
         found = Found::kTombstone;
@@ -262,9 +288,21 @@ DeleteOutcome FarmService::cancel_or_delete(const std::string& id, std::chrono::
         db->exec("UPDATE tasks SET state = 'cancelled' WHERE job_id = $1 AND state = 'queued'",
                  {id});
       } else {
-        // The worker sees it at its next heartbeat and stops.
+        // The workers see it at their next heartbeat and stop; tasks not yet claimed never run.
         found = Found::kRunning;
         db->exec("UPDATE jobs SET cancel_requested = true WHERE id = $1", {id});
+        db->exec("UPDATE tasks SET state = 'cancelled' WHERE job_id = $1 AND state = 'queued'",
+                 {id});
+        // No task under way (a split job between its last tile and its merge): nobody else
+        // will end it.
+        if (db->exec("SELECT 1 FROM tasks WHERE job_id = $1 AND state = 'running'", {id}).size() ==
+            0) {
+          found = Found::kQueued;
+          db->exec(
+              "UPDATE jobs SET state = 'cancelled', finished_at = $2, progress_json = '' WHERE "
+              "id = $1",
+              {id, now});
+        }
       }
     });
   }
@@ -274,7 +312,7 @@ DeleteOutcome FarmService::cancel_or_delete(const std::string& id, std::chrono::
     case Found::kTombstone:
       return DeleteOutcome::kDeleted;
     case Found::kFinished:
-      if (!result_token.empty()) results_.remove(id + "." + result_token);
+      remove_job_files(config_.data_dir, id);
       if (assets_) assets_->remove_job_folder(id);
       return DeleteOutcome::kDeleted;
     case Found::kQueued:
@@ -297,7 +335,7 @@ std::shared_ptr<const Image> FarmService::preview(const std::string& id) const {
   if (!is_valid_job_id(id)) return nullptr;
   const std::string path = farm_preview_path(config_.data_dir, id);
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) return nullptr;
+  if (!std::filesystem::is_regular_file(path, ec)) return tiles_preview(id);
   try {
     // Written whole (temporary name, rename) by the worker: a reader sees one image or none.
     return std::make_shared<const Image>(read_image_file(path));
@@ -306,17 +344,62 @@ std::shared_ptr<const Image> FarmService::preview(const std::string& id) const {
   }
 }
 
+std::shared_ptr<const Image> FarmService::tiles_preview(const std::string& id) const {
+  const auto tiles = tile_previews(config_.data_dir, id);
+  if (tiles.empty()) return nullptr;
+  int width = 0, height = 0;
+  try {
+    auto db = pool_.acquire();
+    PgRows rows = db->exec("SELECT width, height FROM jobs WHERE id = $1", {id});
+    if (rows.size() == 0) return nullptr;
+    width = int(rows.int_value(0, "width"));
+    height = int(rows.int_value(0, "height"));
+  } catch (const StoreError&) {
+    return nullptr;
+  }
+  // Tiles not started yet stay black; each tile's last preview is copied into its window.
+  auto frame = std::make_shared<Image>(width, height);
+  for (const auto& [w, path] : tiles) {
+    if (!w.fits(width, height)) continue;
+    Image part;
+    try {
+      part = read_image_file(path);
+    } catch (const std::exception&) {
+      continue;  // replaced or removed meanwhile
+    }
+    if (part.width != w.width() || part.height != w.height()) continue;
+    for (int y = 0; y < w.height(); ++y)
+      std::copy_n(part.rgb.begin() + std::size_t(y) * w.width() * 3, std::size_t(w.width()) * 3,
+                  frame->rgb.begin() + (std::size_t(w.y0 + y) * width + w.x0) * 3);
+  }
+  return frame;
+}
+
 std::optional<StoredResult> FarmService::open_result(const std::string& id,
                                                      const std::string& format,
                                                      std::optional<int> frame) const {
-  if (frame) return std::nullopt;  // frames of an animation: the farm's frame tasks (to come)
   std::string token;
   {
     auto db = pool_.acquire();
     PgRows rows = db->exec(
-        "SELECT result_token FROM jobs WHERE id = $1 AND state = 'succeeded'", {id});
+        "SELECT state, result_token, frame_first, frame_last FROM jobs WHERE id = $1", {id});
     if (rows.size() == 0) return std::nullopt;
-    token = rows.value(0, "result_token");
+    const int64_t first = rows.int_value(0, "frame_first"), last = rows.int_value(0, "frame_last");
+    if (last < first) {
+      // A still: its one result, once the job succeeded.
+      if (frame || rows.value(0, "state") != "succeeded") return std::nullopt;
+      token = rows.value(0, "result_token");
+    } else {
+      // An animation: each frame's committed task names its files, as soon as it is done.
+      const int64_t f = frame ? int64_t(*frame) : first;
+      if (f < first || f > last || rows.value(0, "state") == "deleted") return std::nullopt;
+      PgRows t = db->exec(
+          "SELECT result_token FROM tasks WHERE job_id = $1 AND kind = 'frame' AND state = "
+          "'done' AND params @> jsonb_build_object('frame', $2::int)",
+          {id, std::to_string(f)});
+      if (t.size() == 0) return std::nullopt;
+      token = t.value(0, "result_token");
+    }
   }
   if (token.empty()) return std::nullopt;
   // Only the committed attempt's files are ever served (farm_worker.cpp, the lease protocol).
@@ -416,7 +499,8 @@ nlohmann::json FarmService::workers() const {
       "extract(epoch FROM now() - w.heartbeat_at) AS heartbeat_age, "
       "w.tasks_succeeded, w.tasks_failed, "
       "coalesce((SELECT json_agg(json_build_object('task', t.id, 'kind', t.kind, 'job', t.job_id, "
-      "'attempt', t.attempts, 'lease_expires', extract(epoch FROM t.lease_expires))) FROM tasks t "
+      "'attempt', t.attempts, 'window', t.params->'window', 'frame', t.params->'frame', "
+      "'lease_expires', extract(epoch FROM t.lease_expires))) FROM tasks t "
       "WHERE t.state = 'running' AND t.lease_owner = w.id), '[]') AS current "
       "FROM workers w WHERE w.stopped_at IS NULL ORDER BY w.id");
   nlohmann::json all = nlohmann::json::array();

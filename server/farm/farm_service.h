@@ -57,6 +57,8 @@ class FarmService final : public JobBackend {
   nlohmann::json workers() const override;
 
  private:
+  // A split job's preview: the tiles' last previews (previews/<id>.w*.exr) placed in one frame.
+  std::shared_ptr<const Image> tiles_preview(const std::string& id) const;
   JobView make_view(const PgRows& rows, int row, PgConnection& db) const;
   void event_loop();
   // Erases finished jobs older than --retention (rows, result files, asset folders); any API

@@ -12,6 +12,7 @@
 #include <thread>
 #include <vector>
 
+#include "server/farm/farm_tasks.h"
 #include "server/farm/pg_connection.h"
 #include "server/jobs/job_runtime.h"
 #include "server/jobs/render_task.h"
@@ -37,6 +38,9 @@ class FarmWorker {
   struct Claim {
     int64_t task = 0;
     std::string job, token, scene;
+    std::string kind = "job";  // job, tile, frame, merge (farm_tasks.h)
+    TaskPiece piece;           // a tile's window, a frame's number
+    int width = 0, height = 0;  // the job's frame
     int attempt = 0;
   };
   void slot_loop();
@@ -44,6 +48,12 @@ class FarmWorker {
   int reap_expired(PgConnection& db);
   std::optional<Claim> claim(PgConnection& db);
   void run(PgConnection& db, const Claim& claim);
+  // A split frame's last step: the committed tiles merged (bit for bit the single-machine
+  // image), denoised if the job asks, stored as the job's result; RenderOutcome as a render's.
+  RenderOutcome merge_tiles(PgConnection& db, const Claim& claim, JobRuntime& runtime);
+  // The progress of a job of several tasks, from every task's last progress (tasks.progress_json)
+  // with this task's `mine`: samples over the whole job, elapsed since its first task started.
+  std::string job_progress_json(PgConnection& db, const Claim& claim, const RenderProgress& mine);
   // The heartbeat of one claim: renews the lease, writes progress, sees a cancellation.
   void heartbeat_loop(const Claim& claim, JobRuntime& runtime, std::atomic<bool>& done,
                       std::atomic<bool>& lease_lost);

@@ -103,12 +103,12 @@ nlohmann::ordered_json job_json(const JobView& v) {
   j["attempts"] = r.attempts;
   j["render"] = {{"width", r.width}, {"height", r.height}, {"spp", r.spp}};
   if (frame_count > 0) {
-    // The animation's frames (both ends rendered) and how many are finished, in order: frames
-    // first .. first + done - 1 are at /result?frame=N. While it renders, the frame under way
-    // and how far it is.
+    // The animation's frames (both ends rendered) and how many are finished (at
+    // /result?frame=N). While one node renders it, frame by frame in order, the frame under way
+    // and how far it is; a farm renders several frames at once, in any order: no single current.
     json frames = {{"first", r.frame_first}, {"last", r.frame_last}, {"done", r.frames_done}};
-    if (r.state == JobState::kRunning && r.frames_done < frame_count) {
-      frames["current"] = r.frame_first + r.frames_done;
+    if (v.current_frame) {
+      frames["current"] = *v.current_frame;
       frames["current_progress"] =
           v.progress ? std::clamp(v.progress->fraction * frame_count - r.frames_done, 0.0, 1.0)
                      : 0.0;

@@ -131,7 +131,9 @@ void get_result(const RouteContext& c, const httplib::Request& req, httplib::Res
                                         "is outside the animation's frames [" +
                                             std::to_string(r.frame_first) + ", " +
                                             std::to_string(r.frame_last) + "]"));
-    if (*frame < r.frame_first + r.frames_done) {
+    // Done is asked of the backend, not read off frames_done: a farm finishes frames in any
+    // order (one task each), one node in order. Every done frame has its PNG (result_files.h).
+    if (c.jobs.open_result(id, "png", frame)) {
       if (send_result(res, c.jobs, id, f, header_value(req, "Range"), which, frame)) return;
     } else if (wants_preview && state == JobState::kRunning && which.empty() &&
                *frame == r.frame_first + r.frames_done && send_preview(c, *v, f, res)) {
@@ -213,8 +215,12 @@ void get_frames_archive(const RouteContext& c, const httplib::Request& req,
   }
   const std::string key = which.empty() ? std::string(file_extension(f))
                                         : which + "." + file_extension(f);
+  // Succeeded: every frame. Otherwise the done ones, which on a farm need not be the first
+  // frames_done (frames finish in any order there).
   std::vector<int> frames;
-  for (int i = 0; i < r.frames_done; ++i) frames.push_back(r.frame_first + i);
+  for (int i = r.frame_first; i <= r.frame_last; ++i) {
+    if (r.state == JobState::kSucceeded || c.jobs.open_result(id, "png", i)) frames.push_back(i);
+  }
   auto plan = plan_frame_archive(c.jobs, id, key, frames, frame_digits(r.frame_first, r.frame_last),
                                  std::int64_t(r.finished_at));
   if (!plan) {

@@ -51,6 +51,9 @@ struct JobView {
   std::optional<RenderProgress> progress;     // while running
   std::optional<std::size_t> queue_position;  // while queued
   bool stop_requested = false;
+  // An animation whose frames render one at a time in order (one node): the frame under way is
+  // frame_first + frames_done. A farm renders several at once, in any order: nullopt.
+  std::optional<int> current_frame;
 };
 
 enum class DeleteOutcome {

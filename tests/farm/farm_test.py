@@ -9,7 +9,10 @@ runs again after its lease expires; the recovery time is printed), api_kill (kil
 node mid-request: retried with the same Idempotency-Key on the other, one job per key),
 postgres_restart (PostgreSQL restarted under load: nothing accepted is lost), cancel_running
 (a cancel reaches the worker at its heartbeat), max_attempts (a task that keeps failing fails
-its job with the reason). Exit 77 (ctest: skipped) without a PostgreSQL server, except with
+its job with the reason), and jobs of several tasks: split_frame (a 1024x1024 frame in 16 tiles
+over 3 workers equals `penumbra render` bit for bit), split_frame_worker_kill (the same with a
+worker killed mid-tile), split_progress_and_preview, split_cancel, split_denoise,
+split_retention, animation_frames (24 frames over 3 workers equal `penumbra render --frame i`). Exit 77 (ctest: skipped) without a PostgreSQL server, except with
 CI=true, where that is a failure.
 """
 import json
@@ -485,6 +488,324 @@ def test_retention(farm):
     print("retention: the job, its row and its files went after --retention 2s")
 
 
+# --- Jobs of several tasks: a large still split into tiles, an animation's frames ------------
+
+
+def big_scene(size=1024, spp=2, seed=7):
+    """The cornell box with every output layer: the merge must place beauty and layers."""
+    s = scene(size, size, spp, seed)
+    s["render"]["outputs"] = ["albedo", "normal", "depth"]
+    return s
+
+
+LOCAL_RENDERS = {}
+
+
+def render_locally(farm, scene_json, out, extra=()):
+    """The single-machine render of the same scene and seed (`penumbra render`, all cores: the
+    image does not depend on the thread count), kept for the next test that asks for it."""
+    key = json.dumps([scene_json, list(extra)], sort_keys=True)
+    if key in LOCAL_RENDERS and os.path.exists(LOCAL_RENDERS[key]):
+        shutil.copyfile(LOCAL_RENDERS[key], out)
+        return out
+    path = os.path.join(farm.work, "local-%d.json" % random.randrange(1 << 30))
+    with open(path, "w") as f:
+        json.dump(scene_json, f)
+    subprocess.check_call([farm.binary, "render", path, "-o", out, "-q", *extra],
+                          stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    kept = tempfile.mkstemp(prefix="penumbra-farm-local-", suffix=".exr")[1]
+    shutil.copyfile(out, kept)
+    LOCAL_RENDERS[key] = kept
+    return out
+
+
+def same_pixels(a, b, names_too=True):
+    """Decoded EXR pixels of every channel (beauty and layers) equal bit for bit: idiff with no
+    tolerance (which also refuses different channel counts), and the same channel names."""
+    names = []
+    for path in ((a, b) if names_too else ()):
+        info = subprocess.run(["oiiotool", "--info", "-v", path], capture_output=True,
+                              text=True).stdout
+        m = re.search(r"channel list: (.*)", info)
+        names.append(m.group(1).strip() if m else None)
+    if names_too and (names[0] is None or names[0] != names[1]):
+        return False
+    return subprocess.call(["idiff", "-fail", "0", "-warn", "0", a, b],
+                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL) == 0
+
+
+def fetch(base, path, out):
+    status, raw, _ = request(base, "GET", path, timeout=120)
+    check(status == 200, "GET %s answered %d: %s" % (path, status, raw[:200]))
+    with open(out, "wb") as f:
+        f.write(raw)
+    return out
+
+
+def tiles_by_worker(farm, job):
+    rows = farm.psql("SELECT a.worker, t.params->>'window' FROM task_attempts a JOIN tasks t ON "
+                     "t.id = a.task_id WHERE a.job_id = '%s' AND t.kind = 'tile' AND "
+                     "a.outcome = 'succeeded'" % job)
+    per = {}
+    for worker, window in rows:
+        per.setdefault(worker, []).append(window)
+    return per
+
+
+def split_job(farm, kill_one=False):
+    api = farm.start("api")
+    workers = [farm.start("worker") for _ in range(3)]
+    s = big_scene()
+    t0 = time.time()
+    job = submit(api["base"], s)
+    kinds = farm.psql("SELECT kind, count(*) FROM tasks WHERE job_id = '%s' GROUP BY kind" % job)
+    check(kinds == [["tile", "16"]], "a 1024x1024 frame is 16 tiles by default: %s" % kinds)
+    if kill_one:
+        # kill -9 of a worker while it renders a tile; a file of an attempt that never committed
+        # is planted beside the tiles: the merge must take only committed tokens.
+        deadline = time.time() + 60
+        owner = None
+        while time.time() < deadline and not owner:
+            rows = farm.psql("SELECT lease_owner FROM tasks WHERE job_id = '%s' AND kind = 'tile' "
+                             "AND state = 'running' LIMIT 1" % job)
+            owner = rows[0][0] if rows else None
+            time.sleep(0.05)
+        check(owner, "a tile started")
+        time.sleep(0.3)
+        pid = int(owner.split("-")[-2])
+        victim = [w for w in workers if w["proc"].pid == pid]
+        check(victim, "the owner is one of our workers")
+        victim[0]["proc"].send_signal(signal.SIGKILL)
+        with open(os.path.join(farm.data, "results", job + "." + "f" * 24 + ".tile.exr"), "wb") as f:
+            f.write(b"not an image: an orphan of a lost attempt")
+    states = wait_states(api["base"], [job], 600)
+    wall = time.time() - t0
+    check(states[job] == "succeeded", "the split job finished: %s" % states[job])
+    _, j = get_json(api["base"], "/v1/jobs/" + job)
+    farm_exr = fetch(api["base"], "/v1/jobs/%s/result?format=exr" % job,
+                     os.path.join(farm.work, "farm.exr"))
+    t1 = time.time()
+    local = render_locally(farm, s, os.path.join(farm.work, "local.exr"))
+    local_seconds = time.time() - t1
+    check(same_pixels(farm_exr, local), "the merged frame equals the single-machine render "
+          "bit for bit (beauty and layers)")
+    per = tiles_by_worker(farm, job)
+    check(sum(len(v) for v in per.values()) == 16, "16 tiles committed: %s" % per)
+    check(len(per) >= 2, "tiles rendered by at least 2 workers: %s" % list(per))
+    kinds = dict((k, n) for k, n in farm.psql(
+        "SELECT kind, count(*) FROM tasks WHERE job_id = '%s' AND state = 'done' GROUP BY kind" % job))
+    check(kinds == {"tile": "16", "merge": "1"}, "16 tiles and one merge done: %s" % kinds)
+    left = [f for f in result_files(farm) if f.endswith(".tile.exr") and f.startswith(job)]
+    check(left == ([job + "." + "f" * 24 + ".tile.exr"] if kill_one else []),
+          "the committed tiles' files are gone after the merge: %s" % left)
+    check(j["stats"].get("tasks") == 16, "the job's stats sum its tiles: %s" % j["stats"])
+    # Where the wall time went: tiles (first start to last end), the merge, from the attempt log.
+    (tiles_span, merge_span, tile_sum), = farm.psql(
+        "SELECT extract(epoch FROM max(a.ended_at) FILTER (WHERE t.kind = 'tile') - "
+        "min(a.started_at) FILTER (WHERE t.kind = 'tile')), extract(epoch FROM "
+        "max(a.ended_at) FILTER (WHERE t.kind = 'merge') - min(a.started_at) FILTER (WHERE "
+        "t.kind = 'merge')), extract(epoch FROM sum(a.ended_at - a.started_at) FILTER (WHERE "
+        "t.kind = 'tile' AND a.outcome = 'succeeded')) FROM task_attempts a JOIN tasks t ON "
+        "t.id = a.task_id WHERE a.job_id = '%s'" % job)
+    print("  tiles %.2f s (first start to last end; %.2f s of tile attempts summed), merge and "
+          "results %.2f s" % (float(tiles_span), float(tile_sum), float(merge_span)))
+    return job, wall, local_seconds, per
+
+
+def test_split_frame(farm):
+    job, wall, local_seconds, per = split_job(farm)
+    print("split_frame: 1024x1024, 16 tiles over 3 workers (1 thread each): %.1f s wall "
+          "(single machine, all cores: %.1f s); tiles per worker %s; bit-identical"
+          % (wall, local_seconds, sorted(len(v) for v in per.values())))
+
+
+def test_split_frame_worker_kill(farm):
+    job, wall, local_seconds, per = split_job(farm, kill_one=True)
+    outcomes = sorted(set(r[0] for r in farm.psql(
+        "SELECT outcome FROM task_attempts WHERE job_id = '%s'" % job)))
+    check("lease_expired" in outcomes, "the killed worker's tile expired: %s" % outcomes)
+    print("split_frame_worker_kill: a worker killed mid-tile; the tile ran again; %.1f s wall; "
+          "bit-identical" % wall)
+
+
+def test_split_progress_and_preview(farm):
+    # Progress of a split job counts samples over all its tiles; the preview places the tiles'
+    # previews in one frame; /v1/workers names each worker's tile.
+    api = farm.start("api")
+    farm.start("worker")
+    farm.start("worker")
+    job = submit(api["base"], scene(512, 512, 1 << 12))
+    deadline = time.time() + 60
+    seen_windows, fractions, preview = set(), [], None
+    while time.time() < deadline and (len(fractions) < 3 or preview is None or not seen_windows):
+        _, w = get_json(api["base"], "/v1/workers")
+        for worker in w["workers"]:
+            for t in worker["current_tasks"]:
+                if t["kind"] == "tile" and t.get("window"):
+                    seen_windows.add(tuple(t["window"]))
+        _, j = get_json(api["base"], "/v1/jobs/" + job)
+        if j and j["state"] == "running" and j["progress"] and j["eta_seconds"] is not None:
+            fractions.append(j["progress"])
+        status, raw, _ = request(api["base"], "GET", "/v1/jobs/%s/result?preview=true&format=exr" % job)
+        if status == 200:
+            preview = raw
+        time.sleep(0.3)
+    request(api["base"], "DELETE", "/v1/jobs/" + job)
+    check(seen_windows, "/v1/workers shows the tiles' windows")
+    check(len(fractions) >= 2 and fractions[-1] > fractions[0] and 0 < fractions[-1] < 1,
+          "the progress of the split job grows: %s" % fractions)
+    check(preview is not None, "a preview of the split job")
+    path = os.path.join(farm.work, "preview.exr")
+    with open(path, "wb") as f:
+        f.write(preview)
+    info = subprocess.run(["oiiotool", "--info", path], capture_output=True, text=True).stdout
+    check("512 x  512" in info or "512 x 512" in info, "the preview is the whole frame: %s" % info)
+    print("split_progress_and_preview: windows %s; fractions %s"
+          % (sorted(seen_windows)[:3], ["%.3f" % f for f in fractions[:4]]))
+
+
+def test_split_cancel(farm):
+    # DELETE of a running split job: every tile stops or never starts, no merge.
+    api = farm.start("api")
+    farm.start("worker")
+    farm.start("worker")
+    job = submit(api["base"], scene(512, 512, 1 << 14))
+    deadline = time.time() + 60
+    while time.time() < deadline:
+        if int(farm.psql("SELECT count(*) FROM tasks WHERE job_id = '%s' AND state = 'running'"
+                         % job)[0][0]) == 2:
+            break
+        time.sleep(0.05)
+    t0 = time.time()
+    status, _, _ = request(api["base"], "DELETE", "/v1/jobs/" + job)
+    check(status in (200, 202, 204), "cancel answered %d" % status)
+    states = wait_states(api["base"], [job], 30)
+    check(states[job] == "cancelled", "cancelled: %s" % states[job])
+    deadline = time.time() + 10
+    while time.time() < deadline:
+        live = farm.psql("SELECT state, count(*) FROM tasks WHERE job_id = '%s' GROUP BY state"
+                         % job)
+        if all(s in ("cancelled",) for s, _ in live):
+            break
+        time.sleep(0.1)
+    check(all(s == "cancelled" for s, _ in live), "every tile cancelled: %s" % live)
+    # Only the two tiles under way at the DELETE ever started: the others never ran.
+    attempts = farm.psql("SELECT count(*) FROM task_attempts WHERE job_id = '%s'" % job)
+    check(attempts == [["2"]], "no tile started after the cancel: %s attempts" % attempts)
+    time.sleep(farm.heartbeat * 2)
+    check(farm.psql("SELECT count(*) FROM tasks WHERE job_id = '%s' AND kind = 'merge'" % job)
+          == [["0"]], "no merge")
+    _, w = get_json(api["base"], "/v1/workers")
+    check(all(not x["current_tasks"] for x in w["workers"]), "the workers are idle: %s" % w)
+    print("split_cancel: 16 tiles cancelled %.2f s after DELETE" % (time.time() - t0))
+
+
+def test_split_denoise(farm):
+    # A split job that asks for denoising: the tiles render the guides, the merge denoises the
+    # whole frame (a window cannot be denoised alone); the result equals `penumbra render` of the
+    # scene, denoised image, kept "noisy" layer and requested layers. --tile-pixels is the API
+    # node's: a 128x128 frame in 4 tiles.
+    api = farm.start("api", ["--tile-pixels", "4096"])
+    farm.start("worker")
+    farm.start("worker")
+    s = scene(128, 128, 4, 5)
+    s["render"]["denoise"] = True
+    s["render"]["outputs"] = ["depth"]
+    job = submit(api["base"], s)
+    check(farm.psql("SELECT kind, count(*) FROM tasks WHERE job_id = '%s' GROUP BY kind" % job)
+          == [["tile", "4"]], "4 tiles")
+    check(wait_states(api["base"], [job], 120)[job] == "succeeded", "rendered")
+    _, j = get_json(api["base"], "/v1/jobs/" + job)
+    a = fetch(api["base"], "/v1/jobs/%s/result?format=exr" % job, os.path.join(farm.work, "d.exr"))
+    b = render_locally(farm, s, os.path.join(farm.work, "dl.exr"))
+    check(same_pixels(a, b), "the denoised merge equals the single-machine denoised render")
+    print("split_denoise: 4 tiles merged then denoised (denoised: %s) == penumbra render"
+          % j["stats"].get("denoised"))
+
+
+def test_split_retention(farm):
+    # A split job expires with every file of it: the result, and a tile file of an attempt that
+    # never committed (planted: what a worker killed between writing and committing leaves).
+    api = farm.start("api", ["--retention", "2s", "--tile-pixels", "4096"])
+    farm.start("worker")
+    job = submit(api["base"], scene(128, 128, 2))
+    orphan = os.path.join(farm.data, "results", job + "." + "e" * 24 + ".tile.exr")
+    with open(orphan, "wb") as f:
+        f.write(b"left by a lost attempt")
+    check(wait_states(api["base"], [job], 60)[job] == "succeeded", "rendered")
+    deadline = time.time() + 10
+    status = 200
+    while time.time() < deadline and status != 404:
+        status, _ = get_json(api["base"], "/v1/jobs/" + job)
+        time.sleep(0.2)
+    check(status == 404, "expired: %d" % status)
+    left = [f for d in ("results", "previews") for f in os.listdir(os.path.join(farm.data, d))
+            if f.startswith(job)]
+    check(not left, "every file of the job is gone: %s" % left)
+    print("split_retention: the split job's result and an orphan tile file went with it")
+
+
+def animation_scene(frames=24):
+    with open(os.path.join(REPO, "scenes", "motion_blur.json")) as f:
+        s = json.load(f)
+    s["camera"].pop("shutter", None)
+    s["animation"] = {"frames": [1, frames], "fps": 24, "shutter": 0.5}
+    s["render"].update({"width": 32, "height": 32, "spp": 4, "seed": 3,
+                        "outputs": ["albedo", "depth"]})
+    return s
+
+
+def test_animation_frames(farm):
+    api = farm.start("api")
+    workers = [farm.start("worker") for _ in range(3)]
+    s = animation_scene()
+    t0 = time.time()
+    job = submit(api["base"], s)
+    check(farm.psql("SELECT count(*), min((params->>'frame')::int), max((params->>'frame')::int) "
+                    "FROM tasks WHERE job_id = '%s' AND kind = 'frame'" % job) == [["24", "1", "24"]],
+          "one task per frame")
+    states = wait_states(api["base"], [job], 300)
+    check(states[job] == "succeeded", "the animation finished: %s" % states[job])
+    wall = time.time() - t0
+    check(farm.psql("SELECT frame_first, frame_last, frames_done FROM jobs WHERE id = '%s'" % job)
+          == [["1", "24", "24"]], "frames counted")
+    tokens = dict((int(f), t) for f, t in farm.psql(
+        "SELECT params->>'frame', result_token FROM tasks WHERE job_id = '%s' AND kind = 'frame' "
+        "AND state = 'done'" % job))
+    per_worker = farm.psql("SELECT count(DISTINCT worker) FROM task_attempts WHERE job_id = '%s' "
+                           "AND outcome = 'succeeded'" % job)[0][0]
+    check(int(per_worker) >= 2, "frames rendered by several workers: %s" % per_worker)
+    # The /result?frame= route is the "anim" branch's; the files the backend serves for each
+    # frame (open_result: the committed task's token) are compared here.
+    path = os.path.join(farm.work, "anim.json")
+    with open(path, "w") as f:
+        json.dump(s, f)
+    bad = []
+
+    def compare(i):
+        local = os.path.join(farm.work, "frame%d.exr" % i)
+        subprocess.check_call([farm.binary, "render", path, "--frame", str(i), "-o", local, "-q",
+                               "--threads", "1"], stdout=subprocess.DEVNULL,
+                              stderr=subprocess.DEVNULL)
+        served = os.path.join(farm.data, "results", "%s.%s.exr" % (job, tokens[i]))
+        # The channel names of every frame are the same task's writing; checked on the first.
+        if not same_pixels(served, local, names_too=i == 1):
+            bad.append(i)
+
+    # Four single renders at a time (each its own process, one thread), to keep the label short.
+    from concurrent.futures import ThreadPoolExecutor
+    with ThreadPoolExecutor(4) as pool:
+        list(pool.map(compare, range(1, 25)))
+    bad.sort()
+    check(not bad, "frames equal to `penumbra render --frame i`: differ %s" % bad)
+    # Without a frame, the job's result is its first frame.
+    first = fetch(api["base"], "/v1/jobs/%s/result?format=exr" % job,
+                  os.path.join(farm.work, "first.exr"))
+    check(same_pixels(first, os.path.join(farm.work, "frame1.exr")), "the result is frame 1")
+    print("animation_frames: 24 frames over 3 workers in %.1f s, each bit-identical to "
+          "penumbra render --frame i" % wall)
+
+
 TESTS = {
     "retention": (test_retention, {}),
     "events_stream": (test_events_stream, {}),
@@ -495,6 +816,13 @@ TESTS = {
     "postgres_restart": (test_postgres_restart, {"lease": 10.0, "heartbeat": 1.0}),
     "cancel_running": (test_cancel_running, {}),
     "max_attempts": (test_max_attempts, {"lease": 2.0, "heartbeat": 0.5, "max_attempts": 2}),
+    "split_frame": (test_split_frame, {}),
+    "split_frame_worker_kill": (test_split_frame_worker_kill, {"lease": 3.0, "heartbeat": 0.5}),
+    "split_progress_and_preview": (test_split_progress_and_preview, {}),
+    "split_cancel": (test_split_cancel, {}),
+    "split_denoise": (test_split_denoise, {}),
+    "split_retention": (test_split_retention, {}),
+    "animation_frames": (test_animation_frames, {}),
 }
 
 
@@ -512,9 +840,10 @@ def main():
     for name in names:
         fn, kw = TESTS[name]
         farm = Farm(binary, **kw)
+        t0 = time.time()
         try:
             fn(farm)
-            print("PASS", name)
+            print("PASS %s (%.1f s)" % (name, time.time() - t0))
         except Exception as e:  # noqa: BLE001 - report and go on to the next test
             print("FAIL", name, "-", e)
             for n in farm.procs:
@@ -523,6 +852,8 @@ def main():
             os.environ["PENUMBRA_KEEP_FARM"] = "1"  # the logs of a failure are kept
         finally:
             farm.close()
+    for kept in LOCAL_RENDERS.values():
+        os.unlink(kept)
     print("farm_test: %d passed, %d failed %s" % (len(names) - len(failed), len(failed), failed))
     return 1 if failed else 0
 
