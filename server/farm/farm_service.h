@@ -55,6 +55,7 @@ class FarmService final : public JobBackend {
   Metrics::Gauges gauges() const override;
   double retry_after_for_queue() const override { return 5; }
   nlohmann::json workers() const override;
+  bool frames_in_order() const override { return false; }
 
  private:
   // A split job's preview: the tiles' last previews (previews/<id>.w*.exr) placed in one frame.

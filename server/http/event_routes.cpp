@@ -139,7 +139,10 @@ bool pump(Stream& st, httplib::DataSink& sink) {
     std::string text;
     bool final = false;
     for (const JobEvent& e : events.after(st.id, st.last_sent)) {
-      text += event_text(e.id, JobView{e.record, e.progress, e.queue_position, false});
+      text += event_text(e.id, JobView{e.record, e.progress, e.queue_position, false,
+                                       st.jobs.frames_in_order()
+                                           ? in_order_current_frame(e.record)
+                                           : std::nullopt});
       st.last_sent = e.id;
       if (is_finished(e.record.state)) {
         final = true;

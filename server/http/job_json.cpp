@@ -48,7 +48,7 @@ std::string webhook_body(const JobRecord& r) {
   JobRecord copy = r;
   const std::string url = copy.notify.url;
   copy.notify = {};
-  nlohmann::ordered_json j = job_json(JobView{copy, std::nullopt, std::nullopt, false});
+  nlohmann::ordered_json j = job_json(JobView{copy, std::nullopt, std::nullopt, false, std::nullopt});
   j["notify"] = {{"url", url}};
   return j.dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace);
 }

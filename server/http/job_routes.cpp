@@ -37,7 +37,7 @@ void submit(const RouteContext& c, const httplib::Request& req, httplib::Respons
     return send_problem(res, req, *p);
   }
   const auto view = c.jobs.view(o.record.id);
-  const JobView v = view ? *view : JobView{o.record, std::nullopt, std::nullopt, false};
+  const JobView v = view ? *view : JobView{o.record, std::nullopt, std::nullopt, false, std::nullopt};
   if (o.kind == SubmitOutcome::Kind::kReplayed) res.set_header("Idempotent-Replayed", "true");
   res.set_header("Location", job_path(o.record.id));
   res.set_header("Retry-After", "1");

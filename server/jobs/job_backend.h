@@ -56,6 +56,12 @@ struct JobView {
   std::optional<int> current_frame;
 };
 
+// The frame under way of a running animation whose frames render in order (see JobView).
+inline std::optional<int> in_order_current_frame(const JobRecord& r) {
+  if (r.state != JobState::kRunning || r.frames_done >= r.frame_count()) return std::nullopt;
+  return r.frame_first + r.frames_done;
+}
+
 enum class DeleteOutcome {
   kNotFound,    // never existed (or expired)
   kCancelled,   // was queued or running, now cancelled
@@ -105,6 +111,9 @@ class JobBackend {
   virtual double retry_after_for_queue() const = 0;
   // GET /v1/workers: the render workers, their heartbeats and current tasks (a JSON array).
   virtual nlohmann::json workers() const = 0;
+  // True when an animation's frames render one at a time, in order (one node); a farm renders
+  // them at once on several workers.
+  virtual bool frames_in_order() const = 0;
 };
 
 }  // namespace penumbra::server

@@ -214,9 +214,7 @@ JobView JobService::make_view(JobEntry entry) const {
   v.record = std::move(entry.record);
   if (v.record.state == JobState::kQueued) v.queue_position = queue_.position(v.record.id);
   if (v.record.state == JobState::kRunning && entry.runtime) v.progress = entry.runtime->progress();
-  const JobRecord& r = v.record;
-  if (r.state == JobState::kRunning && r.frames_done < r.frame_count())
-    v.current_frame = r.frame_first + r.frames_done;
+  v.current_frame = in_order_current_frame(v.record);
   return v;
 }
 

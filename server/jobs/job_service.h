@@ -75,6 +75,7 @@ class JobService final : public JobBackend {
   AssetStore* assets() const override { return assets_; }
   // One node: its own render threads are its only worker.
   nlohmann::json workers() const override;
+  bool frames_in_order() const override { return true; }
   // False while the data directory has less than --min-free-space available (/readyz).
   bool storage_ok() const override;
   // Stops taking jobs; running renders are put back in the queue, except one that will be done
