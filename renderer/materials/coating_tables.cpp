@@ -175,6 +175,7 @@ CoatingTables::CoatingTables() { ++g_alive; }
 CoatingTables::~CoatingTables() { --g_alive; }
 CoatingTables::CoatingTables(const CoatingTables& o)
     : nodes(o.nodes),
+      square_nodes(o.square_nodes),
       cosines(o.cosines),
       transmittance(o.transmittance),
       internal_reflectance(o.internal_reflectance),

@@ -69,6 +69,9 @@ TEST(CoatingTables, SquareNodeIntervalsAreTheBisections) {
   }
   // Adaptive nodes (ior below 1) are never square.
   EXPECT_FALSE(make_coating_tables(false, GgxDistribution(0.3f), 0.7f).square_nodes);
+  // What plastics read: the scene's cached copy, which must keep the shortcut.
+  CoatingTableCache cache;
+  EXPECT_TRUE(cache.get(false, GgxDistribution(0.3f), 1.5f).square_nodes);
 }
 
 }  // namespace
