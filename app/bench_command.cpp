@@ -8,6 +8,7 @@
 #include "app/commands.h"
 #include "app/option_parsing.h"
 #include "renderer/render/embree_baseline.h"
+#include "renderer/render/embree_ray_forms.h"
 #include "renderer/render/render.h"
 
 namespace penumbra::app {
@@ -18,13 +19,37 @@ const char* kUsage =
     "\n"
     "Renders the scene with the path integrator and traces the same kind of rays with Embree\n"
     "alone (camera, shadow and bounce rays, no shading), alternating the two REPEAT times, and\n"
-    "prints both rays/s and their ratio (median of the runs). Default scene: scenes/cornell_box.json.\n"
+    "prints both rays/s and their ratio (median of the runs). Then the same scene's camera rays,\n"
+    "their shadow rays and their bounce rays, pre-generated, traced by Embree alone one by one,\n"
+    "in 16-wide packets and as streams (best of REPEAT), as a table with the renderer's median\n"
+    "rays/s against each. Default scene: scenes/cornell_box.json.\n"
     "  --repeat N      alternating runs of each (default 5)\n"
     "  --spp, --width, --height, --threads, --max-depth, --seed ...   as for render\n";
 
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v.empty() ? 0.0 : v[v.size() / 2];
+}
+
+// One row per kind of ray, one column pair per Embree calling form: Mrays/s and the renderer's
+// median rays/s as a fraction of it.
+void print_ray_forms(const std::vector<RayFormResult>& results, double renderer_mrays) {
+  std::printf("\nEmbree alone on pre-generated rays (best of the runs; ratio = renderer / this):\n");
+  std::printf("| rays | count | single (rtc*1) Mrays/s | ratio | packet (rtc*16) Mrays/s | ratio | stream (rtc*1M) Mrays/s | ratio |\n");
+  std::printf("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
+  for (size_t i = 0; i + 2 < results.size(); i += 3) {
+    std::printf("| %s | %llu", ray_kind_name(results[i].kind), (unsigned long long)results[i].rays);
+    for (size_t j = i; j < i + 3; ++j) {
+      const double m = results[j].mrays_per_second();
+      std::printf(" | %.2f | %.3f", m, m > 0 ? renderer_mrays / m : 0.0);
+    }
+    std::printf(" |\n");
+    // The forms must agree on what they hit; a mismatch would make the rates incomparable.
+    if (results[i].hits != results[i + 1].hits || results[i].hits != results[i + 2].hits)
+      std::printf("warning: %s rays: hits differ between forms (%llu, %llu, %llu)\n", ray_kind_name(results[i].kind),
+                  (unsigned long long)results[i].hits, (unsigned long long)results[i + 1].hits,
+                  (unsigned long long)results[i + 2].hits);
+  }
 }
 
 }  // namespace
@@ -79,6 +104,7 @@ int run_bench(int argc, char** argv) {
               settings.threads > 0 ? std::to_string(settings.threads).c_str() : "all");
   std::printf("median: renderer %.2f Mrays/s, embree-only %.2f Mrays/s, ratio %.3f\n",
               median(renderer_mrays), median(embree_mrays), median(ratios));
+  print_ray_forms(trace_embree_ray_forms(*scene, settings, int(repeat)), median(renderer_mrays));
   return 0;
 }
 

@@ -151,6 +151,7 @@ CoatingTables rough_coating_tables(const GgxDistribution& distr, float eta) {
   // matches it. That mean underestimates the average by about (fdr_int - R_int(1)) / 64, so the
   // rough plastic returns less light than the smooth one, not more (docs/design-notes.md).
   tables.nodes = n;
+  tables.square_nodes = true;
   const std::array<float, n> nodes = grazing_nodes();
   std::copy(nodes.begin(), nodes.end(), tables.cosines.begin());
   std::array<double, n> internal{};
@@ -174,6 +175,7 @@ CoatingTables::CoatingTables() { ++g_alive; }
 CoatingTables::~CoatingTables() { --g_alive; }
 CoatingTables::CoatingTables(const CoatingTables& o)
     : nodes(o.nodes),
+      square_nodes(o.square_nodes),
       cosines(o.cosines),
       transmittance(o.transmittance),
       internal_reflectance(o.internal_reflectance),

@@ -45,8 +45,7 @@ float PlasticBsdf::external_transmittance(float cos_theta) const {
   // Linear interpolation between the table's nodes.
   const float mu = std::clamp(cos_theta, 0.f, 1.f);
   const float* cosines = tables_->cosines.data();
-  const float* upper = std::upper_bound(cosines + 1, cosines + tables_->nodes - 1, mu);
-  const int i = int(upper - cosines) - 1;
+  const int i = tables_->interval(mu);
   // Nodes coincide where the critical cosine rounds to 1 (ior < ~3e-4).
   const float width = cosines[i + 1] - cosines[i];
   const float w = width > 0.f ? (mu - cosines[i]) / width : 1.f;

@@ -17,7 +17,7 @@ inline uint32_t reverse_bits32(uint32_t x) {
 }
 
 // 64-bit finaliser of SplitMix64 (Steele et al. 2014); used to derive independent seeds.
-inline uint64_t mix64(uint64_t x) {
+constexpr uint64_t mix64(uint64_t x) {
   x ^= x >> 30;
   x *= 0xbf58476d1ce4e5b9ull;
   x ^= x >> 27;
@@ -25,7 +25,8 @@ inline uint64_t mix64(uint64_t x) {
   x ^= x >> 31;
   return x;
 }
-inline uint64_t hash_combine(uint64_t a, uint64_t b) { return mix64(a ^ (mix64(b) + 0x9e3779b97f4a7c15ull)); }
+inline constexpr uint64_t kGoldenGamma = 0x9e3779b97f4a7c15ull;
+inline uint64_t hash_combine(uint64_t a, uint64_t b) { return mix64(a ^ (mix64(b) + kGoldenGamma)); }
 
 // Laine-Karras style permutation (only lower bits influence higher ones), with the constants
 // proposed by N. Vegdahl (2021) as an improvement on Burley's. Applied to bit-reversed values it
@@ -69,6 +70,17 @@ inline uint32_t sobol_dimension1(uint32_t index) {
 
 inline float fixed_to_unit_float(uint32_t x) { return float(x >> 8) * 0x1p-24f; }
 
+// hash_combine(seed, d)'s hash of d for the dimensions the sampler caches: one of its two mixes,
+// done at compile time (each pixel's first sample of a pass hashes every dimension it uses).
+struct SamplerDimensionKeys {
+  static constexpr uint64_t kCount = 64;
+  uint64_t key[kCount];
+  constexpr SamplerDimensionKeys() : key() {
+    for (uint64_t d = 0; d < kCount; ++d) key[d] = mix64(d) + kGoldenGamma;
+  }
+};
+inline constexpr SamplerDimensionKeys kSamplerDimensionKeys{};
+
 class Sampler {
  public:
   explicit Sampler(uint64_t seed) : seed_(mix64(seed + 0x51ed270b27c3a4f1ull)) {}
@@ -105,13 +117,13 @@ class Sampler {
   struct DimensionSeeds {
     uint64_t a, b;
   };
-  static constexpr uint64_t kCachedDimensions = 64;
+  static constexpr uint64_t kCachedDimensions = SamplerDimensionKeys::kCount;
 
   const DimensionSeeds& seeds(uint64_t dimension) {
     if (dimension < kCachedDimensions) {
       DimensionSeeds& s = cache_[dimension];
       if (!((cached_ >> dimension) & 1u)) {
-        s.a = hash_combine(pixel_seed_, dimension);
+        s.a = mix64(pixel_seed_ ^ kSamplerDimensionKeys.key[dimension]);  // = hash_combine(pixel_seed_, dimension)
         s.b = mix64(s.a);
         cached_ |= uint64_t(1) << dimension;
       }

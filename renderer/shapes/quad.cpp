@@ -25,7 +25,8 @@ ShapeContext triangles_context(ShapeContext ctx) {
 
 Quad::Quad(const QuadDesc& desc, const ShapeContext& ctx)
     : TriangleMesh(two_triangles(moved(desc, ctx.offset)), triangles_context(ctx)),
-      quad_(moved(desc, ctx.offset)) {
+      quad_(moved(desc, ctx.offset)),
+      normal_(glm::normalize(glm::cross(quad_.u, quad_.v))) {
   set_area(glm::length(glm::cross(desc.u, desc.v)));
 }
 
@@ -35,7 +36,7 @@ bool Quad::sample(const vec3& ref, float time, const vec2& u, ShapeSample* out) 
   out->p = o + su + sv;
   // Three products and two sums per coordinate, rounded once each (pbrt-v4 section 6.8.1).
   out->p_error = gamma_bound(6) * (glm::abs(o) + glm::abs(su) + glm::abs(sv));
-  out->n = glm::normalize(glm::cross(quad_.u, quad_.v));
+  out->n = normal_;
   out->uv = u;
   out->pdf = area_to_solid_angle(ref, out->p, out->n, area());
   return true;

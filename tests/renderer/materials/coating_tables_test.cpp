@@ -2,6 +2,9 @@
 // it: a long-running service that renders many distinct plastics does not grow.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <vector>
+
 #include "renderer/materials/coating_tables.h"
 #include "renderer/materials/plastic.h"
 #include "tests/renderer/render/render_test_util.h"
@@ -45,6 +48,30 @@ TEST(CoatingTables, SharedWithinABuild) {
   const vec3 wi = glm::normalize(vec3(0.3f, 0.1f, 0.9f)), wo = glm::normalize(vec3(-0.4f, 0.2f, 0.8f));
   EXPECT_EQ(ma.eval(BsdfContext{}, wi, wo), alone.eval(BsdfContext{}, wi, wo));
   EXPECT_NE(ma.eval(BsdfContext{}, wi, wo), mc.eval(BsdfContext{}, wi, wo));
+}
+
+// The interval lookup of square nodes (a guess from sqrt(mu), then corrected) answers what the
+// bisection over the stored nodes answers, at the nodes themselves, next to them and between.
+TEST(CoatingTables, SquareNodeIntervalsAreTheBisections) {
+  const CoatingTables tables = make_coating_tables(false, GgxDistribution(0.3f), 1.5f);
+  ASSERT_TRUE(tables.square_nodes);
+  CoatingTables bisected = tables;
+  bisected.square_nodes = false;
+  std::vector<float> mus = {0.f, 1.f, 0.5f, 1e-9f};
+  for (int i = 0; i < tables.nodes; ++i) {
+    const float c = tables.cosines[i];
+    mus.insert(mus.end(), {c, std::nextafter(c, 0.f), std::nextafter(c, 2.f)});
+  }
+  for (int k = 0; k <= 100000; ++k) mus.push_back(float(k) / 100000.f);
+  for (float mu : mus) {
+    if (mu < 0.f || mu > 1.f) continue;
+    ASSERT_EQ(tables.interval(mu), bisected.interval(mu)) << mu;
+  }
+  // Adaptive nodes (ior below 1) are never square.
+  EXPECT_FALSE(make_coating_tables(false, GgxDistribution(0.3f), 0.7f).square_nodes);
+  // What plastics read: the scene's cached copy, which must keep the shortcut.
+  CoatingTableCache cache;
+  EXPECT_TRUE(cache.get(false, GgxDistribution(0.3f), 1.5f).square_nodes);
 }
 
 }  // namespace

@@ -89,5 +89,13 @@ TEST(Sampler, TableDrivenSobolMatchesBitLoop) {
   EXPECT_EQ(nested_uniform_scramble(sobol_dimension0(77u), 991u),
             reverse_bits32(laine_karras_permutation(77u, 991u)));
 }
+
+// The compile-time keys of the cached dimensions are hash_combine's hash of the dimension, so
+// cached dimensions get the seeds the uncached ones (64 and up) get from hash_combine itself.
+TEST(Sampler, DimensionKeysAreHashCombines) {
+  for (uint64_t seed : {0ull, 1ull, 0x0123456789abcdefull})
+    for (uint64_t d = 0; d < SamplerDimensionKeys::kCount; ++d)
+      ASSERT_EQ(mix64(seed ^ kSamplerDimensionKeys.key[d]), hash_combine(seed, d)) << d;
+}
 }  // namespace
 }  // namespace penumbra::test

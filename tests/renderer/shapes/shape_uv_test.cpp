@@ -34,10 +34,15 @@ SurfaceHit hit_from_above(const ShapeDesc& desc, const vec3& target, bool need_u
 
 TEST(ShapeUv, QuadUvIsSAndT) {
   const QuadDesc q{vec3(1.f, 2.f, 0.f), vec3(2.f, 0.f, 0.f), vec3(0.5f, 1.f, 0.f)};
-  for (const vec2 st : {vec2(0.25f, 0.75f), vec2(0.8f, 0.1f), vec2(0.5f, 0.5f)}) {
-    const SurfaceHit h = hit_from_above(q, q.origin + st.x * q.u + st.y * q.v);
+  // Points in both triangles of Embree's split of the quad (s + t < 1 and > 1) and on its
+  // diagonal: the hit point rebuilt from the hit's triangle is the point aimed at.
+  for (const vec2 st : {vec2(0.25f, 0.75f), vec2(0.8f, 0.1f), vec2(0.5f, 0.5f), vec2(0.9f, 0.7f),
+                        vec2(0.3f, 0.95f)}) {
+    const vec3 target = q.origin + st.x * q.u + st.y * q.v;
+    const SurfaceHit h = hit_from_above(q, target);
     EXPECT_NEAR(h.uv.x, st.x, 1e-5f);
     EXPECT_NEAR(h.uv.y, st.y, 1e-5f);
+    EXPECT_NEAR(glm::length(h.p - target), 0.f, 1e-5f);
   }
 }
 

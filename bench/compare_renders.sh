@@ -1,0 +1,42 @@
+#!/usr/bin/env bash
+# Render seconds (the summary line's render phase, scene build excluded) and CPU seconds (user +
+# system of the whole process) of penumbra binaries side by side: every repeat renders each scene
+# with each binary in turn, so a shared machine's load falls evenly on all of them; prints the
+# medians per scene and binary and their ratios to the first binary. On a loaded machine the
+# CPU seconds of one-thread renders (ARGS="--threads 1") are the steadier figure: wall time then
+# mostly measures the scheduler. A binary may be given as ENV=VALUE:PATH to run it with one
+# environment variable set. From the repository root:
+#   bench/compare_renders.sh "SCENE..." BINARY [BINARY...]      (REPEAT=5, extra render flags in ARGS)
+set -euo pipefail
+scenes=$1; shift
+repeat=${REPEAT:-5}
+read -r -a extra <<<"${ARGS:-}"
+out=$(mktemp -d)
+trap 'rm -rf "$out"' EXIT
+median() { sort -g | awk '{a[NR]=$1} END {print (NR % 2) ? a[(NR+1)/2] : (a[NR/2] + a[NR/2+1]) / 2}'; }
+printf '| scene | binary | render s (median of %s) | / first | CPU s | / first |\n| --- | --- | ---: | ---: | ---: | ---: |\n' "$repeat"
+for scene in $scenes; do
+  name=$(basename "$scene" .json)
+  for ((r = 0; r < repeat; ++r)); do
+    i=0
+    for bin in "$@"; do
+      env_kv=(); path=$bin
+      if [[ $bin == *=*:* ]]; then env_kv=("${bin%%:*}"); path=${bin#*:}; fi
+      env "${env_kv[@]}" /usr/bin/time -o "$out/cpu" -f "%U %S" "$path" render "$scene" -o "$out/img.exr" \
+        "${extra[@]}" >"$out/log" 2>&1
+      sed -n 's/.*spp (min [0-9]*, max [0-9]*), \([0-9.]*\) s.*/\1/p' "$out/log" >>"$out/$name.$i"
+      awk '{print $1 + $2}' "$out/cpu" >>"$out/$name.cpu.$i"
+      i=$((i + 1))
+    done
+  done
+  first=$(median <"$out/$name.0")
+  first_cpu=$(median <"$out/$name.cpu.0")
+  i=0
+  for bin in "$@"; do
+    m=$(median <"$out/$name.$i")
+    c=$(median <"$out/$name.cpu.$i")
+    printf '| %s | %s | %.3f | %.3f | %.2f | %.3f |\n' "$name" "$bin" "$m" "$(awk -v a="$m" -v b="$first" 'BEGIN {print a / b}')" \
+      "$c" "$(awk -v a="$c" -v b="$first_cpu" 'BEGIN {print a / b}')"
+    i=$((i + 1))
+  done
+done
