@@ -10,7 +10,7 @@ For each configuration (the SQLite store on one node; the PostgreSQL store with 
 threads and times the stream from the first submission to the last job's end:
   - tiny:  16x16 Cornell box, 2 spp: almost nothing but the per-job overhead of the service;
   - small: 64x64, 16 spp: a short render, as a product configurator's thumbnails;
-  - big:   one SIZE x SIZE frame, 16 spp (split into window tasks where the store does that).
+  - big:   one SIZE x SIZE frame, 8 spp (split into window tasks by the farm, --tile-pixels).
 Besides wall time (noisy on a shared machine) it reads CPU time, which other load barely moves:
 of the serve processes and of the PostgreSQL cluster (every process of its postmaster, from
 /proc), and PostgreSQL's committed transactions (pg_stat_database), each per job. Those per-job
@@ -181,7 +181,7 @@ def main():
 
     workloads = [("tiny", bodies(args.tiny_jobs, 16, 2)), ("small", bodies(args.small_jobs, 64, 16))]
     if args.big:
-        workloads.append(("big", bodies(1, args.big, 16)))
+        workloads.append(("big", bodies(1, args.big, 8)))
     configs = [("sqlite", 1), ("sqlite", 2), ("postgres", 1), ("postgres", 2)]
     samples = []
     for r in range(args.rounds):

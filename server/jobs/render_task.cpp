@@ -45,9 +45,13 @@ struct FrameProgressMap {
 };
 
 // One frame (or a still): build the scene, render it with the time limit counted from `started`.
-RenderOutcome render_one(const api::SceneRequest& request, const RenderJobOptions& options,
-                         std::chrono::steady_clock::time_point started, JobRuntime& runtime,
-                         const FrameProgressMap& map) {
+}  // namespace
+
+RenderOutcome render_request(const api::SceneRequest& request, const RenderJobOptions& options,
+                             std::chrono::steady_clock::time_point started, JobRuntime& runtime,
+                             const ProgressMap& progress_map) {
+  const ProgressMap map =
+      progress_map ? progress_map : ProgressMap([](const RenderProgress& p) { return p; });
   RenderOutcome out;
   RenderSettings settings = request.settings;
   settings.threads = options.threads;
@@ -73,8 +77,9 @@ RenderOutcome render_one(const api::SceneRequest& request, const RenderJobOption
     // then stops within one tile of its own limit (renderer/render/render.cpp).
     const double spent =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-    const double finish =
-        finish_seconds_estimate(std::uint64_t(settings.width) * std::uint64_t(settings.height));
+    const double finish = finish_seconds_estimate(
+        settings.window ? std::uint64_t(settings.window->pixel_count())
+                        : std::uint64_t(settings.width) * std::uint64_t(settings.height));
     settings.time_limit = std::max(1e-3, settings.time_limit - spent - finish);
   }
   if (runtime.cancel_flag()->load()) {
@@ -98,6 +103,8 @@ RenderOutcome render_one(const api::SceneRequest& request, const RenderJobOption
   return out;
 }
 
+namespace {
+
 // The job's statistics so far plus one more frame's: sums, and the spp extremes and mean.
 void add_frame_stats(RenderOutcome& job, const RenderOutcome& frame) {
   RenderStats& s = job.stats;
@@ -120,9 +127,8 @@ void add_frame_stats(RenderOutcome& job, const RenderOutcome& frame) {
 
 }  // namespace
 
-RenderOutcome run_render_job(const std::string& scene_json, const RenderJobOptions& options,
-                             JobRuntime& runtime) {
-  RenderOutcome out;
+api::LoadResult load_job_request(const std::string& scene_json, const RenderJobOptions& options,
+                                 std::string& error) {
   // Validated at submission; validated again because the server may have restarted with
   // tighter limits since.
   // The stored text is the body as submitted: a bare scene or {"scene": ..., "assets": ...}.
@@ -132,16 +138,22 @@ RenderOutcome run_render_job(const std::string& scene_json, const RenderJobOptio
   api::LoadResult loaded =
       submission.ok() ? api::load_scene(submission.scene_text, options.limits, {}, options.assets)
                       : api::LoadResult{std::nullopt, submission.kind, submission.errors, {}};
-  if (!loaded.ok()) {
-    out.error = "the scene is no longer valid under this server's limits: " +
-                loaded.errors.front().to_string();
-    return out;
-  }
+  if (!loaded.ok())
+    error = "the scene is no longer valid under this server's limits: " +
+            loaded.errors.front().to_string();
+  return loaded;
+}
+
+RenderOutcome run_render_job(const std::string& scene_json, const RenderJobOptions& options,
+                             JobRuntime& runtime) {
+  RenderOutcome out;
+  api::LoadResult loaded = load_job_request(scene_json, options, out.error);
+  if (!loaded.ok()) return out;
   api::SceneRequest& request = *loaded.request;
   // A still, or a caller that stores no frames (no on_frame: the farm's whole-job task, until
   // it has frame tasks): one image, an animation's first frame (load_scene set its shutter).
   if (!request.animation || !options.on_frame)
-    return render_one(request, options, options.started, runtime, {});
+    return render_request(request, options, options.started, runtime, {});
 
   // An animation: its frames one after another. Not several at once: the renderer already
   // spreads one frame over all of the job's threads (tiles), so concurrent frames would only
@@ -169,7 +181,7 @@ RenderOutcome run_render_job(const std::string& scene_json, const RenderJobOptio
     runtime.clear_preview();
     // A time limit (the scene's, the server's) is per frame, as `penumbra render --frames`.
     RenderOutcome frame_out =
-        render_one(request, options, std::chrono::steady_clock::now(), runtime, map);
+        render_request(request, options, std::chrono::steady_clock::now(), runtime, map);
     frame_out.frame = frame;
     if (frame_out.kind != RenderOutcome::Kind::kSucceeded) {
       // Stopped (cancel, shutdown) or failed mid-animation: the frames before stay stored.

@@ -59,6 +59,21 @@ std::string render_stats_json(const RenderOutcome& outcome, int threads);
 // The metadata written into a job's result images.
 ImageMetadata result_metadata(const std::string& job_id, const RenderOutcome& outcome);
 
+// Reads the stored job text (a bare scene or {"scene", "assets"}) under this server's limits;
+// `error` says why when it is no longer valid.
+api::LoadResult load_job_request(const std::string& scene_json, const RenderJobOptions& options,
+                                 std::string& error);
+
+// Maps one render's progress onto its job's (an animation's frame onto all frames); empty: as is.
+using ProgressMap = std::function<RenderProgress(const RenderProgress&)>;
+
+// Builds and renders one parsed request (a still, a chosen frame, a window) with the job's
+// threads and the server's budget; a time limit counts from `started` and keeps back the time
+// to store the images.
+RenderOutcome render_request(const api::SceneRequest& request, const RenderJobOptions& options,
+                             std::chrono::steady_clock::time_point started, JobRuntime& runtime,
+                             const ProgressMap& progress_map);
+
 RenderOutcome run_render_job(const std::string& scene_json, const RenderJobOptions& options,
                              JobRuntime& runtime);
 

@@ -775,8 +775,10 @@ def test_animation_frames(farm):
     per_worker = farm.psql("SELECT count(DISTINCT worker) FROM task_attempts WHERE job_id = '%s' "
                            "AND outcome = 'succeeded'" % job)[0][0]
     check(int(per_worker) >= 2, "frames rendered by several workers: %s" % per_worker)
-    # The /result?frame= route is the "anim" branch's; the files the backend serves for each
-    # frame (open_result: the committed task's token) are compared here.
+    status, j = get_json(api["base"], "/v1/jobs/" + job)
+    check(j["frames"] == {"first": 1, "last": 24, "done": 24},
+          "the job JSON's frames (no single current frame on a farm): %s" % j.get("frames"))
+    # Each frame through the API node (/result?frame=i), and all of them as one archive.
     path = os.path.join(farm.work, "anim.json")
     with open(path, "w") as f:
         json.dump(s, f)
@@ -787,7 +789,14 @@ def test_animation_frames(farm):
         subprocess.check_call([farm.binary, "render", path, "--frame", str(i), "-o", local, "-q",
                                "--threads", "1"], stdout=subprocess.DEVNULL,
                               stderr=subprocess.DEVNULL)
-        served = os.path.join(farm.data, "results", "%s.%s.exr" % (job, tokens[i]))
+        served = fetch(api["base"], "/v1/jobs/%s/result?format=exr&frame=%d" % (job, i),
+                       os.path.join(farm.work, "served%d.exr" % i))
+        # What the route served is the committed task's file (open_result by the frame's token).
+        with open(served, "rb") as a, open(os.path.join(
+                farm.data, "results", "%s.%s.exr" % (job, tokens[i])), "rb") as b:
+            if a.read() != b.read():
+                bad.append(i)
+                return
         # The channel names of every frame are the same task's writing; checked on the first.
         if not same_pixels(served, local, names_too=i == 1):
             bad.append(i)
@@ -798,6 +807,17 @@ def test_animation_frames(farm):
         list(pool.map(compare, range(1, 25)))
     bad.sort()
     check(not bad, "frames equal to `penumbra render --frame i`: differ %s" % bad)
+    import io
+    import tarfile
+    status, raw, _ = request(api["base"], "GET", "/v1/jobs/%s/frames.tar" % job, timeout=120)
+    check(status == 200, "frames.tar answered %d" % status)
+    with tarfile.open(fileobj=io.BytesIO(raw)) as tar:
+        names = tar.getnames()
+        check(names == ["frame_%04d.exr" % i for i in range(1, 25)], "archive names: %s" % names)
+        for i in range(1, 25):
+            with open(os.path.join(farm.work, "served%d.exr" % i), "rb") as f:
+                check(tar.extractfile("frame_%04d.exr" % i).read() == f.read(),
+                      "archive member %d = /result?frame=%d" % (i, i))
     # Without a frame, the job's result is its first frame.
     first = fetch(api["base"], "/v1/jobs/%s/result?format=exr" % job,
                   os.path.join(farm.work, "first.exr"))
