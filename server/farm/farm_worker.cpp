@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <random>
@@ -167,6 +168,14 @@ void FarmWorker::slot_loop() {
         run(*db, *c);
         continue;  // look again at once: more work may be queued
       }
+      if (claimable_tasks_locked(*db)) {
+        // Runnable tasks exist but were passed over: their job's row was locked for a moment
+        // (another worker claiming or committing a task of the same job, a heartbeat, a
+        // cancel). No NOTIFY will come for them, so look again shortly rather than sleeping
+        // until the fallback poll: otherwise one worker takes every short task of a split job.
+        std::this_thread::sleep_for(std::chrono::milliseconds(5 + std::rand() % 20));
+        continue;
+      }
       db->exec("UPDATE workers SET heartbeat_at = now() WHERE id = $1", {id_});
       db->wait_notification(kFallbackPollSeconds);
     } catch (const StoreError& e) {
@@ -175,6 +184,14 @@ void FarmWorker::slot_loop() {
       std::this_thread::sleep_for(std::chrono::seconds(1));
     }
   }
+}
+
+bool FarmWorker::claimable_tasks_locked(PgConnection& db) {
+  // The claim's conditions without its locks (a plain read waits for no lock).
+  PgRows rows = db.exec(
+      "SELECT EXISTS (SELECT 1 FROM tasks t JOIN jobs j ON j.id = t.job_id WHERE t.state = "
+      "'queued' AND NOT j.cancel_requested AND j.state IN ('queued', 'running')) AS waiting");
+  return rows.value(0, "waiting") == "t";
 }
 
 int FarmWorker::reap_expired(PgConnection& db) {

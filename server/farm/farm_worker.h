@@ -46,6 +46,8 @@ class FarmWorker {
   void slot_loop();
   // Returns the tasks of expired leases to the queue; the number returned.
   int reap_expired(PgConnection& db);
+  // True when queued tasks of live jobs exist that the last claim passed over (locked rows).
+  bool claimable_tasks_locked(PgConnection& db);
   std::optional<Claim> claim(PgConnection& db);
   void run(PgConnection& db, const Claim& claim);
   // A split frame's last step: the committed tiles merged (bit for bit the single-machine

@@ -750,7 +750,9 @@ def animation_scene(frames=24):
         s = json.load(f)
     s["camera"].pop("shutter", None)
     s["animation"] = {"frames": [1, frames], "fps": 24, "shutter": 0.5}
-    s["render"].update({"width": 32, "height": 32, "spp": 4, "seed": 3,
+    # Frames of some tens of milliseconds, so that one worker cannot take all 24 before the
+    # others have claimed theirs.
+    s["render"].update({"width": 64, "height": 64, "spp": 8, "seed": 3,
                         "outputs": ["albedo", "depth"]})
     return s
 
@@ -758,6 +760,10 @@ def animation_scene(frames=24):
 def test_animation_frames(farm):
     api = farm.start("api")
     workers = [farm.start("worker") for _ in range(3)]
+    deadline = time.time() + 30
+    while len(farm.psql("SELECT id FROM workers WHERE stopped_at IS NULL")) < 3:
+        check(time.time() < deadline, "3 workers registered")
+        time.sleep(0.1)
     s = animation_scene()
     t0 = time.time()
     job = submit(api["base"], s)

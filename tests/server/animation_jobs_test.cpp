@@ -218,7 +218,9 @@ TEST(AnimationJobs, EventsCarryProgressPerFrame) {
   TempDir dir;
   ServerProcess server(dir.path(), {"--render-threads", "1"});
   auto c = server.client();
-  const std::string id = submit(*c, animation_scene(1, 6, 32, 128));
+  // Frames of about 0.7 s on one thread: progress is sampled at most 4 times a second, so a
+  // shorter frame may pass between two samples.
+  const std::string id = submit(*c, animation_scene(1, 6, 32, 512));
   const StreamRead r = read_events(server, id);
   ASSERT_EQ(r.status, 200);
   ASSERT_FALSE(r.events.empty());
