@@ -4,7 +4,8 @@
     .venv-mitsuba/bin/python tools/bench_accuracy.py --penumbra build/app/penumbra \
         [--spp 4,16,64,256] [--seeds 3] [--mitsuba llvm_ad_rgb,scalar_rgb] [--only cornell] \
         [--adaptive 0.1,0.05,0.03] [--adaptive-cap 1024] \
-        [--cycles /usr/bin/blender [--cycles-sphere-mesh 512] [--cycles-reference-spp 4096]]
+        [--cycles /usr/bin/blender [--cycles-sphere-mesh 512] [--cycles-rough-glass] \
+        [--cycles-reference-spp 4096]]
 
 For each scene of tests/accuracy/scenes/, each renderer and each sample count of the ladder, over
 several seeds, it records the render's seconds, spp, RMSE, relMSE and mean FLIP against the
@@ -29,8 +30,8 @@ tools/penumbra_to_cycles.py translates (the others are listed and skipped). Its 
 build + render); the whole Blender process (start-up, conversion, EXR) is in the CSV as
 ``process_seconds``. Its error is against the Mitsuba reference when the translation is exact
 and the material models agree; a scene whose spheres had to be tessellated
-(``--cycles-sphere-mesh N``) is not the same scene, and Cycles' rough glass does not converge to
-Mitsuba's (:func:`cycles_differs`), so there Cycles is measured against its own
+(``--cycles-sphere-mesh N``) is not the same scene, and Cycles' rough glass
+(``--cycles-rough-glass``) is another model (:func:`cycles_differs`), so there Cycles is measured against its own
 ``--cycles-reference-spp`` render instead (the ``reference`` column and the table say which).
 
 Error metrics (per render, against the reference):
@@ -108,14 +109,15 @@ def run_penumbra(binary: str, scene_path: str, spp: int, seed: int, mi,
 
 
 def run_cycles(blender: str, scene_path: str, spp: int, seed: int, mi,
-               sphere_mesh: int = 0) -> tuple[np.ndarray, float, float]:
+               sphere_mesh: int = 0, rough_glass: bool = False) -> tuple[np.ndarray, float, float]:
     """Render with Cycles through tools/penumbra_to_cycles.py in a headless Blender; returns the
     image, the render seconds measured inside Blender and the whole process's seconds."""
     script = os.path.join(os.path.dirname(os.path.abspath(__file__)), "penumbra_to_cycles.py")
     with tempfile.TemporaryDirectory() as tmp:
         out = os.path.join(tmp, "out.exr")
         cmd = [blender, "-b", "--factory-startup", "--python-exit-code", "1", "--python", script, "--",
-               scene_path, "-o", out, "--spp", str(spp), "--seed", str(seed), "--sphere-mesh", str(sphere_mesh)]
+               scene_path, "-o", out, "--spp", str(spp), "--seed", str(seed), "--sphere-mesh", str(sphere_mesh)] \
+            + (["--rough-glass"] if rough_glass else [])
         proc = subprocess.run(cmd, capture_output=True, text=True)
         match = CYCLES_SUMMARY.search(proc.stdout)
         if proc.returncode != 0 or not match:
@@ -125,8 +127,8 @@ def run_cycles(blender: str, scene_path: str, spp: int, seed: int, mi,
 
 def cycles_differs(scene: dict) -> str:
     """Why Cycles does not render exactly the Mitsuba reference's scene ('' when it does):
-    tessellated spheres, or a rough dielectric (Cycles' rough Glass BSDF measured 2.7 % brighter
-    in red than Mitsuba and penumbra on glass_rough, 0.4 % being the noise; docs/accuracy.md)."""
+    tessellated spheres, or a rough dielectric (Cycles 3.x's rough Glass BSDF is another model,
+    see tools/penumbra_to_cycles.py)."""
     reasons = []
     if any(o.get("type") == "sphere" for o in scene.get("objects", [])):
         reasons.append("spheres tessellated")
@@ -136,13 +138,14 @@ def cycles_differs(scene: dict) -> str:
     return ", ".join(reasons)
 
 
-def cycles_reference(blender: str, scene_path: str, spp: int, mi, sphere_mesh: int, out: str) -> np.ndarray:
+def cycles_reference(blender: str, scene_path: str, spp: int, mi, sphere_mesh: int, rough_glass: bool,
+                     out: str) -> np.ndarray:
     """Cycles' own high-spp render of a scene (seed 1000, apart from the ladder's), kept in
     ``out`` and reused by later runs with the same settings."""
     name = os.path.splitext(os.path.basename(scene_path))[0]
     path = os.path.join(out, f"cycles_reference_{name}_{spp}spp_sphere{sphere_mesh}.exr")
     if not os.path.exists(path):
-        image, seconds, _ = run_cycles(blender, scene_path, spp, 1000, mi, sphere_mesh)
+        image, seconds, _ = run_cycles(blender, scene_path, spp, 1000, mi, sphere_mesh, rough_glass)
         mi.Bitmap(image.astype(np.float32), mi.Bitmap.PixelFormat.RGB).write(path)
         print(f"{name:13s} cycles reference {spp} spp: {seconds:.1f} s -> {path}", flush=True)
     return read_exr(mi, path)
@@ -272,6 +275,8 @@ def main(argv: list[str]) -> int:
                     help="add Blender Cycles (this blender executable) for the scenes it translates")
     ap.add_argument("--cycles-sphere-mesh", type=int, default=0, metavar="N",
                     help="tessellate spheres for Cycles as UV spheres of N segments (0: skip such scenes)")
+    ap.add_argument("--cycles-rough-glass", action="store_true",
+                    help="let Cycles render rough glass with its own model (else skip such scenes)")
     ap.add_argument("--cycles-reference-spp", type=int, default=4096,
                     help="spp of Cycles' own reference for scenes it renders only approximately")
     ap.add_argument("--out", default=os.path.join(REPO, "bench", "out"))
@@ -307,7 +312,7 @@ def main(argv: list[str]) -> int:
         reference = read_exr(mi, os.path.join(ACCURACY, "references", f"{scene_name}.exr"))
         instants = len(p2m.shutter_instants(scene, args.instants))
         with open(scene_path, encoding="utf-8") as f:
-            refused = p2c.refusals(json.load(f), args.cycles_sphere_mesh)
+            refused = p2c.refusals(json.load(f), args.cycles_sphere_mesh, args.cycles_rough_glass)
         for renderer in renderers:
             if renderer == "cycles":
                 if refused:
@@ -316,13 +321,14 @@ def main(argv: list[str]) -> int:
                 approximate = cycles_differs(scene)
                 if approximate:
                     cycles_ref = cycles_reference(args.cycles, scene_path, args.cycles_reference_spp, mi,
-                                                  args.cycles_sphere_mesh, args.out)
+                                                  args.cycles_sphere_mesh, args.cycles_rough_glass, args.out)
                     ref_name = f"cycles {args.cycles_reference_spp} spp ({approximate})"
-                run_cycles(args.cycles, scene_path, ladder[0], 0, mi, args.cycles_sphere_mesh)
+                run_cycles(args.cycles, scene_path, ladder[0], 0, mi, args.cycles_sphere_mesh,
+                           args.cycles_rough_glass)
                 for spp in ladder:
                     for seed in range(args.seeds):
                         image, seconds, process = run_cycles(args.cycles, scene_path, spp, seed, mi,
-                                                             args.cycles_sphere_mesh)
+                                                             args.cycles_sphere_mesh, args.cycles_rough_glass)
                         row = {"scene": scene_name, "renderer": renderer, "spp": spp, "threshold": 0.0,
                                "seed": seed, "seconds": seconds, "instants": 1,
                                **errors(image, cycles_ref if approximate else reference),
