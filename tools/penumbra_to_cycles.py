@@ -34,8 +34,9 @@ Mapping (each checked against penumbra and Mitsuba on the accuracy scenes, docs/
   inline meshes as they are (counter-clockwise front), per-vertex normals as custom split
   normals (smooth), none -> flat. Transforms become the object's matrix.
 * spheres: Cycles has no analytic sphere. Refused unless ``--sphere-mesh N``: a UV sphere of N
-  segments and N/2 rings, smooth shaded (NOT exact: its silhouette is inside the true sphere by
-  up to r(1 - cos(pi/N)); the benchmark says so).
+  segments and N/2 rings with the sphere's exact normals at its vertices, smooth shaded (NOT
+  exact: its facets lie inside the true sphere by up to r(1 - cos(pi/N)), and the interpolated
+  normals are not the sphere's between vertices; the benchmark says so).
 * environment ``radiance`` -> World Background of that colour, strength 1.
 * camera: look_at matrix, vertical fov (sensor fit Vertical), thin lens with aperture radius
   a: Cycles' aperture radius is focal_length / (2 f-stop), so f-stop = focal_length / (2 a).
@@ -51,9 +52,18 @@ and Mitsuba's box filter). Cycles samples with its own quasi-random sequence (it
 pattern) and its own Russian roulette (penumbra's rr_depth has no Cycles equivalent); both are
 unbiased.
 
+* mesh files (PLY, OBJ; relative to the scene's folder) are read here as penumbra reads them
+  (:func:`read_ply`, :func:`read_obj`: polygons fan-triangulated, vertex normals when the PLY
+  has nx, ny, nz or every OBJ corner names a normal, else flat) and built as inline meshes:
+  Blender 3.4's PLY importer drops normals and its OBJ importer may merge or smooth otherwise.
+* point light of intensity I (W/sr) -> a Point lamp of radius 0, power 4 pi max(I) W, colour
+  I / max(I) (Cycles: intensity = power / 4 pi, docs/blender.md). Directional light of
+  irradiance E travelling along d -> a Sun of angle 0, strength max(E), colour E / max(E), its
+  -Z along d.
+
 Refused: plastic (Cycles has no layered diffuse + dielectric coat equal to penumbra's), textures
-and normal maps, point and directional lights, environment maps, instances, mesh files, motion
-blur, max_depth 1, integrators other than ``path``, a zero normal in a mesh.
+and normal maps, environment maps, instances, motion blur, max_depth 1, integrators other than
+``path``, a zero normal in a mesh.
 
 Output: a linear float32 RGB EXR. Printed on stdout:
 ``cycles: render S s, process P s`` where S is ``bpy.ops.render.render`` (Cycles' scene sync,
@@ -101,8 +111,9 @@ def refusals(scene: dict, sphere_mesh: int = 0, rough_glass: bool = False) -> li
         out.append(Refused("/render/integrator", "only 'path' has a Cycles equivalent"))
     if render.get("max_depth", 8) == 1:
         out.append(Refused("/render/max_depth", "1 (emitters only): Cycles always adds direct light"))
-    if scene.get("lights"):
-        out.append(Refused("/lights", "point and directional lights are not translated"))
+    for i, light in enumerate(scene.get("lights", [])):
+        if light.get("type") not in ("point", "directional"):
+            out.append(Refused(f"/lights/{i}/type", f"{light.get('type')!r} is not translated"))
     env = scene.get("environment") or {}
     for key in env:
         if key != "radiance":
@@ -125,8 +136,11 @@ def refusals(scene: dict, sphere_mesh: int = 0, rough_glass: bool = False) -> li
         if kind == "sphere" and sphere_mesh <= 0:
             out.append(Refused(f"{base}/type", "Cycles has no analytic sphere (--sphere-mesh N "
                                                "tessellates it, not exactly)"))
+        elif kind == "sphere" and not uniform_scale(object_matrix(obj.get("transform"))):
+            out.append(Refused(f"{base}/transform", "a sphere's transform must scale uniformly"))
         elif kind == "mesh" and "file" in obj:
-            out.append(Refused(f"{base}/file", "mesh files are not translated"))
+            if os.path.splitext(obj["file"])[1].lower() not in (".ply", ".obj"):
+                out.append(Refused(f"{base}/file", "only .ply and .obj files"))
         elif kind == "mesh" and obj.get("normals") and any(
                 obj["normals"][k:k + 3] == [0, 0, 0] for k in range(0, len(obj["normals"]), 3)):
             out.append(Refused(f"{base}/normals", "a zero normal (penumbra's fallback is not translated)"))
@@ -204,6 +218,153 @@ def look_at(position, target, up):
             [right[1], true_up[1], back[1], position[1]],
             [right[2], true_up[2], back[2], position[2]],
             [0, 0, 0, 1]]
+
+
+def uv_sphere(center, radius: float, segments: int):
+    """A UV sphere of ``segments`` meridians and ``segments // 2`` rings around ``center``:
+    flat lists (positions, polygons, normals), the normals exact (the sphere's own at each
+    vertex), polygons counter-clockwise seen from outside (front outwards, as penumbra's
+    sphere). Its flat facets lie inside the sphere by at most radius * (1 - cos(pi / segments))."""
+    rings = max(2, segments // 2)
+    dirs = [[0.0, 0.0, 1.0]]
+    for i in range(1, rings):
+        theta = math.pi * i / rings
+        for j in range(segments):
+            phi = 2.0 * math.pi * j / segments
+            dirs.append([math.sin(theta) * math.cos(phi), math.sin(theta) * math.sin(phi), math.cos(theta)])
+    dirs.append([0.0, 0.0, -1.0])
+    bottom = len(dirs) - 1
+
+    def at(i, j):  # ring i in 1 .. rings-1
+        return 1 + (i - 1) * segments + j % segments
+
+    polys = []
+    for j in range(segments):
+        polys.append([0, at(1, j), at(1, j + 1)])
+        for i in range(1, rings - 1):
+            polys.append([at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)])
+        polys.append([at(rings - 1, j), bottom, at(rings - 1, j + 1)])
+    positions = [center[k] + radius * d[k] for d in dirs for k in range(3)]
+    return positions, polys, [x for d in dirs for x in d]
+
+
+def uniform_scale(matrix) -> bool:
+    """Whether the linear part of a 4x4 matrix is a rotation times one scale (a sphere stays one)."""
+    cols = [[matrix[r][c] for r in range(3)] for c in range(3)]
+    dots = [[sum(a * b for a, b in zip(cols[i], cols[j])) for j in range(3)] for i in range(3)]
+    s2 = dots[0][0]
+    return all(abs(dots[i][j] - (s2 if i == j else 0.0)) <= 1e-6 * s2 for i in range(3) for j in range(3))
+
+
+# --------------------------------------------------------------------------------------------
+# Mesh files, read as penumbra's readers read them (renderer/io/, docs/mesh-files.md)
+# --------------------------------------------------------------------------------------------
+
+_PLY_TYPES = {"char": "b", "int8": "b", "uchar": "B", "uint8": "B", "short": "h", "int16": "h",
+              "ushort": "H", "uint16": "H", "int": "i", "int32": "i", "uint": "I", "uint32": "I",
+              "float": "f", "float32": "f", "double": "d", "float64": "d"}
+
+
+def _fan(polygon):
+    """Fan triangulation from the first corner, as penumbra's FaceSink."""
+    return [[polygon[0], polygon[k], polygon[k + 1]] for k in range(1, len(polygon) - 1)]
+
+
+def read_ply(path: str):
+    """(positions, triangles, normals or None) of a PLY file (ASCII or binary), flat lists."""
+    import struct
+
+    with open(path, "rb") as f:
+        data = f.read()
+    end = data.index(b"end_header")
+    body = data[data.index(b"\n", end) + 1:]
+    fmt, elements = "ascii", []
+    for line in data[:end].decode("ascii", "replace").splitlines():
+        w = line.split()
+        if w[:1] == ["format"]:
+            fmt = w[1]
+        elif w[:1] == ["element"]:
+            elements.append((w[1], int(w[2]), []))
+        elif w[:1] == ["property"]:
+            elements[-1][2].append(("list", w[2], w[3], w[4]) if w[1] == "list" else ("scalar", w[1], w[2]))
+    order = "<" if fmt == "binary_little_endian" else ">"
+    tokens = body.split() if fmt == "ascii" else None
+    pos = 0
+    positions, normals, faces = [], [], []
+
+    def scalar(kind):
+        nonlocal pos
+        if tokens is not None:
+            pos += 1
+            return float(tokens[pos - 1]) if _PLY_TYPES[kind] in "fd" else int(tokens[pos - 1])
+        code = order + _PLY_TYPES[kind]
+        value = struct.unpack_from(code, body, pos)[0]
+        pos += struct.calcsize(code)
+        return value
+
+    for name, count, props in elements:
+        names = [p[-1] for p in props]
+        for _ in range(count):
+            values = {}
+            for prop in props:
+                if prop[0] == "list":
+                    n = scalar(prop[1])
+                    values[prop[3]] = [scalar(prop[2]) for _ in range(n)]
+                else:
+                    values[prop[2]] = scalar(prop[1])
+            if name == "vertex":
+                positions += [values["x"], values["y"], values["z"]]
+                if {"nx", "ny", "nz"} <= set(names):
+                    normals += [values["nx"], values["ny"], values["nz"]]
+            elif name == "face":
+                corners = values.get("vertex_indices", values.get("vertex_index"))
+                for tri in _fan(corners):
+                    faces += tri
+    return positions, faces, normals or None
+
+
+def read_obj(path: str):
+    """(positions, triangles, normals or None) of an OBJ file: v, vn and f statements; vertex
+    normals only when every corner names one (then one vertex per distinct position/normal
+    pair, as penumbra's reader splits them)."""
+    v, vn, polys = [], [], []
+    with open(path, encoding="utf-8", errors="replace") as f:
+        for line in f:
+            w = line.split()
+            if not w:
+                continue
+            if w[0] == "v":
+                v.append([float(x) for x in w[1:4]])
+            elif w[0] == "vn":
+                vn.append([float(x) for x in w[1:4]])
+            elif w[0] == "f":
+                corners = []
+                for c in w[1:]:
+                    parts = c.split("/")
+                    vi = int(parts[0])
+                    ni = int(parts[2]) if len(parts) == 3 and parts[2] else None
+                    corners.append((vi - 1 if vi > 0 else len(v) + vi,
+                                    None if ni is None else (ni - 1 if ni > 0 else len(vn) + ni)))
+                polys.append(corners)
+    with_normals = bool(polys) and all(n is not None for p in polys for _, n in p)
+    index, positions, normals, faces = {}, [], [], []
+    for p in polys:
+        ids = []
+        for vi, ni in p:
+            key = (vi, ni) if with_normals else (vi, None)
+            if key not in index:
+                index[key] = len(index)
+                positions += v[vi]
+                if with_normals:
+                    normals += vn[ni]
+            ids.append(index[key])
+        for tri in _fan(ids):
+            faces += tri
+    return positions, faces, normals or None
+
+
+def read_mesh_file(path: str):
+    return read_ply(path) if path.lower().endswith(".ply") else read_obj(path)
 
 
 # --------------------------------------------------------------------------------------------
@@ -302,7 +463,36 @@ def _no_bias(obj):
         obj.shadow_terminator_geometry_offset = 0.0
 
 
-def build_scene(bpy, scene_json: dict, spp: int, seed: int, sphere_mesh: int):
+def add_lights(bpy, lights: list):
+    """Point lights (radius 0) and suns (angle 0) of the same intensity / irradiance."""
+    for i, light in enumerate(lights):
+        if light["type"] == "point":
+            value = [float(x) for x in light["intensity"]]
+            data = bpy.data.lights.new(f"light{i}", "POINT")
+            data.shadow_soft_size = 0.0
+            data.energy = 4.0 * math.pi * max(value)  # Cycles: W/sr = W / 4 pi
+            matrix = [[1, 0, 0, light["position"][0]], [0, 1, 0, light["position"][1]],
+                      [0, 0, 1, light["position"][2]], [0, 0, 0, 1]]
+        else:
+            value = [float(x) for x in light["irradiance"]]
+            data = bpy.data.lights.new(f"light{i}", "SUN")
+            data.angle = 0.0
+            data.energy = max(value)  # W/m^2 on a surface facing the sun
+            d = normalize([float(x) for x in light["direction"]])
+            z = [-d[0], -d[1], -d[2]]  # the sun shines along its -Z
+            helper = [1.0, 0.0, 0.0] if abs(z[0]) < 0.9 else [0.0, 1.0, 0.0]
+            x = normalize(cross(helper, z))
+            y = cross(z, x)
+            matrix = [[x[0], y[0], z[0], 0], [x[1], y[1], z[1], 0], [x[2], y[2], z[2], 0], [0, 0, 0, 1]]
+        peak = max(value)
+        data.color = [c / peak for c in value] if peak > 0 else [0.0, 0.0, 0.0]
+        data.cycles.cast_shadow = True
+        obj = bpy.data.objects.new(f"light{i}", data)
+        obj.matrix_world = _matrix(matrix)
+        bpy.context.scene.collection.objects.link(obj)
+
+
+def build_scene(bpy, scene_json: dict, spp: int, seed: int, sphere_mesh: int, folder: str = "."):
     """Empty the factory scene and build ``scene_json`` into it."""
     for obj in list(bpy.data.objects):
         bpy.data.objects.remove(obj, do_unlink=True)
@@ -325,21 +515,20 @@ def build_scene(bpy, scene_json: dict, spp: int, seed: int, sphere_mesh: int):
                        [o[j] + v[j] for j in range(3)]]
             add_mesh_object(bpy, f"object{i}", [c for p in corners for c in p], [[0, 1, 2, 3]], None,
                             matrix, material)
+        elif kind == "mesh" and "file" in obj:
+            positions, faces, normals = read_mesh_file(os.path.join(folder, obj["file"]))
+            add_mesh_object(bpy, f"object{i}", positions, faces, normals, matrix, material)
         elif kind == "mesh":
             add_mesh_object(bpy, f"object{i}", [float(x) for x in obj["positions"]],
                             [int(x) for x in obj["indices"]],
                             [float(x) for x in obj["normals"]] if obj.get("normals") else None,
                             matrix, material)
         else:  # sphere, tessellated on request (refusals() guards the rest)
-            bpy.ops.mesh.primitive_uv_sphere_add(segments=sphere_mesh, ring_count=max(3, sphere_mesh // 2),
-                                                 radius=float(obj["radius"]),
-                                                 location=[float(x) for x in obj["center"]])
-            sphere = bpy.context.active_object
-            sphere.name = f"object{i}"
-            bpy.ops.object.shade_smooth()
-            sphere.data.materials.append(material)
-            sphere.matrix_world = _matrix(matrix) @ sphere.matrix_world
-            _no_bias(sphere)
+            positions, faces, normals = uv_sphere([float(x) for x in obj["center"]], float(obj["radius"]),
+                                                  sphere_mesh)
+            add_mesh_object(bpy, f"object{i}", positions, faces, normals, matrix, material)
+
+    add_lights(bpy, scene_json.get("lights", []))
 
     # camera
     cam_json = scene_json["camera"]
@@ -473,7 +662,8 @@ def main(argv: list[str]) -> int:
 
     render = scene_json.get("render", {})
     build_scene(bpy, scene_json, args.spp or int(render.get("spp", 64)),
-                args.seed if args.seed is not None else int(render.get("seed", 0)), args.sphere_mesh)
+                args.seed if args.seed is not None else int(render.get("seed", 0)), args.sphere_mesh,
+                os.path.dirname(os.path.abspath(args.scene)))
     bpy.context.scene.render.filepath = os.path.abspath(args.output)
     start = time.perf_counter()
     bpy.ops.render.render(write_still=False)
