@@ -199,9 +199,11 @@ def time_to_reach(rows: list[dict], target: float) -> float:
 
 def summarise(rows: list[dict], scenes: list[str], renderers: list[str]) -> list[str]:
     """Markdown table: per scene, seconds to the relMSE penumbra reaches at its largest spp, for
-    each renderer, and penumbra / fastest Mitsuba."""
-    lines = ["| scene | target relMSE | " + " | ".join(f"{r} (s)" for r in renderers) + " | penumbra / fastest Mitsuba |",
-             "| --- | ---: | " + " | ".join("---:" for _ in renderers) + " | ---: |"]
+    each renderer, and penumbra / fastest Mitsuba (and penumbra / Cycles when Cycles ran)."""
+    cycles = "cycles" in renderers
+    lines = ["| scene | target relMSE | " + " | ".join(f"{r} (s)" for r in renderers) + " | penumbra / fastest Mitsuba |"
+             + (" penumbra / cycles |" if cycles else ""),
+             "| --- | ---: | " + " | ".join("---:" for _ in renderers) + " | ---: |" + (" ---: |" if cycles else "")]
     for scene in scenes:
         pen = [r for r in rows if r["scene"] == scene and r["renderer"] == "penumbra"]
         if not pen:
@@ -216,10 +218,12 @@ def summarise(rows: list[dict], scenes: list[str], renderers: list[str]) -> list
         own = {r["reference"] for r in rows if r["scene"] == scene and r["renderer"] == "cycles"
                and r.get("reference", "mitsuba") != "mitsuba"}
         notes = (["motion: Mitsuba averages instants"] if moving else []) + \
-                [f"Cycles vs its own {ref}" for ref in sorted(own)]
+                [f"Cycles against its own {ref.removeprefix('cycles ')}" for ref in sorted(own)]
         lines.append(f"| {scene}{' (' + '; '.join(notes) + ')' if notes else ''} | {target:.2e} | "
                      + " | ".join("–" if math.isnan(secs[n]) else f"{secs[n]:.2f}" for n in renderers)
-                     + f" | {ratio:.2f} |")
+                     + f" | {ratio:.2f} |"
+                     + (f" {secs['penumbra'] / secs['cycles']:.2f} |" if cycles and not math.isnan(secs["cycles"])
+                        else " – |" if cycles else ""))
     return lines
 
 
@@ -322,7 +326,7 @@ def main(argv: list[str]) -> int:
                 if approximate:
                     cycles_ref = cycles_reference(args.cycles, scene_path, args.cycles_reference_spp, mi,
                                                   args.cycles_sphere_mesh, args.cycles_rough_glass, args.out)
-                    ref_name = f"cycles {args.cycles_reference_spp} spp ({approximate})"
+                    ref_name = f"cycles {args.cycles_reference_spp} spp render: {approximate}"
                 run_cycles(args.cycles, scene_path, ladder[0], 0, mi, args.cycles_sphere_mesh,
                            args.cycles_rough_glass)
                 for spp in ladder:
