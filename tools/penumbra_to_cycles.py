@@ -600,6 +600,8 @@ def build_scene(bpy, scene_json: dict, spp: int, seed: int, sphere_mesh: int, fo
     c.filter_width = 1.0
     c.time_limit = 0.0
     c.use_fast_gi = False
+    if hasattr(c, "direct_light_sampling_type"):
+        c.direct_light_sampling_type = "MULTIPLE_IMPORTANCE_SAMPLING"
     for attr in ("use_guiding", "auto_scrambling_distance"):
         if hasattr(c, attr):
             setattr(c, attr, False)
@@ -617,6 +619,11 @@ def build_scene(bpy, scene_json: dict, spp: int, seed: int, sphere_mesh: int, fo
     c.min_transparent_bounces = 0
     world.cycles.sample_as_light = True  # MIS on the environment (unbiased)
     scene.view_layers[0].use_pass_combined = True
+
+
+def struct_error():
+    import struct
+    return struct.error
 
 
 def process_seconds() -> float:
@@ -647,7 +654,12 @@ def main(argv: list[str]) -> int:
     except (OSError, ValueError) as e:
         print(f"penumbra_to_cycles: {args.scene}: {e}", file=sys.stderr)
         return 2
-    problems = refusals(scene_json, args.sphere_mesh, args.rough_glass)
+    try:
+        problems = refusals(scene_json, args.sphere_mesh, args.rough_glass)
+    except (AttributeError, KeyError, TypeError, ValueError, IndexError) as e:
+        # not a valid penumbra scene (penumbra validate names the field); no traceback
+        print(f"penumbra_to_cycles: {args.scene}: not a valid scene ({type(e).__name__}: {e})", file=sys.stderr)
+        return 2
     for p in problems:
         print(f"penumbra_to_cycles: {args.scene}: refused: {p}", file=sys.stderr)
     if problems:
@@ -661,9 +673,14 @@ def main(argv: list[str]) -> int:
     import bpy
 
     render = scene_json.get("render", {})
-    build_scene(bpy, scene_json, args.spp or int(render.get("spp", 64)),
-                args.seed if args.seed is not None else int(render.get("seed", 0)), args.sphere_mesh,
-                os.path.dirname(os.path.abspath(args.scene)))
+    try:
+        build_scene(bpy, scene_json, args.spp or int(render.get("spp", 64)),
+                    args.seed if args.seed is not None else int(render.get("seed", 0)), args.sphere_mesh,
+                    os.path.dirname(os.path.abspath(args.scene)))
+    except (KeyError, TypeError, ValueError, IndexError, OSError, struct_error()) as e:
+        print(f"penumbra_to_cycles: {args.scene}: not a valid scene ({type(e).__name__}: {e}); "
+              "`penumbra validate` names the field", file=sys.stderr)
+        return 2
     bpy.context.scene.render.filepath = os.path.abspath(args.output)
     start = time.perf_counter()
     bpy.ops.render.render(write_still=False)
