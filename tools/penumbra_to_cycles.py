@@ -151,8 +151,6 @@ def refusals(scene: dict, sphere_mesh: int = 0, rough_glass: bool = False) -> li
                 out.append(Refused(f"{base}/{key}", "motion blur is not translated"))
         if isinstance(obj.get("emission"), dict):
             out.append(Refused(f"{base}/emission", "textured emission is not translated"))
-        if "uvs" in obj:
-            pass  # uvs only matter to textures, which are refused above
     return out
 
 
@@ -453,14 +451,10 @@ def _matrix(rows):
 
 
 def _no_bias(obj):
-    """Cycles' shadow-terminator offsets move shadow rays off the surface: off."""
-    for attr in ("shadow_terminator_offset", "shadow_terminator_geometry_offset"):
-        if hasattr(obj.cycles, attr):
-            setattr(obj.cycles, attr, 0.0)
-    if hasattr(obj, "shadow_terminator_offset"):
-        obj.shadow_terminator_offset = 0.0
-    if hasattr(obj, "shadow_terminator_geometry_offset"):
-        obj.shadow_terminator_geometry_offset = 0.0
+    """Cycles' shadow-terminator offsets move shadow rays off smooth-shaded surfaces (the
+    geometry offset defaults to 0.1): both off."""
+    obj.cycles.shadow_terminator_offset = 0.0
+    obj.cycles.shadow_terminator_geometry_offset = 0.0
 
 
 def add_lights(bpy, lights: list):
