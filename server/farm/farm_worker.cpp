@@ -563,23 +563,34 @@ void FarmWorker::run(PgConnection& db, const Claim& c) {
     committed = commit_with_retry(db, [&] {
       final_state.clear();
       const std::string job_state = c.kind != "job" ? lock_job() : std::string("running");
+      // This task ends cancelled, and its job with it while the job is live (its queued tasks
+      // too); `stats`: the job's statistics to record, nullopt to keep them. False when there is
+      // nothing more to write (the lease is gone, or the job had already ended).
+      const auto end_cancelled = [&](const std::optional<std::string>& stats) {
+        mine = db.exec(std::string(kStillMine), {tid, c.token, "cancelled", ""}).affected() > 0;
+        if (!mine) return false;
+        end_attempt("cancelled");
+        if (!job_live(job_state)) return false;
+        final_state = "cancelled";
+        if (stats)
+          db.exec("UPDATE jobs SET state = 'cancelled', finished_at = $2, stats_json = $3, "
+                  "progress_json = '' WHERE id = $1",
+                  {c.job, now, *stats});
+        else
+          db.exec("UPDATE jobs SET state = 'cancelled', finished_at = $2, progress_json = '' "
+                  "WHERE id = $1",
+                  {c.job, now});
+        db.exec("UPDATE tasks SET state = 'cancelled' WHERE job_id = $1 AND state = 'queued'",
+                {c.job});
+        return true;
+      };
       switch (outcome.kind) {
         case RenderOutcome::Kind::kSucceeded:
           if (c.kind != "job" && (!job_live(job_state) || cancel_requested)) {
             // The job failed or was cancelled meanwhile: this piece counts for nothing. A cancel
             // that reached no heartbeat of this task (it finished first) ends the job here,
             // before a merge could be queued that no claim would take.
-            mine = db.exec(std::string(kStillMine), {tid, c.token, "cancelled", ""}).affected() > 0;
-            if (!mine) return;
-            end_attempt("cancelled");
-            if (!job_live(job_state)) return;
-            final_state = "cancelled";
-            db.exec(
-                "UPDATE jobs SET state = 'cancelled', finished_at = $2, progress_json = '' WHERE "
-                "id = $1",
-                {c.job, now});
-            db.exec("UPDATE tasks SET state = 'cancelled' WHERE job_id = $1 AND state = 'queued'",
-                    {c.job});
+            if (!end_cancelled(std::nullopt)) return;
             break;
           }
           mine = db.exec(std::string(kStillMine), {tid, c.token, "done", ""}).affected() > 0;
@@ -636,17 +647,7 @@ void FarmWorker::run(PgConnection& db, const Claim& c) {
           }
           break;
         case RenderOutcome::Kind::kStopped:
-          mine = db.exec(std::string(kStillMine), {tid, c.token, "cancelled", ""}).affected() > 0;
-          if (!mine) return;
-          end_attempt("cancelled");
-          if (!job_live(job_state)) return;
-          final_state = "cancelled";
-          db.exec(
-              "UPDATE jobs SET state = 'cancelled', finished_at = $2, stats_json = $3, "
-              "progress_json = '' WHERE id = $1",
-              {c.job, now, render_stats_json(outcome, options.threads)});
-          db.exec("UPDATE tasks SET state = 'cancelled' WHERE job_id = $1 AND state = 'queued'",
-                  {c.job});
+          if (!end_cancelled(render_stats_json(outcome, options.threads))) return;
           break;
         case RenderOutcome::Kind::kFailed: {
           // Tried again (another worker may have what this one lacks) until --max-attempts.

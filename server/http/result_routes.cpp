@@ -56,6 +56,13 @@ std::variant<std::string, Problem> result_variant(const httplib::Request& req) {
   return variant;
 }
 
+// Blender's layout exists as EXR only: any other format for it is a 422 naming `layout`.
+std::optional<Problem> blender_layout_conflict(const std::string& which, ImageFormat f) {
+  if (which != "blender" || f == ImageFormat::kExr) return std::nullopt;
+  return unprocessable_parameter("layout-conflict", "Layout and layer conflict", "layout",
+                                 "blender is an EXR layout; ask format=exr");
+}
+
 // ?frame=N: which frame of an animation. A malformed number is a 400 naming the parameter.
 std::variant<std::optional<int>, Problem> frame_param(const httplib::Request& req) {
   const auto text = param_value(req, "frame");
@@ -108,10 +115,7 @@ void get_result(const RouteContext& c, const httplib::Request& req, httplib::Res
   const auto format = negotiate_image_format(format_param, header_value(req, "Accept"));
   if (const auto* p = std::get_if<Problem>(&format)) return send_problem(res, req, *p);
   const ImageFormat f = std::get<ImageFormat>(format);
-  if (which == "blender" && f != ImageFormat::kExr)
-    return send_problem(res, req,
-                        unprocessable_parameter("layout-conflict", "Layout and layer conflict",
-                                                "layout", "blender is an EXR layout; ask format=exr"));
+  if (auto p = blender_layout_conflict(which, f)) return send_problem(res, req, *p);
   const auto v = c.jobs.view(id);
   if (!v) return send_problem(res, req, status_problem(404, "no job " + id));
   const JobState state = v->record.state;
@@ -187,10 +191,7 @@ void get_frames_archive(const RouteContext& c, const httplib::Request& req,
       param_value(req, "format").value_or("exr"), std::nullopt);
   if (const auto* p = std::get_if<Problem>(&format)) return send_problem(res, req, *p);
   const ImageFormat f = std::get<ImageFormat>(format);
-  if (which == "blender" && f != ImageFormat::kExr)
-    return send_problem(res, req,
-                        unprocessable_parameter("layout-conflict", "Layout and layer conflict",
-                                                "layout", "blender is an EXR layout; ask format=exr"));
+  if (auto p = blender_layout_conflict(which, f)) return send_problem(res, req, *p);
   const auto v = c.jobs.view(id);
   if (!v) return send_problem(res, req, status_problem(404, "no job " + id));
   const JobRecord& r = v->record;
