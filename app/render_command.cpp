@@ -54,6 +54,9 @@ const char* kUsage =
     "  --frame N                render frame N of the scene's \"animation\"\n"
     "  --frames                 render every frame of the animation, one file each: OUT must\n"
     "                           hold a # pattern, out_####.exr -> out_0017.exr\n"
+    "  --scalar                 advance one path at a time, one ray at a time (the reference\n"
+    "                           driver; the default advances batches of paths a bounce at a\n"
+    "                           time with rays traced in packets; both give the same image)\n"
     "  -q, --quiet              no progress bar\n";
 
 enum class Layout { kPlain, kBlender, kSeparate };
@@ -77,6 +80,7 @@ int run_render(int argc, char** argv) {
   bool quiet = false;
   std::optional<int64_t> frame;
   bool all_frames = false;
+  bool scalar = false;
   std::string layout_name = "plain";
   std::vector<api::RenderOverride> overrides;
   OptionParser p(argc, argv);
@@ -94,6 +98,8 @@ int run_render(int argc, char** argv) {
       frame = n;
     } else if (p.is("--frames")) {
       all_frames = true;
+    } else if (p.is("--scalar")) {
+      scalar = true;
     } else if (p.is("-q") || p.is("--quiet")) {
       quiet = true;
     } else if (parse_render_override(p, overrides)) {
@@ -130,6 +136,7 @@ int run_render(int argc, char** argv) {
   api::LoadResult loaded = api::load_scene_file(scene_path, {}, overrides);
   if (!report_load_problems(scene_path, loaded)) return 1;
   api::SceneRequest& request = *loaded.request;
+  if (scalar) request.settings.wavefront = false;
 
   // Which frames: --frame N, --frames (all), or none (a scene with an animation renders its
   // first frame, as load_scene left it).

@@ -1,222 +1,35 @@
 #include "renderer/render/integrator.h"
 
 #include <array>
-#include <climits>
 #include <utility>
 
-#include "renderer/core/frame.h"
-#include "renderer/lights/area_light.h"
-#include "renderer/materials/surface_bsdf.h"
-#include "renderer/shapes/shape.h"
-#include "renderer/sampling/sampling.h"
+#include "renderer/render/path_step.h"
 
 namespace penumbra {
 namespace {
 
-// A direction pair is usable only if the shading frame and the true surface agree on whether it
-// reflects or transmits; otherwise shading normals would leak light through surfaces
-// (Veach 1997 section 5.3).
-bool geometry_agrees(const vec3& wi_world, const vec3& wo_world, const vec3& ng, const vec3& wi_local,
-                     const vec3& wo_local) {
-  const float geo = glm::dot(wi_world, ng) * glm::dot(wo_world, ng);
-  const float shade = wi_local.z * wo_local.z;
-  return geo != 0.f && (geo > 0.f) == (shade > 0.f);
-}
-
-// The shading frame with its tangent along dp/du, which a normal map's x axis follows
-// (Mitsuba 3's SurfaceInteraction::initialize_sh_frame: Gram-Schmidt of dp/du against the
-// shading normal). Any frame of the normal where the parametrisation degenerates.
-Frame tangent_frame(const Scene& scene, float time, SurfaceHit* hit) {
-  scene.surface_derivatives(time, hit);
-  const vec3 n = hit->ns;
-  const vec3 s = hit->dpdu - n * glm::dot(n, hit->dpdu);
-  const float len = glm::length(s);
-  if (!(len > 0.f) || !std::isfinite(len)) return Frame(n);
-  Frame f;
-  f.n = n;
-  f.s = s / len;
-  f.t = glm::cross(n, f.s);
-  return f;
-}
-
-// The output layers' view of the camera ray's first hit (docs/output-layers.md). Out of line and
-// only called when layers are requested: it repeats the texture lookup and tangent frame the
-// loop builds later (after emission and the depth test), which costs a requested layer a little
-// and the beauty render nothing.
-[[gnu::noinline]] void record_first_hit(const Scene& scene, const Material& material,
-                                        const Ray& ray, SurfaceHit hit, FirstHit* first) {
-  std::optional<SurfaceBsdf> textured;
-  const SurfaceBsdf* bsdf = &material.bsdf();
-  if (material.varies()) bsdf = &textured.emplace(material.bsdf_at(TextureQuery{hit.p, hit.uv, ray.time}));
-  // The normal the BSDF shades with: the hit's, or a normal map's within the tangent frame.
-  const Frame frame = material.normal_mapped() ? tangent_frame(scene, ray.time, &hit) : Frame(hit.ns);
-  vec3 n = frame.to_world(bsdf->shading_normal(frame.to_local(-ray.direction)));
-  // Facing the viewer, as Cycles' Normal and denoising normal passes: the side the camera sees.
-  if (glm::dot(n, ray.direction) > 0.f) n = -n;
-  first->hit = true;
-  first->albedo = bsdf->albedo();
-  first->normal = n;
-  first->p = hit.p;
-}
-
-void record_miss(const EnvironmentLight* environment, const Ray& ray, FirstHit* first) {
-  first->hit = false;
-  first->normal = vec3(0.f);
-  // The background's colour, clamped into an albedo's range: a denoiser then keeps the
-  // environment's detail where the camera sees it directly (docs/output-layers.md).
-  first->albedo = environment ? glm::clamp(environment->radiance(ray.direction), Spectrum(0.f),
-                                           Spectrum(1.f))
-                              : Spectrum(0.f);
-  if (!is_finite(first->albedo)) first->albedo = Spectrum(0.f);
-}
-
-// Feature bits an instantiation is compiled for. A bit that is off removes that code from the
-// loop entirely (Cycles compiles only the kernel features a scene uses); a bit that is on keeps
-// the run-time test, so the all-on instantiation is the generic integrator and any
-// instantiation gives bit-identical images on the scenes it is chosen for.
-enum IntegratorFeature : uint32_t {
-  kFeatureAbsorption = 1u << 0,    // Beer-Lambert attenuation inside dielectrics
-  kFeatureTransmission = 1u << 1,  // refraction: eta bookkeeping for Russian roulette
-  kFeatureEnvironment = 1u << 2,   // escaping rays gather the environment
-  kFeatureLights = 1u << 3,        // next-event estimation (any light at all)
-  kFeatureAll = (1u << 4) - 1,
-};
-
+// The scalar driver: one path from the camera to its end, one ray at a time. The readable
+// reference the wavefront driver (wavefront_integrator.h) is tested against.
 template <bool kDistributed, uint32_t kFeatures>
 Spectrum integrate(const Scene& scene, const IntegratorSettings& settings, Ray ray,
                    Sampler& sampler, PathCounters& counters, FirstHit* first) {
-  Spectrum radiance(0.f), beta(1.f);
-  const int max_depth = settings.max_depth < 0 ? INT_MAX : settings.max_depth;
-  // The strategy that produced the current ray, for MIS on the emitter it may hit.
-  float prev_pdf = 0.f;
-  bool prev_delta = true;
-  vec3 prev_p = ray.origin;
-  float eta = 1.f;
-  const LightSampler& lights = scene.light_sampler();
-  const EnvironmentLight* environment = scene.environment();
-  constexpr uint32_t kContinueLobes = kDistributed ? uint32_t(kLobeNonDiffuse) : uint32_t(kLobeAll);
-
-  for (int depth = 1;; ++depth) {
+  PathState s(ray);
+  for (;;) {
     SurfaceHit hit;
     ++counters.rays;
-    if (!scene.intersect(ray, &hit)) {
-      if (first && depth == 1) record_miss(environment, ray, first);
-      if constexpr ((kFeatures & kFeatureEnvironment) != 0) {
-        if (!environment) break;
-        const float w =
-            prev_delta ? 1.f
-                       : power_heuristic(prev_pdf, lights.pmf(scene.environment_light()) *
-                                                       environment->pdf(ray.direction));
-        radiance += beta * environment->radiance(ray.direction) * w;
-      }
+    if (!scene.intersect(s.ray, &hit)) {
+      path_escaped<kFeatures>(scene, s, first);
       break;
     }
-    const SceneObject& obj = scene.object(hit.object);
-    const Material& material = scene.material(obj.material);
-    const bool front = glm::dot(ray.direction, hit.ng) < 0.f;
-    if (first && depth == 1) record_first_hit(scene, material, ray, hit, first);
-
-    // Beer-Lambert: a segment that ends on the back of an absorbing dielectric ran inside it.
-    if constexpr ((kFeatures & kFeatureAbsorption) != 0) {
-      if (scene.features().absorption && !front) {
-        const Spectrum sigma = material.absorption();
-        if (!is_black(sigma)) beta *= glm::exp(-sigma * hit.t);
-      }
-    }
-    if (obj.area_light && front) {
-      float w = 1.f;
-      if (!prev_delta)
-        w = power_heuristic(prev_pdf, lights.pmf(obj.light) * obj.area_light->pdf(prev_p, hit.p, hit.ng,
-                                                                                  ray.time));
-      radiance += beta * obj.area_light->radiance(TextureQuery{hit.p, hit.uv, ray.time}) * w;
-    }
-    if (depth >= max_depth) break;
-
-    // The BSDF here: the material's own where nothing varies over its surface (no lookup, the
-    // path untextured scenes take), else the one with its textures looked up at this point.
-    std::optional<SurfaceBsdf> textured;
-    const SurfaceBsdf* bsdf = &material.bsdf();
-    if (material.varies()) bsdf = &textured.emplace(material.bsdf_at(TextureQuery{hit.p, hit.uv, ray.time}));
-    const Frame frame = material.normal_mapped() ? tangent_frame(scene, ray.time, &hit) : Frame(hit.ns);
-    const vec3 wi_world = -ray.direction;
-    const vec3 wi = frame.to_local(wi_world);
-    const uint32_t lobes = bsdf->lobes();
-
-    // Next-event estimation.
-    if ((kFeatures & kFeatureLights) != 0 && (lobes & ~uint32_t(kLobeDelta)) && !lights.empty()) {
-      const float u_light = sampler.get_1d();
-      const vec2 u_point = sampler.get_2d();
-      LightSample ls;
-      const int light = lights.choose(u_light);
-      if (scene.light(light).sample(hit.p, ray.time, u_point, &ls)) {
-        ls.pdf *= lights.pmf(light);
-        const vec3 wo = frame.to_local(ls.wi);
-        if (geometry_agrees(wi_world, ls.wi, hit.ng, wi, wo)) {
-          Spectrum f;
-          if constexpr (kDistributed) {
-            // Diffuse lobes see direct light through light sampling alone; the other lobes
-            // share it with their own sampling by MIS.
-            const BsdfContext diffuse{kLobeDiffuse}, rest{kLobeNonDiffuse};
-            const Spectrum f_rest = bsdf->eval(rest, wi, wo);
-            const float w = ls.is_delta ? 1.f : power_heuristic(ls.pdf, bsdf->pdf(rest, wi, wo));
-            f = bsdf->eval(diffuse, wi, wo) + f_rest * w;
-          } else {
-            const BsdfContext all{};
-            const float w = ls.is_delta ? 1.f : power_heuristic(ls.pdf, bsdf->pdf(all, wi, wo));
-            f = bsdf->eval(all, wi, wo) * w;
-          }
-          if (!is_black(f)) {
-            const vec3 origin = offset_ray_origin(hit.p, hit.p_error, hit.ng, ls.wi);
-            vec3 dir = ls.wi;
-            float t_max = kInfinity;
-            if (std::isfinite(ls.distance)) {
-              const vec3 target = ls.n == vec3(0.f)
-                                      ? ls.p
-                                      : offset_ray_origin(ls.p, ls.p_error, ls.n, -ls.wi);
-              const vec3 d = target - origin;
-              const float dist = glm::length(d);
-              dir = dist > 0.f ? d / dist : ls.wi;
-              // A point light is a point in free space: nothing at the far end to miss, and a
-              // relative shortening would let the ray stop short of a wall the light sits
-              // closer to than 1e-4 of the distance (a leak the stress suite checks). An area
-              // light's point is offset off its surface already; the epsilon absorbs rounding.
-              t_max = ls.n == vec3(0.f) ? dist : dist * (1.f - kShadowEpsilon);
-            }
-            ++counters.rays;
-            if (t_max > 0.f && !scene.occluded(origin, dir, t_max, ray.time))
-              radiance += beta * f * ls.value / ls.pdf;
-          }
-        }
-      }
-    }
-
-    if constexpr (kDistributed) {
-      if (!(lobes & kLobeNonDiffuse)) break;
-    }
-    const float u_lobe = sampler.get_1d();
-    const vec2 u_dir = sampler.get_2d();
-    const auto bs = bsdf->sample(BsdfContext{kContinueLobes}, wi, u_lobe, u_dir);
-    if (!bs) break;
-    const vec3 wo_world = frame.to_world(bs->wo);
-    if (!geometry_agrees(wi_world, wo_world, hit.ng, wi, bs->wo)) break;
-    beta *= bs->weight;
-    prev_pdf = bs->pdf;
-    prev_delta = (bs->lobe & kLobeDelta) != 0;
-    prev_p = hit.p;
-    if constexpr ((kFeatures & kFeatureTransmission) != 0) eta *= bs->eta;
-    ray = Ray{offset_ray_origin(hit.p, hit.p_error, hit.ng, wo_world), wo_world, ray.time};
-
-    const float beta_max = max_component(beta);
-    if (!(beta_max > 0.f)) break;
-    // Russian roulette as Mitsuba 3: survival by throughput, with eta^2 undoing the radiance
-    // scaling of refraction so paths inside glass are not killed early.
-    if (depth >= settings.rr_depth) {
-      const float q = std::min(beta_max * eta * eta, 0.95f);
-      if (sampler.get_1d() >= q) break;
-      beta /= q;
-    }
+    ShadowQuery shadow;
+    bool has_shadow;
+    const bool goes_on =
+        path_hit<kDistributed, kFeatures>(scene, settings, s, hit, sampler, counters, first, &shadow, &has_shadow);
+    if (has_shadow && !scene.occluded(shadow.ray.origin, shadow.ray.direction, shadow.ray.t_max, shadow.ray.time))
+      s.radiance += shadow.contribution;
+    if (!goes_on) break;
   }
-  return radiance;
+  return s.radiance;
 }
 
 template <bool kDistributed, size_t... kMasks>

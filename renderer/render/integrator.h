@@ -9,19 +9,11 @@
 #include "renderer/core/math.h"
 #include "renderer/core/ray.h"
 #include "renderer/render/output_layers.h"
+#include "renderer/render/path_step.h"
 #include "renderer/sampling/sampler.h"
 #include "renderer/scene/scene.h"
 
 namespace penumbra {
-
-struct IntegratorSettings {
-  int max_depth = 8;  // path segments, Mitsuba 3 convention; <0 = unlimited
-  int rr_depth = 5;
-};
-
-struct PathCounters {
-  uint64_t rays = 0;
-};
 
 // `first`, when not null, receives the camera ray's first hit for the output layers
 // (output_layers.h); null when the render asks for none.

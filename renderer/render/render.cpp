@@ -15,11 +15,16 @@
 #include "renderer/denoise/denoise_result.h"
 #include "renderer/render/output_layers.h"
 #include "renderer/render/thin_lens_camera.h"
+#include "renderer/render/wavefront_integrator.h"
 
 namespace penumbra {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+// Camera samples the wavefront driver advances together: enough to fill its 16-wide packets
+// for several bounces as paths end, few enough that their state stays in cache.
+constexpr size_t kWavefrontBatch = 256;
 
 // The rendered pixels tile by tile (row-major inside each tile), and where each tile starts in
 // that order: a pass's work items are ranges of it. Indices are into the film, which covers the
@@ -107,6 +112,7 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
   const ThinLensCamera camera(scene.camera(), settings.width, settings.height);
   const int width = window.width(), height = window.height();
   const IntegrateFn integrate = select_integrator(settings.integrator, scene.features());
+  const IntegrateBatchFn integrate_batch = select_batch_integrator(settings.integrator, scene.features());
   const IntegratorSettings isettings{settings.max_depth, settings.rr_depth};
   const bool sample_lens = scene.features().lens;
   const bool sample_time = scene.features().motion;
@@ -183,29 +189,84 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
             stop = true;
             return;
           }
-          Sampler sampler(settings.seed);
           PathCounters counters;
           FirstHit first_hit;
           FirstHit* const first = layer_film ? &first_hit : nullptr;
           uint64_t item_samples = 0, item_nonfinite = 0;
-          for (size_t k = items[item]; k < items[item + 1]; ++k) {
-            const uint32_t pi = order.pixels[k];
-            const int fx = int(pi % uint32_t(width)), fy = int(pi / uint32_t(width));
-            const int x = window.x0 + fx, y = window.y0 + fy;
-            const uint32_t n0 = taken[pi], n1 = std::min(n0 + uint32_t(s1 - s0), limit[pi]);
-            if (n0 >= n1) continue;
-            taken[pi] = n1;
-            for (uint32_t s = n0; s < n1; ++s) {
-              sampler.start_pixel_sample(x, y, s);
-              const vec2 film_pos = vec2(float(x), float(y)) + sampler.get_2d();
-              const vec2 lens = sample_lens ? sampler.get_2d() : vec2(0.5f);
-              const float time = sample_time ? sampler.get_1d() : 0.f;
-              const CameraRay cr = camera.generate_ray(film_pos, lens, time);
-              const Spectrum L =
-                  integrate(scene, isettings, Ray{cr.origin, cr.direction, cr.time}, sampler, counters, first);
-              if (!film.add_sample(fx, fy, L)) ++item_nonfinite;
-              if (first) layer_film->add_sample(fx, fy, first_hit);
-              ++item_samples;
+          // One camera sample of film pixel (fx, fy): the camera's dimensions of the pixel's
+          // sampler, then its ray.
+          auto camera_ray = [&](Sampler& sampler, int x, int y, uint32_t s) {
+            sampler.start_pixel_sample(x, y, s);
+            const vec2 film_pos = vec2(float(x), float(y)) + sampler.get_2d();
+            const vec2 lens = sample_lens ? sampler.get_2d() : vec2(0.5f);
+            const float time = sample_time ? sampler.get_1d() : 0.f;
+            const CameraRay cr = camera.generate_ray(film_pos, lens, time);
+            return Ray{cr.origin, cr.direction, cr.time};
+          };
+          if (settings.wavefront) {
+            // Batches of the item's samples in pixel order, one sampler per pixel of a batch;
+            // the film takes each batch's results in that order, as the scalar loop adds them.
+            const size_t item_paths = [&] {
+              size_t n = 0;
+              for (size_t k = items[item]; k < items[item + 1]; ++k) {
+                const uint32_t pi = order.pixels[k];
+                const uint32_t n0 = taken[pi], n1 = std::min(n0 + uint32_t(s1 - s0), limit[pi]);
+                n += n1 > n0 ? n1 - n0 : 0;
+              }
+              return n;
+            }();
+            const size_t capacity = std::max<size_t>(1, std::min(item_paths, kWavefrontBatch));
+            PathBatch batch(capacity, first != nullptr);
+            std::vector<Sampler> samplers;
+            samplers.reserve(capacity);
+            std::vector<uint32_t> batch_pixels;
+            batch_pixels.reserve(capacity);
+            auto flush = [&] {
+              integrate_batch(scene, isettings, batch, counters);
+              for (size_t i = 0; i < batch.size(); ++i) {
+                const uint32_t pi = batch_pixels[i];
+                const int fx = int(pi % uint32_t(width)), fy = int(pi / uint32_t(width));
+                if (!film.add_sample(fx, fy, batch.radiance(i))) ++item_nonfinite;
+                if (first) layer_film->add_sample(fx, fy, batch.first_hit(i));
+              }
+              item_samples += batch.size();
+              batch.clear();
+              samplers.clear();
+              batch_pixels.clear();
+            };
+            for (size_t k = items[item]; k < items[item + 1]; ++k) {
+              const uint32_t pi = order.pixels[k];
+              const int fx = int(pi % uint32_t(width)), fy = int(pi / uint32_t(width));
+              const int x = window.x0 + fx, y = window.y0 + fy;
+              const uint32_t n0 = taken[pi], n1 = std::min(n0 + uint32_t(s1 - s0), limit[pi]);
+              if (n0 >= n1) continue;
+              taken[pi] = n1;
+              for (uint32_t s = n0; s < n1; ++s) {
+                if (batch.full()) flush();
+                if (samplers.empty() || batch_pixels.back() != pi) samplers.emplace_back(settings.seed);
+                Sampler& sampler = samplers.back();
+                const Ray ray = camera_ray(sampler, x, y, s);
+                batch.add(ray, &sampler);
+                batch_pixels.push_back(pi);
+              }
+            }
+            if (batch.size()) flush();
+          } else {
+            Sampler sampler(settings.seed);
+            for (size_t k = items[item]; k < items[item + 1]; ++k) {
+              const uint32_t pi = order.pixels[k];
+              const int fx = int(pi % uint32_t(width)), fy = int(pi / uint32_t(width));
+              const int x = window.x0 + fx, y = window.y0 + fy;
+              const uint32_t n0 = taken[pi], n1 = std::min(n0 + uint32_t(s1 - s0), limit[pi]);
+              if (n0 >= n1) continue;
+              taken[pi] = n1;
+              for (uint32_t s = n0; s < n1; ++s) {
+                const Ray ray = camera_ray(sampler, x, y, s);
+                const Spectrum L = integrate(scene, isettings, ray, sampler, counters, first);
+                if (!film.add_sample(fx, fy, L)) ++item_nonfinite;
+                if (first) layer_film->add_sample(fx, fy, first_hit);
+                ++item_samples;
+              }
             }
           }
           rays += counters.rays;

@@ -98,6 +98,19 @@ class Sampler {
     dimension_ = 0;
   }
 
+  // Where a sample is in its dimensions. The wavefront integrator interleaves the paths of one
+  // pixel's samples on one sampler (the dimension seeds depend on the pixel alone): it sets a
+  // path's cursor aside between bounces and resumes it, with the sampler still on that pixel.
+  struct Cursor {
+    uint32_t index;
+    uint64_t dimension;
+  };
+  Cursor cursor() const { return Cursor{index_, dimension_}; }
+  void resume(const Cursor& c) {
+    index_ = c.index;
+    dimension_ = c.dimension;
+  }
+
   float get_1d() {
     const DimensionSeeds& h = seeds(dimension_++);
     const uint32_t shuffled = nested_uniform_scramble(index_, uint32_t(h.a));

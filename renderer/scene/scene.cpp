@@ -20,21 +20,81 @@ bool Scene::intersect(const Ray& ray, SurfaceHit* hit) const {
   RTCRayHit rh = embree_ray_hit(ray);
   rtcIntersect1(rtc_scene_, &context, &rh);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
-
-  hit->t = rh.ray.tfar;
-  hit->primitive = rh.hit.primID;
-  if (rh.hit.instID[0] != RTC_INVALID_GEOMETRY_ID) {  // a copy: geomID is the mesh's id in it
-    const Instance& copy = instances_[rh.hit.instID[0] - objects_.size()];
-    hit->object = copy.object();
-    hit->instance = rh.hit.instID[0] - uint32_t(objects_.size());
-    copy.hit_geometry(ray, hit->t, rh.hit.primID, vec2(rh.hit.u, rh.hit.v), hit);
-    return true;
-  }
-  hit->object = rh.hit.geomID;
-  hit->instance = SurfaceHit::kNotACopy;
-  objects_[rh.hit.geomID].shape->hit_geometry(ray, hit->t, rh.hit.primID, vec2(rh.hit.u, rh.hit.v),
-                                              hit);
+  complete_hit(ray, rh.ray.tfar, rh.hit.geomID, rh.hit.instID[0], rh.hit.primID,
+               vec2(rh.hit.u, rh.hit.v), hit);
   return true;
+}
+
+void Scene::complete_hit(const Ray& ray, float t, uint32_t geom_id, uint32_t inst_id,
+                         uint32_t prim_id, vec2 uv, SurfaceHit* hit) const {
+  hit->t = t;
+  hit->primitive = prim_id;
+  if (inst_id != RTC_INVALID_GEOMETRY_ID) {  // a copy: geom_id is the mesh's id in it
+    const Instance& copy = instances_[inst_id - objects_.size()];
+    hit->object = copy.object();
+    hit->instance = inst_id - uint32_t(objects_.size());
+    copy.hit_geometry(ray, t, prim_id, uv, hit);
+    return;
+  }
+  hit->object = geom_id;
+  hit->instance = SurfaceHit::kNotACopy;
+  objects_[geom_id].shape->hit_geometry(ray, t, prim_id, uv, hit);
+}
+
+namespace {
+
+// Lanes [0, count) of a 16-wide packet hold rays[0, count); the rest are switched off.
+template <typename Packet>
+void fill_packet_rays(const Ray* rays, int count, int* valid, Packet* r) {
+  for (int i = 0; i < Scene::kPacketSize; ++i) {
+    valid[i] = i < count ? -1 : 0;
+    const Ray& ray = rays[i < count ? i : 0];
+    r->org_x[i] = ray.origin.x;
+    r->org_y[i] = ray.origin.y;
+    r->org_z[i] = ray.origin.z;
+    r->dir_x[i] = ray.direction.x;
+    r->dir_y[i] = ray.direction.y;
+    r->dir_z[i] = ray.direction.z;
+    r->tnear[i] = 0.f;
+    r->tfar[i] = ray.t_max;
+    r->time[i] = ray.time;
+    r->mask[i] = 0xFFFFFFFFu;  // Debian's Embree is built with ray masks: 0 would hit nothing
+    r->id[i] = unsigned(i);
+    r->flags[i] = 0;
+  }
+}
+
+}  // namespace
+
+void Scene::intersect_packet(const Ray* rays, int count, bool coherent, SurfaceHit* hits,
+                             bool* found) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  if (coherent) context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  alignas(64) int valid[kPacketSize];
+  alignas(64) RTCRayHit16 rh;
+  fill_packet_rays(rays, count, valid, &rh.ray);
+  for (int i = 0; i < kPacketSize; ++i) {
+    rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+  }
+  rtcIntersect16(valid, rtc_scene_, &context, &rh);
+  for (int i = 0; i < count; ++i) {
+    found[i] = rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
+    if (found[i])
+      complete_hit(rays[i], rh.ray.tfar[i], rh.hit.geomID[i], rh.hit.instID[0][i], rh.hit.primID[i],
+                   vec2(rh.hit.u[i], rh.hit.v[i]), &hits[i]);
+  }
+}
+
+void Scene::occluded_packet(const Ray* rays, int count, bool* occluded) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  alignas(64) int valid[kPacketSize];
+  alignas(64) RTCRay16 r;
+  fill_packet_rays(rays, count, valid, &r);
+  rtcOccluded16(valid, rtc_scene_, &context, &r);
+  for (int i = 0; i < count; ++i) occluded[i] = r.tfar[i] < 0.f;
 }
 
 void Scene::surface_derivatives(float time, SurfaceHit* hit) const {

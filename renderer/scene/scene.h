@@ -41,6 +41,15 @@ class Scene {
   // Whether anything blocks origin + t*dir for t in (0, t_max) at normalised time `time`.
   bool occluded(const vec3& origin, const vec3& dir, float t_max, float time) const;
 
+  // The same queries for up to kPacketSize rays at once, traced as one Embree packet
+  // (rtcIntersect16 / rtcOccluded16): found[i] and hits[i] (occluded[i]) are what intersect()
+  // (occluded()) gives for rays[i]. `coherent`: the rays start close together and point alike
+  // (camera rays), which lets Embree trace them as a bundle.
+  static constexpr int kPacketSize = 16;
+  void intersect_packet(const Ray* rays, int count, bool coherent, SurfaceHit* hits,
+                        bool* found) const;
+  void occluded_packet(const Ray* rays, int count, bool* occluded) const;
+
   const CameraDesc& camera() const { return camera_; }
   const SceneFeatures& features() const { return features_; }
   // World bounds of every object over the shutter (empty scene: a point at the origin).
@@ -64,6 +73,10 @@ class Scene {
   RTCSceneTy* embree_scene() const { return rtc_scene_; }
 
  private:
+  // The hit record of Embree's answer: which object or copy, and its geometry from the shape.
+  void complete_hit(const Ray& ray, float t, uint32_t geom_id, uint32_t inst_id, uint32_t prim_id,
+                    vec2 uv, SurfaceHit* hit) const;
+
   friend class SceneBuilder;
   Scene() = default;
 

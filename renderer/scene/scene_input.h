@@ -135,6 +135,10 @@ struct RenderSettings {
   // sampling; adaptive sampling decides within the window (docs/animation-and-windows.md).
   // Unset: the whole image. Must fit inside the image (api/ checks it).
   std::optional<PixelWindow> window;
+  // How paths are advanced: a batch a bounce at a time with rays traced in packets
+  // (renderer/render/wavefront_integrator.h), or one path at a time, one ray at a time
+  // (integrator.h, the reference). Both give the same image.
+  bool wavefront = true;
 };
 
 }  // namespace penumbra

@@ -1,0 +1,113 @@
+#include "renderer/render/wavefront_integrator.h"
+
+#include <algorithm>
+#include <array>
+#include <numeric>
+#include <utility>
+
+#include "renderer/render/integrator.h"
+
+namespace penumbra {
+
+PathBatch::PathBatch(size_t capacity, bool record_first_hits)
+    : capacity_(std::max<size_t>(1, capacity)), record_first_hits_(record_first_hits) {
+  states_.reserve(capacity_);
+  samplers_.reserve(capacity_);
+  cursors_.reserve(capacity_);
+  if (record_first_hits_) firsts_.reserve(capacity_);
+  live_.reserve(capacity_);
+  hits_.resize(capacity_);
+  found_.resize(capacity_);
+  shadows_.resize(capacity_);
+  shadow_paths_.resize(capacity_);
+}
+
+void PathBatch::clear() {
+  states_.clear();
+  samplers_.clear();
+  cursors_.clear();
+  firsts_.clear();
+}
+
+void PathBatch::add(const Ray& camera_ray, Sampler* sampler) {
+  states_.emplace_back(camera_ray);
+  samplers_.push_back(sampler);
+  cursors_.push_back(sampler->cursor());
+  if (record_first_hits_) firsts_.emplace_back();
+}
+
+template <bool kDistributed, uint32_t kFeatures>
+void integrate_batch(const Scene& scene, const IntegratorSettings& settings, PathBatch& b,
+                     PathCounters& counters) {
+  constexpr int kPacket = Scene::kPacketSize;
+  std::vector<uint32_t>& live = b.live_;
+  live.resize(b.size());
+  std::iota(live.begin(), live.end(), 0u);
+  for (bool camera_rays = true; !live.empty(); camera_rays = false) {
+    // Trace: the live paths' rays, in packets of consecutive live paths.
+    std::array<Ray, kPacket> rays;
+    std::array<bool, kPacket> found;
+    for (size_t k = 0; k < live.size(); k += kPacket) {
+      const int count = int(std::min<size_t>(kPacket, live.size() - k));
+      for (int i = 0; i < count; ++i) rays[i] = b.states_[live[k + i]].ray;
+      scene.intersect_packet(rays.data(), count, camera_rays, &b.hits_[k], found.data());
+      for (int i = 0; i < count; ++i) b.found_[k + i] = found[i];
+    }
+    counters.rays += live.size();
+
+    // Shade: every live path takes its step; the survivors are kept in order.
+    size_t survivors = 0, shadows = 0;
+    for (size_t k = 0; k < live.size(); ++k) {
+      const uint32_t p = live[k];
+      PathState& s = b.states_[p];
+      FirstHit* first = b.record_first_hits_ ? &b.firsts_[p] : nullptr;
+      if (!b.found_[k]) {
+        path_escaped<kFeatures>(scene, s, first);
+        continue;
+      }
+      Sampler& sampler = *b.samplers_[p];
+      sampler.resume(b.cursors_[p]);
+      bool has_shadow;
+      const bool goes_on = path_hit<kDistributed, kFeatures>(
+          scene, settings, s, b.hits_[k], sampler, counters, first, &b.shadows_[shadows], &has_shadow);
+      b.cursors_[p] = sampler.cursor();
+      if (has_shadow) b.shadow_paths_[shadows++] = p;
+      if (goes_on) live[survivors++] = p;  // survivors <= k: reads stay ahead of writes
+    }
+    live.resize(survivors);
+
+    // The bounce's shadow rays; an unblocked one adds its estimate before the path's next step,
+    // as in the scalar driver.
+    std::array<bool, kPacket> blocked;
+    for (size_t k = 0; k < shadows; k += kPacket) {
+      const int count = int(std::min<size_t>(kPacket, shadows - k));
+      for (int i = 0; i < count; ++i) rays[i] = b.shadows_[k + i].ray;
+      scene.occluded_packet(rays.data(), count, blocked.data());
+      for (int i = 0; i < count; ++i)
+        if (!blocked[i]) b.states_[b.shadow_paths_[k + i]].radiance += b.shadows_[k + i].contribution;
+    }
+  }
+}
+
+namespace {
+
+template <bool kDistributed, size_t... kMasks>
+constexpr std::array<IntegrateBatchFn, sizeof...(kMasks)> make_table(std::index_sequence<kMasks...>) {
+  return {&integrate_batch<kDistributed, uint32_t(kMasks)>...};
+}
+constexpr auto kPathTable = make_table<false>(std::make_index_sequence<kFeatureAll + 1>{});
+constexpr auto kDistributedTable = make_table<true>(std::make_index_sequence<kFeatureAll + 1>{});
+
+}  // namespace
+
+IntegrateBatchFn select_batch_integrator(IntegratorKind kind, const SceneFeatures& features) {
+  const uint32_t mask = integrator_feature_mask(features);
+  return kind == IntegratorKind::kDistributed ? kDistributedTable[mask] : kPathTable[mask];
+}
+
+IntegrateBatchFn select_generic_batch_integrator(IntegratorKind kind) {
+  return kind == IntegratorKind::kDistributed ? kDistributedTable[kFeatureAll]
+                                              : kPathTable[kFeatureAll];
+}
+
+}  // namespace penumbra

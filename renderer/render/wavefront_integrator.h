@@ -1,0 +1,57 @@
+#pragma once
+// The wavefront driver of the integrators: a batch of camera samples advanced together a bounce
+// at a time (pbrt-v4's wavefront integrator and Mitsuba 3's LLVM mode are the models). Each
+// bounce traces all live paths' rays in 16-wide Embree packets (camera rays as coherent ones),
+// shades every path with the same steps as the scalar driver (path_step.h), then traces the
+// bounce's shadow rays in packets. Per path the steps, sampler dimensions and additions are the
+// scalar driver's, so both give the same image; only the order paths are advanced in differs.
+#include <cstdint>
+#include <vector>
+
+#include "renderer/render/path_step.h"
+
+namespace penumbra {
+
+class PathBatch {
+ public:
+  // Paths the batch holds at most (reserved once, so pointers into it stay valid).
+  explicit PathBatch(size_t capacity, bool record_first_hits);
+
+  size_t size() const { return states_.size(); }
+  bool full() const { return states_.size() >= capacity_; }
+  void clear();
+  // A camera sample: its ray and its pixel's sampler, positioned after the dimensions the camera
+  // took. The sampler must stay on that pixel until the batch is integrated (other samples of the
+  // same pixel may share it).
+  void add(const Ray& camera_ray, Sampler* sampler);
+
+  // After integrate: the path's radiance and, if recorded, its camera ray's first hit.
+  const Spectrum& radiance(size_t i) const { return states_[i].radiance; }
+  const FirstHit& first_hit(size_t i) const { return firsts_[i]; }
+
+  template <bool, uint32_t>
+  friend void integrate_batch(const Scene&, const IntegratorSettings&, PathBatch&, PathCounters&);
+
+ private:
+  size_t capacity_;
+  bool record_first_hits_;
+  std::vector<PathState> states_;
+  std::vector<Sampler*> samplers_;
+  std::vector<Sampler::Cursor> cursors_;
+  std::vector<FirstHit> firsts_;
+  // Scratch of one bounce: the live paths, their hits, and the shadow queries with their paths.
+  std::vector<uint32_t> live_;
+  std::vector<SurfaceHit> hits_;
+  std::vector<uint8_t> found_;
+  std::vector<ShadowQuery> shadows_;
+  std::vector<uint32_t> shadow_paths_;
+};
+
+using IntegrateBatchFn = void (*)(const Scene& scene, const IntegratorSettings& settings,
+                                  PathBatch& batch, PathCounters& counters);
+
+// As select_integrator (integrator.h): specialised on the scene's features.
+IntegrateBatchFn select_batch_integrator(IntegratorKind kind, const SceneFeatures& features);
+IntegrateBatchFn select_generic_batch_integrator(IntegratorKind kind);
+
+}  // namespace penumbra
