@@ -16,8 +16,12 @@ struct Frame {
     s = vec3(1.f + sign * n.x * n.x * a, sign * b, -sign * n.x);
     t = vec3(b, sign + n.y * n.y * a, -n.y);
   }
-  vec3 to_local(const vec3& v) const { return vec3(glm::dot(v, s), glm::dot(v, t), glm::dot(v, n)); }
-  vec3 to_world(const vec3& v) const { return s * v.x + t * v.y + n * v.z; }
+  // Always inline: a few products each, called at every path vertex; GCC otherwise outlines
+  // them from the large integrator body (a call per use in the profile).
+  [[gnu::always_inline]] vec3 to_local(const vec3& v) const {
+    return vec3(glm::dot(v, s), glm::dot(v, t), glm::dot(v, n));
+  }
+  [[gnu::always_inline]] vec3 to_world(const vec3& v) const { return s * v.x + t * v.y + n * v.z; }
 };
 
 }  // namespace penumbra

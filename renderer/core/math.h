@@ -29,6 +29,10 @@ inline bool is_black(const Spectrum& s) { return s.x == 0.f && s.y == 0.f && s.z
 inline bool is_finite(const Spectrum& s) {
   return std::isfinite(s.x) && std::isfinite(s.y) && std::isfinite(s.z);
 }
+// |v| per component with std::fabs, which compiles to one mask (andps). glm::abs is
+// `x >= 0 ? x : -x`, which GCC keeps as a compare and branch per component (it differs from
+// fabs on -0 and NaN), nine branches in a hit point's error bound (docs/performance.md).
+inline vec3 abs_components(const vec3& v) { return vec3(std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)); }
 inline float safe_sqrt(float x) { return std::sqrt(std::max(0.f, x)); }
 inline float sqr(float x) { return x * x; }
 

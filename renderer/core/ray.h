@@ -46,7 +46,7 @@ inline float next_float_down(float v) {
 }
 
 inline vec3 offset_ray_origin(const vec3& p, const vec3& error, const vec3& n, const vec3& w) {
-  const float d = glm::dot(glm::abs(n), error);
+  const float d = glm::dot(abs_components(n), error);
   vec3 offset = d * n;
   if (glm::dot(w, n) < 0.f) offset = -offset;
   vec3 po = p + offset;

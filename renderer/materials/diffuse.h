@@ -1,7 +1,15 @@
 #pragma once
 // Lambertian reflection.
+//
+// Defined here, not in a .cpp: SurfaceBsdf dispatches over its models with std::visit, which
+// libstdc++ compiles to a switch, and with the bodies visible the most common model inlines into
+// that switch instead of being a call that returns its std::optional through memory
+// (docs/performance.md).
+#include <optional>
+
 #include "renderer/materials/bsdf.h"
 #include "renderer/materials/material_params.h"
+#include "renderer/sampling/sampling.h"
 
 namespace penumbra {
 
@@ -14,10 +22,30 @@ class DiffuseBsdf : public OpaqueBsdf {
   uint32_t lobes() const { return kLobeDiffuseReflection; }
   // The first-hit albedo of the "albedo" output (docs/output-layers.md): the reflectance.
   Spectrum albedo() const { return color_; }
-  Spectrum eval(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
-  float pdf(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
-  std::optional<BsdfSample> sample(const BsdfContext& ctx, const vec3& wi, float u_lobe,
-                                   const vec2& u) const;
+
+  Spectrum eval(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const {
+    if (!(ctx.lobes & kLobeDiffuseReflection) || wi.z <= 0.f || wo.z <= 0.f) return Spectrum(0.f);
+    return color_ * (kInvPi * wo.z);
+  }
+
+  float pdf(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const {
+    if (!(ctx.lobes & kLobeDiffuseReflection) || wi.z <= 0.f || wo.z <= 0.f) return 0.f;
+    return cosine_hemisphere_pdf(wo);
+  }
+
+  std::optional<BsdfSample> sample(const BsdfContext& ctx, const vec3& wi, float,
+                                   const vec2& u) const {
+    if (!(ctx.lobes & kLobeDiffuseReflection) || wi.z <= 0.f) return std::nullopt;
+    BsdfSample bs;
+    bs.wo = square_to_cosine_hemisphere(u);
+    bs.pdf = cosine_hemisphere_pdf(bs.wo);
+    if (!(bs.pdf > 0.f)) return std::nullopt;
+    // f cos / pdf = (color / pi) cos / (cos / pi).
+    bs.weight = color_;
+    bs.lobe = kLobeDiffuseReflection;
+    bs.eta = 1.f;
+    return bs;
+  }
 
  private:
   Spectrum color_;

@@ -48,9 +48,7 @@ Frame SurfaceBsdf::perturbed_frame(const vec3& wi) const {
   return f;
 }
 
-Spectrum SurfaceBsdf::eval_front(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const {
-  if (!normal_mapped_)
-    return std::visit([&](const auto& m) { return m.eval(ctx, wi, wo); }, model_);
+Spectrum SurfaceBsdf::eval_mapped(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const {
   const Frame f = perturbed_frame(wi);
   const vec3 wo_p = f.to_local(wo), wi_p = f.to_local(wi);
   if (!(wo.z * wo_p.z > 0.f)) return Spectrum(0.f);
@@ -58,18 +56,15 @@ Spectrum SurfaceBsdf::eval_front(const BsdfContext& ctx, const vec3& wi, const v
   return value * shadow_terminator(f.n, wo);
 }
 
-float SurfaceBsdf::pdf_front(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const {
-  if (!normal_mapped_) return std::visit([&](const auto& m) { return m.pdf(ctx, wi, wo); }, model_);
+float SurfaceBsdf::pdf_mapped(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const {
   const Frame f = perturbed_frame(wi);
   const vec3 wo_p = f.to_local(wo), wi_p = f.to_local(wi);
   if (!(wo.z * wo_p.z > 0.f)) return 0.f;
   return std::visit([&](const auto& m) { return m.pdf(ctx, wi_p, wo_p); }, model_);
 }
 
-std::optional<BsdfSample> SurfaceBsdf::sample_front(const BsdfContext& ctx, const vec3& wi,
-                                                    float u_lobe, const vec2& u) const {
-  if (!normal_mapped_)
-    return std::visit([&](const auto& m) { return m.sample(ctx, wi, u_lobe, u); }, model_);
+std::optional<BsdfSample> SurfaceBsdf::sample_mapped(const BsdfContext& ctx, const vec3& wi,
+                                                     float u_lobe, const vec2& u) const {
   const Frame f = perturbed_frame(wi);
   std::optional<BsdfSample> bs =
       std::visit([&](const auto& m) { return m.sample(ctx, f.to_local(wi), u_lobe, u); }, model_);
@@ -84,14 +79,18 @@ std::optional<BsdfSample> SurfaceBsdf::sample_front(const BsdfContext& ctx, cons
 Spectrum SurfaceBsdf::eval(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const {
   const bool flip = two_sided_ && wi.z < 0.f;
   const vec3 a = flip ? flip_z(wi) : wi, b = flip ? flip_z(wo) : wo;
-  const Spectrum f = eval_front(ctx, a, b);
+  const Spectrum f = normal_mapped_
+                         ? eval_mapped(ctx, a, b)
+                         : std::visit([&](const auto& m) { return m.eval(ctx, a, b); }, model_);
   return is_finite(f) ? f : Spectrum(0.f);
 }
 
 float SurfaceBsdf::pdf(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const {
   const bool flip = two_sided_ && wi.z < 0.f;
   const vec3 a = flip ? flip_z(wi) : wi, b = flip ? flip_z(wo) : wo;
-  const float p = pdf_front(ctx, a, b);
+  const float p = normal_mapped_
+                      ? pdf_mapped(ctx, a, b)
+                      : std::visit([&](const auto& m) { return m.pdf(ctx, a, b); }, model_);
   return std::isfinite(p) ? p : 0.f;
 }
 
@@ -99,15 +98,13 @@ std::optional<BsdfSample> SurfaceBsdf::sample(const BsdfContext& ctx, const vec3
                                               const vec2& u) const {
   const bool flip = two_sided_ && wi.z < 0.f;
   const vec3 a = flip ? flip_z(wi) : wi;
-  std::optional<BsdfSample> bs = sample_front(ctx, a, u_lobe, u);
+  std::optional<BsdfSample> bs =
+      normal_mapped_ ? sample_mapped(ctx, a, u_lobe, u)
+                     : std::visit([&](const auto& m) { return m.sample(ctx, a, u_lobe, u); }, model_);
   if (!bs) return std::nullopt;
   if (!is_finite(bs->weight) || !std::isfinite(bs->pdf) || !is_finite(bs->wo)) return std::nullopt;
   if (flip) bs->wo = flip_z(bs->wo);
   return bs;
-}
-
-uint32_t SurfaceBsdf::lobes() const {
-  return std::visit([](const auto& m) { return m.lobes(); }, model_);
 }
 
 Spectrum SurfaceBsdf::albedo() const {

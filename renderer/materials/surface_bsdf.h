@@ -44,7 +44,10 @@ class SurfaceBsdf {
   std::optional<BsdfSample> sample(const BsdfContext& ctx, const vec3& wi, float u_lobe,
                                    const vec2& u) const;
 
-  uint32_t lobes() const;  // union of BsdfLobe bits this BSDF can produce
+  // Union of BsdfLobe bits this BSDF can produce. Inline: the integrator asks at every vertex.
+  uint32_t lobes() const {
+    return std::visit([](const auto& m) { return m.lobes(); }, model_);
+  }
   // Opaque models are two-sided (the back behaves as the front); oriented ones are not.
   bool two_sided() const { return two_sided_; }
   // Beer-Lambert sigma_a of the interior, zero for everything that does not absorb inside.
@@ -54,11 +57,13 @@ class SurfaceBsdf {
   const BsdfModel& model() const { return model_; }
 
  private:
-  // The front-side answers (wi mirrored to the front already for two-sided models).
-  Spectrum eval_front(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
-  float pdf_front(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
-  std::optional<BsdfSample> sample_front(const BsdfContext& ctx, const vec3& wi, float u_lobe,
-                                         const vec2& u) const;
+  // The front-side answers with a normal map (wi mirrored to the front already for two-sided
+  // models). Without one, eval / pdf / sample visit the model directly: the common case stays
+  // one call deep, with the inline models (DiffuseBsdf) inlined into it (docs/performance.md).
+  Spectrum eval_mapped(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
+  float pdf_mapped(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
+  std::optional<BsdfSample> sample_mapped(const BsdfContext& ctx, const vec3& wi, float u_lobe,
+                                          const vec2& u) const;
   // The normal map's frame in shading-frame coordinates, for incident direction wi.
   Frame perturbed_frame(const vec3& wi) const;
 

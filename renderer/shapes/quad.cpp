@@ -32,10 +32,10 @@ Quad::Quad(const QuadDesc& desc, const ShapeContext& ctx)
 
 bool Quad::sample(const vec3& ref, float time, const vec2& u, ShapeSample* out) const {
   const vec3 su = u.x * quad_.u, sv = u.y * quad_.v;
-  const vec3 o = quad_.origin + displacement_at(time);
+  const vec3 o = moving() ? quad_.origin + displacement_at(time) : quad_.origin;
   out->p = o + su + sv;
   // Three products and two sums per coordinate, rounded once each (pbrt-v4 section 6.8.1).
-  out->p_error = gamma_bound(6) * (glm::abs(o) + glm::abs(su) + glm::abs(sv));
+  out->p_error = gamma_bound(6) * (abs_components(o) + abs_components(su) + abs_components(sv));
   out->n = normal_;
   out->uv = u;
   out->pdf = area_to_solid_angle(ref, out->p, out->n, area());

@@ -162,7 +162,7 @@ void sphere_hit_geometry(const vec3& center, float radius, const vec3& p_approx,
   hit->p = center + n * radius;
   // Error of centre + radius*n after re-projection (pbrt-v4 eq. 6.16 bounds the re-projected
   // point by gamma(5)|p| about the centre); the addition of the centre adds gamma(1)|p|.
-  hit->p_error = gamma_bound(6) * (glm::abs(center) + glm::abs(n * radius));
+  hit->p_error = gamma_bound(6) * (abs_components(center) + abs_components(n * radius));
   hit->ng = n;
   hit->ns = n;
 }
@@ -177,7 +177,7 @@ ShapeSample sample_sphere(const vec3& center, float radius, const vec3& ref, con
     const vec3 n = square_to_uniform_sphere(u);
     s.p = center + radius * n;
     s.n = n;
-    s.p_error = gamma_bound(6) * (glm::abs(center) + glm::abs(n * radius));
+    s.p_error = gamma_bound(6) * (abs_components(center) + abs_components(n * radius));
     s.pdf = area_to_solid_angle(ref, s.p, n, 4.f * kPi * r2);
     return s;
   }
@@ -203,7 +203,7 @@ ShapeSample sample_sphere(const vec3& center, float radius, const vec3& ref, con
   const vec3 n = -frame.to_world(n_local);
   s.n = glm::normalize(n);
   s.p = center + radius * s.n;
-  s.p_error = gamma_bound(6) * (glm::abs(center) + glm::abs(s.n * radius));
+  s.p_error = gamma_bound(6) * (abs_components(center) + abs_components(s.n * radius));
   s.pdf = 1.f / (2.f * kPi * one_minus_cos_max);
   return s;
 }

@@ -67,7 +67,7 @@ int motion_time_steps(const Motion& motion, float span, float camera_distance) {
                                                      vec3* p, vec3* error) {
   const vec3 t0 = b0 * p0, t1 = b1 * p1, t2 = b2 * p2;
   *p = t0 + t1 + t2;
-  *error = gamma_bound(7) * (glm::abs(t0) + glm::abs(t1) + glm::abs(t2));
+  *error = gamma_bound(7) * (abs_components(t0) + abs_components(t1) + abs_components(t2));
 }
 
 float triangle_area(const vec3& a, const vec3& b, const vec3& c) {
@@ -161,11 +161,14 @@ EmbreeGeometry TriangleMesh::make_geometry(RTCDevice device) const {
 
 void TriangleMesh::hit_geometry(const Ray& ray, float, uint32_t prim, const vec2& uv,
                                 SurfaceHit* hit) const {
-  const vec3 disp = displacement_at(ray.time);
   const uint32_t* tri = &indices_[size_t(prim) * 3];
-  const vec3 p0 = positions_[tri[0]] + disp;
-  const vec3 p1 = positions_[tri[1]] + disp;
-  const vec3 p2 = positions_[tri[2]] + disp;
+  vec3 p0 = positions_[tri[0]], p1 = positions_[tri[1]], p2 = positions_[tri[2]];
+  if (time_steps_ > 1) {  // static meshes skip adding a zero displacement
+    const vec3 disp = interpolated_displacement(ray.time);
+    p0 += disp;
+    p1 += disp;
+    p2 += disp;
+  }
   const float b1 = uv.x, b2 = uv.y, b0 = 1.f - b1 - b2;
   barycentric_point(p0, p1, p2, b0, b1, b2, &hit->p, &hit->p_error);
   if (need_uv_) hit->uv = uv_at(tri, b0, b1, b2);

@@ -55,6 +55,8 @@ class TriangleMesh : public Shape {
  protected:
   // For shapes made of triangles that keep their own area and sampling (quads).
   void set_area(float area) { area_ = area; }
+  // Whether the mesh moves over the shutter (more than one Embree time step).
+  bool moving() const { return time_steps_ > 1; }
 
  private:
   vec3 interpolated_displacement(float time) const;
