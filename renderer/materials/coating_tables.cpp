@@ -160,8 +160,7 @@ CoatingTables rough_coating_tables(const GgxDistribution& distr, float eta) {
   std::copy(nodes.begin(), nodes.end(), tables.cosines.begin());
   std::array<double, n> internal{};
   tbb::parallel_for(0, n, [&](int i) {
-    tables.transmittance[i] =
-        coating_transmittance(distr, std::max(1e-6f, tables.cosines[i]), eta);
+    tables.transmittance[i] = coating_transmittance(distr, std::max(1e-6f, tables.cosines[i]), eta);
     const float mu = std::max(1e-6f, float(i) / float(n - 1));
     internal[i] = coating_reflectance(distr, mu, 1.f / eta) * mu;
   });
@@ -263,7 +262,8 @@ CoatingTableLru& lru() {
 
 }  // namespace
 
-std::shared_ptr<const CoatingTables> shared_coating_tables(bool smooth, const GgxDistribution& distr,
+std::shared_ptr<const CoatingTables> shared_coating_tables(bool smooth,
+                                                           const GgxDistribution& distr,
                                                            float eta) {
   return lru().get(smooth, distr, eta);
 }

@@ -78,8 +78,8 @@ class CoatingTableCache {
 // ignored. Two threads missing the same key at once may both compute it (identical tables); the
 // cache keeps one. Nothing beyond the bound and what live scenes hold stays alive.
 inline constexpr size_t kCoatingTableLruCapacity = 128;
-std::shared_ptr<const CoatingTables> shared_coating_tables(bool smooth, const GgxDistribution& distr,
-                                                           float eta);
+std::shared_ptr<const CoatingTables> shared_coating_tables(bool smooth,
+                                                           const GgxDistribution& distr, float eta);
 // Entries held by the process-wide cache.
 size_t coating_table_lru_size();
 // For tests: drop every entry / change the bound (evicting down to it); returns the old bound.

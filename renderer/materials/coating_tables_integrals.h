@@ -30,11 +30,11 @@ class VisibleNormalQuadrature {
 
  private:
   struct Node {
-    float p1;            // disk point along t1
-    float p1_slack;      // 1 - p1^2, the disk's half-height at p1 squared
-    float p1_root;       // safe_sqrt(1 - p1^2)
-    float py;            // disk point along t2 before the squeeze
-    double weight;       // w_a w_b / 4: the product rule on [0, 1]^2
+    float p1;        // disk point along t1
+    float p1_slack;  // 1 - p1^2, the disk's half-height at p1 squared
+    float p1_root;   // safe_sqrt(1 - p1^2)
+    float py;        // disk point along t2 before the squeeze
+    double weight;   // w_a w_b / 4: the product rule on [0, 1]^2
   };
   template <typename Fn>
   float integrate(const GgxDistribution& distr, float cos_i, Fn fn) const;

@@ -84,7 +84,7 @@ TEST(CoatingTables, LeastRecentlyUsedIsEvicted) {
   const GgxDistribution d(0.3f);
   const auto a = shared_coating_tables(false, d, 1.5f);
   const auto b = shared_coating_tables(false, d, 1.6f);
-  EXPECT_EQ(shared_coating_tables(false, d, 1.5f), a);  // a is now the most recent
+  EXPECT_EQ(shared_coating_tables(false, d, 1.5f), a);   // a is now the most recent
   const auto c = shared_coating_tables(false, d, 1.7f);  // evicts b
   EXPECT_EQ(coating_table_lru_size(), 2u);
   EXPECT_EQ(shared_coating_tables(false, d, 1.5f), a);
