@@ -5,8 +5,12 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <list>
+#include <mutex>
+#include <tuple>
 #include <vector>
 
+#include "renderer/materials/coating_tables_integrals.h"
 #include "renderer/materials/fresnel.h"
 
 namespace penumbra {
@@ -63,7 +67,7 @@ void adaptive_transmittance_table(const GgxDistribution& distr, float eta,
   constexpr int n = kCoatingTableCapacity;
   constexpr int seed = 16;  // nodes of the coarse clustering
   const auto t_at = [&](double mu) {
-    return rough_dielectric_transmittance(distr, std::max(1e-6f, float(mu)), eta);
+    return coating_transmittance(distr, std::max(1e-6f, float(mu)), eta);
   };
   const double mu_c = std::sqrt(1.0 - double(eta) * eta);
   std::vector<double> mu(seed);
@@ -156,10 +160,9 @@ CoatingTables rough_coating_tables(const GgxDistribution& distr, float eta) {
   std::copy(nodes.begin(), nodes.end(), tables.cosines.begin());
   std::array<double, n> internal{};
   tbb::parallel_for(0, n, [&](int i) {
-    tables.transmittance[i] =
-        rough_dielectric_transmittance(distr, std::max(1e-6f, tables.cosines[i]), eta);
+    tables.transmittance[i] = coating_transmittance(distr, std::max(1e-6f, tables.cosines[i]), eta);
     const float mu = std::max(1e-6f, float(i) / float(n - 1));
-    internal[i] = rough_dielectric_reflectance(distr, mu, 1.f / eta) * mu;
+    internal[i] = coating_reflectance(distr, mu, 1.f / eta) * mu;
   });
   double sum = 0.0;
   for (double v : internal) sum += v;  // fixed order: the result does not depend on threads
@@ -189,10 +192,89 @@ CoatingTables make_coating_tables(bool smooth, const GgxDistribution& distr, flo
   return smooth ? smooth_coating_tables(eta) : rough_coating_tables(distr, eta);
 }
 
+namespace {
+
+// The process-wide LRU: a list in order of use (front: most recent) and an index into it.
+class CoatingTableLru {
+ public:
+  using Key = std::tuple<bool, float, float>;
+
+  std::shared_ptr<const CoatingTables> get(bool smooth, const GgxDistribution& distr, float eta) {
+    const Key key(smooth, smooth ? 0.f : distr.alpha(), eta);
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (auto found = index_.find(key); found != index_.end()) {
+        entries_.splice(entries_.begin(), entries_, found->second);
+        return found->second->second;
+      }
+    }
+    // Computed without the lock: the tables run a parallel_for, and a TBB thread waiting in it
+    // may take another task that asks this cache (a lock held here would then deadlock), and a
+    // miss must not stall every other material's lookup.
+    auto tables = std::make_shared<const CoatingTables>(make_coating_tables(smooth, distr, eta));
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (auto found = index_.find(key); found != index_.end()) {  // another thread was faster
+      entries_.splice(entries_.begin(), entries_, found->second);
+      return found->second->second;
+    }
+    if (capacity_ == 0) return tables;
+    entries_.emplace_front(key, tables);
+    index_.emplace(key, entries_.begin());
+    evict_to(capacity_);
+    return tables;
+  }
+
+  size_t size() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return entries_.size();
+  }
+  void clear() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    evict_to(0);
+  }
+  size_t set_capacity(size_t capacity) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const size_t old = capacity_;
+    capacity_ = capacity;
+    evict_to(capacity_);
+    return old;
+  }
+
+ private:
+  void evict_to(size_t n) {
+    while (entries_.size() > n) {
+      index_.erase(entries_.back().first);
+      entries_.pop_back();
+    }
+  }
+
+  std::mutex mutex_;
+  size_t capacity_ = kCoatingTableLruCapacity;
+  std::list<std::pair<Key, std::shared_ptr<const CoatingTables>>> entries_;
+  std::map<Key, decltype(entries_)::iterator> index_;
+};
+
+CoatingTableLru& lru() {
+  // Never destroyed: a scene destroyed during static destruction may still release tables.
+  static CoatingTableLru* const instance = new CoatingTableLru();
+  return *instance;
+}
+
+}  // namespace
+
+std::shared_ptr<const CoatingTables> shared_coating_tables(bool smooth,
+                                                           const GgxDistribution& distr,
+                                                           float eta) {
+  return lru().get(smooth, distr, eta);
+}
+size_t coating_table_lru_size() { return lru().size(); }
+void clear_coating_table_lru() { lru().clear(); }
+size_t set_coating_table_lru_capacity(size_t capacity) { return lru().set_capacity(capacity); }
+
 const CoatingTables& CoatingTableCache::get(bool smooth, const GgxDistribution& distr, float eta) {
   const std::pair<float, float> key(smooth ? 0.f : distr.alpha(), eta);
   auto& slot = tables_[key];
-  if (!slot) slot = std::make_unique<CoatingTables>(make_coating_tables(smooth, distr, eta));
+  if (!slot) slot = shared_coating_tables(smooth, distr, eta);
   return *slot;
 }
 

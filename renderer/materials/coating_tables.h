@@ -57,19 +57,34 @@ struct CoatingTables {
 // The tables of a smooth (alpha ignored) or rough GGX coating of relative ior eta.
 CoatingTables make_coating_tables(bool smooth, const GgxDistribution& distr, float eta);
 
-// Tables shared by the materials of one scene. The rough tables cost ~10^6 microfacet
+// Tables shared by the materials of one scene. The rough tables cost ~3 * 10^5 microfacet
 // evaluations (the smooth ones a few hundred Fresnel evaluations) and depend only on
 // (alpha, eta), so every plastic with the same coating computes them once. The scene owns the
-// cache and its plastics point into it (entries never move: they are held by unique_ptr), so a
-// long-running service that renders many distinct materials keeps nothing between scenes.
+// cache and its plastics point into it (entries never move: they are held by shared_ptr). The
+// tables come from the process-wide cache below, so a service that renders the same materials
+// again and again computes them once; a scene's cache holds its tables alive for as long as the
+// scene lives, whatever the process-wide cache evicts meanwhile.
 class CoatingTableCache {
  public:
   const CoatingTables& get(bool smooth, const GgxDistribution& distr, float eta);
   size_t size() const { return tables_.size(); }
 
  private:
-  std::map<std::pair<float, float>, std::unique_ptr<CoatingTables>> tables_;
+  std::map<std::pair<float, float>, std::shared_ptr<const CoatingTables>> tables_;
 };
+
+// The process-wide cache of coating tables: least recently used first out, bounded in entries
+// (a table is about 1 KB), thread-safe. Key (smooth, alpha, eta); a smooth coating's alpha is
+// ignored. Two threads missing the same key at once may both compute it (identical tables); the
+// cache keeps one. Nothing beyond the bound and what live scenes hold stays alive.
+inline constexpr size_t kCoatingTableLruCapacity = 128;
+std::shared_ptr<const CoatingTables> shared_coating_tables(bool smooth,
+                                                           const GgxDistribution& distr, float eta);
+// Entries held by the process-wide cache.
+size_t coating_table_lru_size();
+// For tests: drop every entry / change the bound (evicting down to it); returns the old bound.
+void clear_coating_table_lru();
+size_t set_coating_table_lru_capacity(size_t capacity);
 
 // How many CoatingTables exist in the process (a test checks that nothing accumulates).
 int64_t coating_tables_alive();
