@@ -34,16 +34,12 @@ float VisibleNormalQuadrature::integrate(const GgxDistribution& distr, float cos
   const float c = std::clamp(cos_i, 1e-6f, 1.f);
   const vec3 wi(std::sqrt(std::max(0.f, 1.f - c * c)), 0.f, c);
   // Stretch to the alpha = 1 configuration and build the frame around the stretched view.
-  const vec3 vh = glm::normalize(vec3(alpha * wi.x, alpha * wi.y, wi.z));
-  const float len2 = vh.x * vh.x + vh.y * vh.y;
-  const vec3 t1 = len2 > 0.f ? vec3(-vh.y, vh.x, 0.f) / std::sqrt(len2) : vec3(1.f, 0.f, 0.f);
-  const vec3 t2 = glm::cross(vh, t1);
-  const float s = 0.5f * (1.f + vh.z);
+  const StretchedView f = stretched_view(alpha, wi);
   double sum = 0.0;
   for (const Node& n : nodes_) {
     // Squeeze the disk's far half by s, lift onto the hemisphere, unstretch.
-    const float p2 = (1.f - s) * n.p1_root + s * n.py;
-    const vec3 nh = n.p1 * t1 + p2 * t2 + safe_sqrt(n.p1_slack - p2 * p2) * vh;
+    const float p2 = (1.f - f.s) * n.p1_root + f.s * n.py;
+    const vec3 nh = n.p1 * f.t1 + p2 * f.t2 + safe_sqrt(n.p1_slack - p2 * p2) * f.vh;
     const vec3 m = glm::normalize(vec3(alpha * nh.x, alpha * nh.y, std::max(0.f, nh.z)));
     sum += n.weight * fn(wi, m);
   }

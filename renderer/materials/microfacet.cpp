@@ -27,16 +27,12 @@ float GgxDistribution::smith_g1(const vec3& v, const vec3& m) const {
 vec3 GgxDistribution::sample_visible(const vec3& wi, const vec2& u) const {
   // Heitz 2018, listing 1: stretch the view vector to the alpha = 1 configuration, sample the
   // projected hemisphere (a disk whose far half is squeezed by (1 + V.z) / 2), unstretch.
-  const vec3 vh = glm::normalize(vec3(alpha_ * wi.x, alpha_ * wi.y, wi.z));
-  const float len2 = vh.x * vh.x + vh.y * vh.y;
-  const vec3 t1 = len2 > 0.f ? vec3(-vh.y, vh.x, 0.f) / std::sqrt(len2) : vec3(1.f, 0.f, 0.f);
-  const vec3 t2 = glm::cross(vh, t1);
+  const StretchedView f = stretched_view(alpha_, wi);
   // The concentric map keeps the stratification of low-discrepancy samples (Heitz uses polar).
   const vec2 p = square_to_disk_concentric(u);
-  const float s = 0.5f * (1.f + vh.z);
   const float p1 = p.x;
-  const float p2 = (1.f - s) * safe_sqrt(1.f - p1 * p1) + s * p.y;
-  const vec3 nh = p1 * t1 + p2 * t2 + safe_sqrt(1.f - p1 * p1 - p2 * p2) * vh;
+  const float p2 = (1.f - f.s) * safe_sqrt(1.f - p1 * p1) + f.s * p.y;
+  const vec3 nh = p1 * f.t1 + p2 * f.t2 + safe_sqrt(1.f - p1 * p1 - p2 * p2) * f.vh;
   return glm::normalize(vec3(alpha_ * nh.x, alpha_ * nh.y, std::max(0.f, nh.z)));
 }
 

@@ -18,6 +18,23 @@ inline constexpr float kMinMicrofacetAlpha = 1e-4f;
 // glTF convention: the user's roughness r in [0,1] maps to GGX alpha = r^2.
 inline float roughness_to_alpha(float roughness) { return roughness * roughness; }
 
+// The frame of visible-normal sampling (Heitz 2018, listing 1): the view stretched to the
+// alpha = 1 configuration (vh), two tangents around it (t1, t2), and s = (1 + vh.z) / 2, by which
+// the far half of the projected hemisphere's disk is squeezed.
+struct StretchedView {
+  vec3 vh, t1, t2;
+  float s;
+};
+inline StretchedView stretched_view(float alpha, const vec3& wi) {
+  StretchedView f;
+  f.vh = glm::normalize(vec3(alpha * wi.x, alpha * wi.y, wi.z));
+  const float len2 = f.vh.x * f.vh.x + f.vh.y * f.vh.y;
+  f.t1 = len2 > 0.f ? vec3(-f.vh.y, f.vh.x, 0.f) / std::sqrt(len2) : vec3(1.f, 0.f, 0.f);
+  f.t2 = glm::cross(f.vh, f.t1);
+  f.s = 0.5f * (1.f + f.vh.z);
+  return f;
+}
+
 class GgxDistribution {
  public:
   explicit GgxDistribution(float alpha) : alpha_(std::max(alpha, kMinMicrofacetAlpha)) {}

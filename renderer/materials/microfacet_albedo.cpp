@@ -36,11 +36,7 @@ MicrofacetAlbedo integrate(float mu, float alpha) {
   const float c = std::max(mu, 1e-4f);
   const vec3 wi(std::sqrt(std::max(0.f, 1.f - c * c)), 0.f, c);
   // Heitz 2018 listing 1 with the disk in polar coordinates instead of a warp of the square.
-  const vec3 vh = glm::normalize(vec3(alpha * wi.x, alpha * wi.y, wi.z));
-  const float len2 = vh.x * vh.x + vh.y * vh.y;
-  const vec3 t1 = len2 > 0.f ? vec3(-vh.y, vh.x, 0.f) / std::sqrt(len2) : vec3(1.f, 0.f, 0.f);
-  const vec3 t2 = glm::cross(vh, t1);
-  const float s = 0.5f * (1.f + vh.z);
+  const StretchedView f = stretched_view(alpha, wi);
   double e = 0.0, e5 = 0.0;
   const auto& [x, w] = rule;
   for (size_t a = 0; a < x.size(); ++a) {
@@ -53,8 +49,8 @@ MicrofacetAlbedo integrate(float mu, float alpha) {
       const double phi = 2.0 * kPi * (b + 0.5) / kAngles;
       const float p1 = float(rho * std::cos(phi));
       const float p2d = float(rho * std::sin(phi));
-      const float p2 = (1.f - s) * safe_sqrt(1.f - p1 * p1) + s * p2d;
-      const vec3 nh = p1 * t1 + p2 * t2 + safe_sqrt(1.f - p1 * p1 - p2 * p2) * vh;
+      const float p2 = (1.f - f.s) * safe_sqrt(1.f - p1 * p1) + f.s * p2d;
+      const vec3 nh = p1 * f.t1 + p2 * f.t2 + safe_sqrt(1.f - p1 * p1 - p2 * p2) * f.vh;
       const vec3 m = glm::normalize(vec3(alpha * nh.x, alpha * nh.y, std::max(0.f, nh.z)));
       const vec3 wo = 2.f * glm::dot(wi, m) * m - wi;
       if (wo.z <= 0.f) continue;

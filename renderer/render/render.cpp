@@ -203,19 +203,21 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
             const CameraRay cr = camera.generate_ray(film_pos, lens, time);
             return Ray{cr.origin, cr.direction, cr.time};
           };
+          // The item's samples in order: each pixel's next samples of this pass, up to its limit.
+          auto for_each_sample = [&](auto&& take) {
+            for (size_t k = items[item]; k < items[item + 1]; ++k) {
+              const uint32_t pi = order.pixels[k];
+              const uint32_t n0 = taken[pi], n1 = std::min(n0 + uint32_t(s1 - s0), limit[pi]);
+              if (n0 >= n1) continue;
+              taken[pi] = n1;
+              const int fx = int(pi % uint32_t(width)), fy = int(pi / uint32_t(width));
+              for (uint32_t s = n0; s < n1; ++s) take(pi, fx, fy, s);
+            }
+          };
           if (settings.wavefront) {
-            // Batches of the item's samples in pixel order, one sampler per pixel of a batch;
+            // Batches of the item's samples in that order, one sampler per pixel of a batch;
             // the film takes each batch's results in that order, as the scalar loop adds them.
-            const size_t item_paths = [&] {
-              size_t n = 0;
-              for (size_t k = items[item]; k < items[item + 1]; ++k) {
-                const uint32_t pi = order.pixels[k];
-                const uint32_t n0 = taken[pi], n1 = std::min(n0 + uint32_t(s1 - s0), limit[pi]);
-                n += n1 > n0 ? n1 - n0 : 0;
-              }
-              return n;
-            }();
-            const size_t capacity = std::max<size_t>(1, std::min(item_paths, kWavefrontBatch));
+            const size_t capacity = std::min(kWavefrontBatch, (items[item + 1] - items[item]) * size_t(s1 - s0));
             PathBatch batch(capacity, first != nullptr);
             std::vector<Sampler> samplers;
             samplers.reserve(capacity);
@@ -234,40 +236,23 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
               samplers.clear();
               batch_pixels.clear();
             };
-            for (size_t k = items[item]; k < items[item + 1]; ++k) {
-              const uint32_t pi = order.pixels[k];
-              const int fx = int(pi % uint32_t(width)), fy = int(pi / uint32_t(width));
-              const int x = window.x0 + fx, y = window.y0 + fy;
-              const uint32_t n0 = taken[pi], n1 = std::min(n0 + uint32_t(s1 - s0), limit[pi]);
-              if (n0 >= n1) continue;
-              taken[pi] = n1;
-              for (uint32_t s = n0; s < n1; ++s) {
-                if (batch.full()) flush();
-                if (samplers.empty() || batch_pixels.back() != pi) samplers.emplace_back(settings.seed);
-                Sampler& sampler = samplers.back();
-                const Ray ray = camera_ray(sampler, x, y, s);
-                batch.add(ray, &sampler);
-                batch_pixels.push_back(pi);
-              }
-            }
+            for_each_sample([&](uint32_t pi, int fx, int fy, uint32_t s) {
+              if (batch.full()) flush();
+              if (samplers.empty() || batch_pixels.back() != pi) samplers.emplace_back(settings.seed);
+              Sampler& sampler = samplers.back();
+              batch.add(camera_ray(sampler, window.x0 + fx, window.y0 + fy, s), &sampler);
+              batch_pixels.push_back(pi);
+            });
             if (batch.size()) flush();
           } else {
             Sampler sampler(settings.seed);
-            for (size_t k = items[item]; k < items[item + 1]; ++k) {
-              const uint32_t pi = order.pixels[k];
-              const int fx = int(pi % uint32_t(width)), fy = int(pi / uint32_t(width));
-              const int x = window.x0 + fx, y = window.y0 + fy;
-              const uint32_t n0 = taken[pi], n1 = std::min(n0 + uint32_t(s1 - s0), limit[pi]);
-              if (n0 >= n1) continue;
-              taken[pi] = n1;
-              for (uint32_t s = n0; s < n1; ++s) {
-                const Ray ray = camera_ray(sampler, x, y, s);
-                const Spectrum L = integrate(scene, isettings, ray, sampler, counters, first);
-                if (!film.add_sample(fx, fy, L)) ++item_nonfinite;
-                if (first) layer_film->add_sample(fx, fy, first_hit);
-                ++item_samples;
-              }
-            }
+            for_each_sample([&](uint32_t, int fx, int fy, uint32_t s) {
+              const Ray ray = camera_ray(sampler, window.x0 + fx, window.y0 + fy, s);
+              const Spectrum L = integrate(scene, isettings, ray, sampler, counters, first);
+              if (!film.add_sample(fx, fy, L)) ++item_nonfinite;
+              if (first) layer_film->add_sample(fx, fy, first_hit);
+              ++item_samples;
+            });
           }
           rays += counters.rays;
           samples_done += item_samples;
