@@ -1,8 +1,5 @@
 #include "renderer/render/integrator.h"
 
-#include <array>
-#include <utility>
-
 #include "renderer/render/path_step.h"
 
 namespace penumbra {
@@ -32,12 +29,11 @@ Spectrum integrate(const Scene& scene, const IntegratorSettings& settings, Ray r
   return s.radiance;
 }
 
-template <bool kDistributed, size_t... kMasks>
-constexpr std::array<IntegrateFn, sizeof...(kMasks)> make_table(std::index_sequence<kMasks...>) {
-  return {&integrate<kDistributed, uint32_t(kMasks)>...};
-}
-constexpr auto kPathTable = make_table<false>(std::make_index_sequence<kFeatureAll + 1>{});
-constexpr auto kDistributedTable = make_table<true>(std::make_index_sequence<kFeatureAll + 1>{});
+template <bool kDistributed, uint32_t kFeatures>
+struct ScalarKernel {
+  static constexpr IntegrateFn fn = &integrate<kDistributed, kFeatures>;
+};
+using ScalarInstantiations = FeatureInstantiations<IntegrateFn, ScalarKernel>;
 
 }  // namespace
 
@@ -52,13 +48,11 @@ uint32_t integrator_feature_mask(const SceneFeatures& f) {
 }
 
 IntegrateFn select_integrator(IntegratorKind kind, const SceneFeatures& features) {
-  const uint32_t mask = integrator_feature_mask(features);
-  return kind == IntegratorKind::kDistributed ? kDistributedTable[mask] : kPathTable[mask];
+  return ScalarInstantiations::select(kind, integrator_feature_mask(features));
 }
 
 IntegrateFn select_generic_integrator(IntegratorKind kind) {
-  return kind == IntegratorKind::kDistributed ? kDistributedTable[kFeatureAll]
-                                              : kPathTable[kFeatureAll];
+  return ScalarInstantiations::select(kind, kFeatureAll);
 }
 
 }  // namespace penumbra

@@ -5,9 +5,11 @@
 // packets). A path's state between bounces is a PathState; the visibility test of its
 // next-event estimate is handed back as a ShadowQuery for the driver to trace, so a driver can
 // batch them. Both drivers run exactly these steps in this order, so they give the same image.
+#include <array>
 #include <climits>
 #include <cstdint>
 #include <optional>
+#include <utility>
 
 #include "renderer/core/frame.h"
 #include "renderer/core/ray.h"
@@ -40,6 +42,25 @@ enum IntegratorFeature : uint32_t {
   kFeatureEnvironment = 1u << 2,   // escaping rays gather the environment
   kFeatureLights = 1u << 3,        // next-event estimation (any light at all)
   kFeatureAll = (1u << 4) - 1,
+};
+
+// A driver's instantiations, one per integrator kind and feature mask, and the choice among
+// them: Kernel<kDistributed, kFeatures>::fn is the driver's function of that instantiation (a
+// class template, since a function template cannot be passed as a template argument).
+template <typename Fn, template <bool, uint32_t> class Kernel>
+class FeatureInstantiations {
+ public:
+  static Fn select(IntegratorKind kind, uint32_t mask) {
+    return kind == IntegratorKind::kDistributed ? kDistributed[mask] : kPath[mask];
+  }
+
+ private:
+  template <bool kDistributedKind, size_t... kMasks>
+  static constexpr std::array<Fn, sizeof...(kMasks)> table(std::index_sequence<kMasks...>) {
+    return {Kernel<kDistributedKind, uint32_t(kMasks)>::fn...};
+  }
+  static constexpr auto kPath = table<false>(std::make_index_sequence<kFeatureAll + 1>{});
+  static constexpr auto kDistributed = table<true>(std::make_index_sequence<kFeatureAll + 1>{});
 };
 
 // What a path carries from one bounce to the next.

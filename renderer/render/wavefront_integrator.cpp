@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <array>
 #include <numeric>
-#include <utility>
 
 #include "renderer/render/integrator.h"
 
@@ -91,23 +90,20 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
 
 namespace {
 
-template <bool kDistributed, size_t... kMasks>
-constexpr std::array<IntegrateBatchFn, sizeof...(kMasks)> make_table(std::index_sequence<kMasks...>) {
-  return {&integrate_batch<kDistributed, uint32_t(kMasks)>...};
-}
-constexpr auto kPathTable = make_table<false>(std::make_index_sequence<kFeatureAll + 1>{});
-constexpr auto kDistributedTable = make_table<true>(std::make_index_sequence<kFeatureAll + 1>{});
+template <bool kDistributed, uint32_t kFeatures>
+struct BatchKernel {
+  static constexpr IntegrateBatchFn fn = &integrate_batch<kDistributed, kFeatures>;
+};
+using BatchInstantiations = FeatureInstantiations<IntegrateBatchFn, BatchKernel>;
 
 }  // namespace
 
 IntegrateBatchFn select_batch_integrator(IntegratorKind kind, const SceneFeatures& features) {
-  const uint32_t mask = integrator_feature_mask(features);
-  return kind == IntegratorKind::kDistributed ? kDistributedTable[mask] : kPathTable[mask];
+  return BatchInstantiations::select(kind, integrator_feature_mask(features));
 }
 
 IntegrateBatchFn select_generic_batch_integrator(IntegratorKind kind) {
-  return kind == IntegratorKind::kDistributed ? kDistributedTable[kFeatureAll]
-                                              : kPathTable[kFeatureAll];
+  return BatchInstantiations::select(kind, kFeatureAll);
 }
 
 }  // namespace penumbra
