@@ -91,7 +91,7 @@ namespace path_step_detail {
 // A direction pair is usable only if the shading frame and the true surface agree on whether it
 // reflects or transmits; otherwise shading normals would leak light through surfaces
 // (Veach 1997 section 5.3).
-inline bool geometry_agrees(const vec3& wi_world, const vec3& wo_world, const vec3& ng,
+[[gnu::always_inline]] inline bool geometry_agrees(const vec3& wi_world, const vec3& wo_world, const vec3& ng,
                             const vec3& wi_local, const vec3& wo_local) {
   const float geo = glm::dot(wi_world, ng) * glm::dot(wo_world, ng);
   const float shade = wi_local.z * wo_local.z;
@@ -167,9 +167,11 @@ inline void path_escaped(const Scene& scene, PathState& s, FirstHit* first) {
 // The path's ray hit `hit`: emission, next-event estimation (its visibility test returned in
 // *shadow when `*has_shadow`), then the BSDF's sample for the next segment and Russian roulette.
 // Returns whether the path goes on with s.ray.
-template <bool kDistributed, uint32_t kFeatures>
+// `sampler`: a Sampler, or anything with its get_1d/get_2d (the wavefront driver's
+// PrefetchedSampler hands out values computed for a whole bounce at once).
+template <bool kDistributed, uint32_t kFeatures, class PathSampler>
 inline bool path_hit(const Scene& scene, const IntegratorSettings& settings, PathState& s,
-                     SurfaceHit& hit, Sampler& sampler, PathCounters& counters, FirstHit* first,
+                     SurfaceHit& hit, PathSampler& sampler, PathCounters& counters, FirstHit* first,
                      ShadowQuery* shadow, bool* has_shadow) {
   using namespace path_step_detail;
   *has_shadow = false;

@@ -54,8 +54,15 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
     }
     counters.rays += live.size();
 
+    // The sampler values the paths that hit something will take, for all of them at once.
+    BounceSamples& samples = b.samples_;
+    samples.start(live.size());
+    for (size_t k = 0; k < live.size(); ++k)
+      if (b.found_[k]) samples.add(*b.samplers_[live[k]], b.cursors_[live[k]]);
+    samples.compute();
+
     // Shade: every live path takes its step; the survivors are kept in order.
-    size_t survivors = 0, shadows = 0;
+    size_t survivors = 0, shadows = 0, hit_index = 0;
     for (size_t k = 0; k < live.size(); ++k) {
       const uint32_t p = live[k];
       PathState& s = b.states_[p];
@@ -64,8 +71,9 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
         path_escaped<kFeatures>(scene, s, first);
         continue;
       }
-      Sampler& sampler = *b.samplers_[p];
-      sampler.resume(b.cursors_[p]);
+      PrefetchedSampler sampler(*b.samplers_[p], b.cursors_[p], samples.x(hit_index),
+                                samples.y(hit_index));
+      ++hit_index;
       bool has_shadow;
       const bool goes_on = path_hit<kDistributed, kFeatures>(
           scene, settings, s, b.hits_[k], sampler, counters, first, &b.shadows_[shadows], &has_shadow);

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "renderer/render/path_step.h"
+#include "renderer/sampling/sobol_batch.h"
 
 namespace penumbra {
 
@@ -45,6 +46,7 @@ class PathBatch {
   std::vector<uint8_t> found_;
   std::vector<ShadowQuery> shadows_;
   std::vector<uint32_t> shadow_paths_;
+  BounceSamples samples_;  // the sampler values of the bounce's paths that hit something
 };
 
 using IntegrateBatchFn = void (*)(const Scene& scene, const IntegratorSettings& settings,

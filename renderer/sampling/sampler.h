@@ -3,6 +3,7 @@
 // Scrambling", JCGT 9(4)). Every value is a pure function of (seed, pixel, sample index,
 // dimension), so images do not depend on threads, tiles or the order samples are taken in.
 #include <cstdint>
+#include <cstring>
 
 #include "renderer/core/math.h"
 
@@ -52,23 +53,44 @@ inline uint32_t sobol_dimension1_reference(uint32_t index) {
     if (index & 1u) result ^= v;
   return result;
 }
-// The same, a byte at a time: the generator matrix is linear over GF(2), so the image of each
-// index byte is looked up in a 4 x 256 table and the four parts XORed (scrambled indices use all
-// 32 bits, which made the bit loop the sampler's main cost).
-struct SobolDimension1Table {
-  uint32_t entries[4][256];
-  SobolDimension1Table() {
-    for (int k = 0; k < 4; ++k)
-      for (uint32_t b = 0; b < 256; ++b) entries[k][b] = sobol_dimension1_reference(b << (8 * k));
-  }
-};
-inline uint32_t sobol_dimension1(uint32_t index) {
-  static const SobolDimension1Table table;
-  return table.entries[0][index & 0xffu] ^ table.entries[1][(index >> 8) & 0xffu] ^
-         table.entries[2][(index >> 16) & 0xffu] ^ table.entries[3][index >> 24];
+// The same without a loop. Column k of this dimension's generator matrix is row k of Pascal's
+// triangle mod 2 read from the top bit (the recurrence is Pascal's rule), so output bit 31 - j is
+// the parity of the index bits k with C(k, j) odd, which by Lucas' theorem are the k whose bits
+// contain j's. That parity for all j at once is the superset-sum transform over GF(2): five
+// shift-and-XOR steps, one per bit of j. So the dimension is a bit reversal of that transform,
+// and a scramble applied in reversed order cancels the reversal (scrambled_sobol_y).
+inline uint32_t superset_parity(uint32_t x) {
+  x ^= (x >> 1) & 0x55555555u;
+  x ^= (x >> 2) & 0x33333333u;
+  x ^= (x >> 4) & 0x0f0f0f0fu;
+  x ^= (x >> 8) & 0x00ff00ffu;
+  x ^= (x >> 16) & 0x0000ffffu;
+  return x;
 }
+inline uint32_t sobol_dimension1(uint32_t index) { return reverse_bits32(superset_parity(index)); }
 
-inline float fixed_to_unit_float(uint32_t x) { return float(x >> 8) * 0x1p-24f; }
+inline float fixed_to_unit_float(uint32_t x) { return float(int32_t(x >> 8)) * 0x1p-24f; }
+
+// The scrambling seeds of one (pixel, dimension): the sample index's shuffle and the two
+// coordinates' scrambles.
+struct DimensionScramble {
+  uint32_t index, x, y;
+};
+
+// One scrambled Sobol point of a dimension pair: the sample index is shuffled by a nested uniform
+// scramble (Burley 2020, section 4), then both coordinates are scrambled. Shared by
+// Sampler::get_1d/get_2d and the batch kernel (sobol_batch.h), which must agree to the bit.
+inline uint32_t shuffled_sample_index(uint32_t index, uint32_t seed) {
+  return nested_uniform_scramble(index, seed);
+}
+inline float scrambled_sobol_x(uint32_t shuffled, uint32_t seed) {
+  // nested_uniform_scramble(reverse(i)) = reverse(LK(i)): two reversals cancel.
+  return fixed_to_unit_float(reverse_bits32(laine_karras_permutation(shuffled, seed)));
+}
+inline float scrambled_sobol_y(uint32_t shuffled, uint32_t seed) {
+  // nested_uniform_scramble(sobol_dimension1(i)) = reverse(LK(superset_parity(i))).
+  return fixed_to_unit_float(reverse_bits32(laine_karras_permutation(superset_parity(shuffled), seed)));
+}
 
 // hash_combine(seed, d)'s hash of d for the dimensions the sampler caches: one of its two mixes,
 // done at compile time (each pixel's first sample of a pass hashes every dimension it uses).
@@ -112,39 +134,59 @@ class Sampler {
   }
 
   float get_1d() {
-    const DimensionSeeds& h = seeds(dimension_++);
-    const uint32_t shuffled = nested_uniform_scramble(index_, uint32_t(h.a));
-    // nested_uniform_scramble(reverse(i)) = reverse(LK(i)): two reversals cancel.
-    return fixed_to_unit_float(reverse_bits32(laine_karras_permutation(shuffled, uint32_t(h.a >> 32))));
+    const DimensionScramble h = scramble(dimension_++);
+    return scrambled_sobol_x(shuffled_sample_index(index_, h.index), h.x);
   }
 
   vec2 get_2d() {
-    const DimensionSeeds& h = seeds(dimension_++);
-    const uint32_t shuffled = nested_uniform_scramble(index_, uint32_t(h.a));
-    return vec2(
-        fixed_to_unit_float(reverse_bits32(laine_karras_permutation(shuffled, uint32_t(h.a >> 32)))),
-        fixed_to_unit_float(nested_uniform_scramble(sobol_dimension1(shuffled), uint32_t(h.b))));
+    const DimensionScramble h = scramble(dimension_++);
+    const uint32_t shuffled = shuffled_sample_index(index_, h.index);
+    return vec2(scrambled_sobol_x(shuffled, h.x), scrambled_sobol_y(shuffled, h.y));
+  }
+
+  // The seeds of a dimension of the current pixel (the batch kernel takes them from here).
+  DimensionScramble scramble(uint64_t dimension) {
+    if (dimension < kCachedDimensions) {
+      fill_cache(dimension);
+      return DimensionScramble{cache_index_[dimension], cache_x_[dimension], cache_y_[dimension]};
+    }
+    return scramble_of(hash_combine(pixel_seed_, dimension));
+  }
+  // Those of `count` consecutive dimensions from `first`, as three arrays.
+  template <int count>
+  void scrambles(uint64_t first, uint32_t* index, uint32_t* x, uint32_t* y) {
+    static_assert(count > 0 && count < int(kCachedDimensions));
+    constexpr uint64_t kBlock = (uint64_t(1) << count) - 1;
+    if (first + count <= kCachedDimensions && ((cached_ >> first) & kBlock) == kBlock) {
+      std::memcpy(index, &cache_index_[first], sizeof(uint32_t) * count);
+      std::memcpy(x, &cache_x_[first], sizeof(uint32_t) * count);
+      std::memcpy(y, &cache_y_[first], sizeof(uint32_t) * count);
+      return;
+    }
+    for (int j = 0; j < count; ++j) {
+      const DimensionScramble h = scramble(first + uint64_t(j));
+      index[j] = h.index;
+      x[j] = h.x;
+      y[j] = h.y;
+    }
   }
 
  private:
-  struct DimensionSeeds {
-    uint64_t a, b;
-  };
   static constexpr uint64_t kCachedDimensions = SamplerDimensionKeys::kCount;
 
-  const DimensionSeeds& seeds(uint64_t dimension) {
-    if (dimension < kCachedDimensions) {
-      DimensionSeeds& s = cache_[dimension];
-      if (!((cached_ >> dimension) & 1u)) {
-        s.a = mix64(pixel_seed_ ^ kSamplerDimensionKeys.key[dimension]);  // = hash_combine(pixel_seed_, dimension)
-        s.b = mix64(s.a);
-        cached_ |= uint64_t(1) << dimension;
-      }
-      return s;
-    }
-    overflow_.a = hash_combine(pixel_seed_, dimension);
-    overflow_.b = mix64(overflow_.a);
-    return overflow_;
+  // A dimension's 64-bit hash a gives the index shuffle (low half) and the first coordinate's
+  // scramble (high half); mix64(a) the second's.
+  static DimensionScramble scramble_of(uint64_t a) {
+    return DimensionScramble{uint32_t(a), uint32_t(a >> 32), uint32_t(mix64(a))};
+  }
+  void fill_cache(uint64_t dimension) {
+    if ((cached_ >> dimension) & 1u) return;
+    // = hash_combine(pixel_seed_, dimension)
+    const DimensionScramble h = scramble_of(mix64(pixel_seed_ ^ kSamplerDimensionKeys.key[dimension]));
+    cache_index_[dimension] = h.index;
+    cache_x_[dimension] = h.x;
+    cache_y_[dimension] = h.y;
+    cached_ |= uint64_t(1) << dimension;
   }
 
   uint64_t seed_;
@@ -153,8 +195,8 @@ class Sampler {
   uint32_t index_ = 0;
   uint64_t dimension_ = 0;
   uint64_t cached_ = 0;  // bit d set: cache_[d] holds the seeds of dimension d for this pixel
-  DimensionSeeds cache_[kCachedDimensions];
-  DimensionSeeds overflow_{};
+  // The cached dimensions' seeds, by part (the batch kernel copies runs of them).
+  uint32_t cache_index_[kCachedDimensions], cache_x_[kCachedDimensions], cache_y_[kCachedDimensions];
 };
 
 }  // namespace penumbra

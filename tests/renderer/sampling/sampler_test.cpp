@@ -80,7 +80,7 @@ TEST(Sampler, PixelsAndDimensionsAreDecorrelated) {
 
 namespace penumbra::test {
 namespace {
-TEST(Sampler, TableDrivenSobolMatchesBitLoop) {
+TEST(Sampler, ClosedFormSobolDimension1MatchesBitLoop) {
   uint32_t x = 12345;
   for (int i = 0; i < 100000; ++i) {
     x = x * 1664525u + 1013904223u;

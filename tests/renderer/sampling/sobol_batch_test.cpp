@@ -1,0 +1,106 @@
+#include "renderer/sampling/sobol_batch.h"
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <vector>
+
+namespace penumbra::test {
+namespace {
+
+uint32_t float_bits(float f) {
+  uint32_t u;
+  std::memcpy(&u, &f, sizeof u);
+  return u;
+}
+
+// The batch kernel runs whichever SIMD clone this CPU selects; its values must be the scalar
+// sampler's to the bit, for any index and seeds (sizes not a multiple of any vector width).
+TEST(SobolBatch, KernelIsTheScalarSamplerToTheBit) {
+  for (size_t n : {1u, 7u, 16u, 37u, 1280u}) {
+    std::vector<uint32_t> index(n), si(n), sx(n), sy(n);
+    uint32_t r = 2463534242u + uint32_t(n);
+    auto next = [&r] {
+      r ^= r << 13;
+      r ^= r >> 17;
+      r ^= r << 5;
+      return r;
+    };
+    for (size_t i = 0; i < n; ++i) {
+      index[i] = i % 3 == 0 ? uint32_t(i) : next();
+      si[i] = next();
+      sx[i] = next();
+      sy[i] = next();
+    }
+    std::vector<float> x(n), y(n);
+    scrambled_sobol_batch(n, index.data(), si.data(), sx.data(), sy.data(), x.data(), y.data());
+    for (size_t i = 0; i < n; ++i) {
+      const uint32_t shuffled = nested_uniform_scramble(index[i], si[i]);
+      // The definitions: Burley's nested uniform scramble of each Sobol coordinate.
+      const float ex = fixed_to_unit_float(nested_uniform_scramble(sobol_dimension0(shuffled), sx[i]));
+      const float ey = fixed_to_unit_float(nested_uniform_scramble(sobol_dimension1_reference(shuffled), sy[i]));
+      ASSERT_EQ(float_bits(x[i]), float_bits(ex)) << "n " << n << " entry " << i;
+      ASSERT_EQ(float_bits(y[i]), float_bits(ey)) << "n " << n << " entry " << i;
+    }
+  }
+}
+
+// Paths of one pixel interleaved through BounceSamples/PrefetchedSampler take the values a
+// Sampler gives each path alone: within the prefetched dimensions, past them (the fallback), and
+// across the end of the sampler's cached dimensions (64).
+TEST(SobolBatch, PrefetchedPathsSeeTheSamplersSequence) {
+  constexpr int kPaths = 6;
+  Sampler shared(42), alone(42);
+  shared.start_pixel_sample(3, 5, 0);
+  std::vector<Sampler::Cursor> cursors;
+  for (int p = 0; p < kPaths; ++p) {
+    shared.start_pixel_sample(3, 5, uint32_t(p * 11));
+    cursors.push_back(shared.cursor());
+  }
+  std::vector<std::vector<float>> expected(kPaths), got(kPaths);
+  // Bounces taking 1d,2d,1d,2d,1d (five dimensions), then seven (two past the prefetch), from
+  // dimension 0 until well past 64.
+  const int pattern[] = {1, 2, 1, 2, 1, 2, 1};
+  for (int bounce = 0; bounce < 14; ++bounce) {
+    const int takes = bounce % 2 ? 7 : 5;
+    BounceSamples samples;
+    samples.start(kPaths);
+    for (int p = 0; p < kPaths; ++p) samples.add(shared, cursors[p]);
+    samples.compute();
+    for (int p = 0; p < kPaths; ++p) {
+      PrefetchedSampler s(shared, cursors[p], samples.x(size_t(p)), samples.y(size_t(p)));
+      for (int j = 0; j < takes; ++j) {
+        if (pattern[j] == 1) {
+          got[p].push_back(s.get_1d());
+        } else {
+          const vec2 u = s.get_2d();
+          got[p].push_back(u.x);
+          got[p].push_back(u.y);
+        }
+      }
+      cursors[p] = s.cursor();
+    }
+  }
+  for (int p = 0; p < kPaths; ++p) {
+    alone.start_pixel_sample(3, 5, uint32_t(p * 11));
+    for (int bounce = 0; bounce < 14; ++bounce) {
+      const int takes = bounce % 2 ? 7 : 5;
+      for (int j = 0; j < takes; ++j) {
+        if (pattern[j] == 1) {
+          expected[p].push_back(alone.get_1d());
+        } else {
+          const vec2 u = alone.get_2d();
+          expected[p].push_back(u.x);
+          expected[p].push_back(u.y);
+        }
+      }
+    }
+    EXPECT_GT(alone.cursor().dimension, 64u);
+    ASSERT_EQ(got[p].size(), expected[p].size());
+    for (size_t i = 0; i < got[p].size(); ++i)
+      ASSERT_EQ(float_bits(got[p][i]), float_bits(expected[p][i])) << "path " << p << " value " << i;
+  }
+}
+
+}  // namespace
+}  // namespace penumbra::test
