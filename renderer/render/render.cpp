@@ -14,6 +14,7 @@
 #include "renderer/render/integrator.h"
 #include "renderer/denoise/denoise_result.h"
 #include "renderer/render/output_layers.h"
+#include "renderer/render/camera_stage.h"
 #include "renderer/render/thin_lens_camera.h"
 #include "renderer/render/wavefront_integrator.h"
 
@@ -219,11 +220,13 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
             // the film takes each batch's results in that order, as the scalar loop adds them.
             const size_t capacity = std::min(kWavefrontBatch, (items[item + 1] - items[item]) * size_t(s1 - s0));
             PathBatch batch(capacity, first != nullptr);
+            CameraStage camera_stage(camera, sample_lens, sample_time, capacity);
             std::vector<Sampler> samplers;
             samplers.reserve(capacity);
             std::vector<uint32_t> batch_pixels;
             batch_pixels.reserve(capacity);
             auto flush = [&] {
+              camera_stage.generate(batch);
               integrate_batch(scene, isettings, batch, counters);
               for (size_t i = 0; i < batch.size(); ++i) {
                 const uint32_t pi = batch_pixels[i];
@@ -237,13 +240,16 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
               batch_pixels.clear();
             };
             for_each_sample([&](uint32_t pi, int fx, int fy, uint32_t s) {
-              if (batch.full()) flush();
-              if (samplers.empty() || batch_pixels.back() != pi) samplers.emplace_back(settings.seed);
-              Sampler& sampler = samplers.back();
-              batch.add(camera_ray(sampler, window.x0 + fx, window.y0 + fy, s), &sampler);
+              if (batch_pixels.size() >= capacity) flush();
+              const int x = window.x0 + fx, y = window.y0 + fy;
+              if (samplers.empty() || batch_pixels.back() != pi) {
+                samplers.emplace_back(settings.seed);
+                samplers.back().start_pixel_sample(x, y, s);
+              }
+              camera_stage.add(&samplers.back(), x, y, s);
               batch_pixels.push_back(pi);
             });
-            if (batch.size()) flush();
+            if (!batch_pixels.empty()) flush();
           } else {
             Sampler sampler(settings.seed);
             for_each_sample([&](uint32_t, int fx, int fy, uint32_t s) {

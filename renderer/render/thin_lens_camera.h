@@ -17,6 +17,11 @@ class ThinLensCamera {
 
   // film: continuous pixel coordinates (x right, y down, [0,w)x[0,h)); lens, time: in [0,1).
   CameraRay generate_ray(const vec2& film, const vec2& lens, float time) const;
+  // generate_ray's origins and directions for n samples at once, to the bit (camera_batch.cpp):
+  // film positions (film_x, film_y), lens samples (lens_x, lens_y; ignored without an
+  // aperture); origin and direction components into out[0..5][i].
+  void generate_rays(size_t n, const float* film_x, const float* film_y, const float* lens_x,
+                     const float* lens_y, float* const out[6]) const;
   // The centre of the lens and the unit optical axis (z-depth is measured along it).
   const vec3& position() const { return position_; }
   const vec3& forward() const { return forward_; }

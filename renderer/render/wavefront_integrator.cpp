@@ -28,10 +28,10 @@ void PathBatch::clear() {
   firsts_.clear();
 }
 
-void PathBatch::add(const Ray& camera_ray, Sampler* sampler) {
+void PathBatch::add(const Ray& camera_ray, Sampler* sampler, const Sampler::Cursor& cursor) {
   states_.emplace_back(camera_ray);
   samplers_.push_back(sampler);
-  cursors_.push_back(sampler->cursor());
+  cursors_.push_back(cursor);
   if (record_first_hits_) firsts_.emplace_back();
 }
 
@@ -71,9 +71,7 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
         path_escaped<kFeatures>(scene, s, first);
         continue;
       }
-      PrefetchedSampler sampler(*b.samplers_[p], b.cursors_[p], samples.x(hit_index),
-                                samples.y(hit_index));
-      ++hit_index;
+      PrefetchedSampler sampler(*b.samplers_[p], b.cursors_[p], samples, hit_index++);
       bool has_shadow;
       const bool goes_on = path_hit<kDistributed, kFeatures>(
           scene, settings, s, b.hits_[k], sampler, counters, first, &b.shadows_[shadows], &has_shadow);

@@ -24,7 +24,9 @@ class PathBatch {
   // A camera sample: its ray and its pixel's sampler, positioned after the dimensions the camera
   // took. The sampler must stay on that pixel until the batch is integrated (other samples of the
   // same pixel may share it).
-  void add(const Ray& camera_ray, Sampler* sampler);
+  void add(const Ray& camera_ray, Sampler* sampler) { add(camera_ray, sampler, sampler->cursor()); }
+  // The same with the sample's cursor given (the camera stage's samplers are not moved).
+  void add(const Ray& camera_ray, Sampler* sampler, const Sampler::Cursor& cursor);
 
   // After integrate: the path's radiance and, if recorded, its camera ray's first hit.
   const Spectrum& radiance(size_t i) const { return states_[i].radiance; }

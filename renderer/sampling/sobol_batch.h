@@ -19,17 +19,18 @@ namespace penumbra {
 void scrambled_sobol_batch(size_t n, const uint32_t* index, const uint32_t* seed_index,
                            const uint32_t* seed_x, const uint32_t* seed_y, float* x, float* y);
 
-// The values a bounce of many paths will take, computed together, and each path's view of them.
-// Entry block k holds path k's next kPerPath dimensions (a bounce takes at most five: light
-// choice, light point, lobe, direction, Russian roulette); a path that takes more than were
-// prefetched falls back to its sampler.
+// The values a step of many paths will take, computed together, and each path's view of them.
+// Entry block k holds path k's next per_path dimensions (a bounce takes at most five: light
+// choice, light point, lobe, direction, Russian roulette; the camera one to three); a path that
+// takes more than were prefetched falls back to its sampler.
 class BounceSamples {
  public:
-  static constexpr int kPerPath = 5;
+  static constexpr int kBounce = 5;
 
-  // Room for `paths` paths' values, from path 0.
-  void start(size_t paths) {
-    const size_t n = paths * kPerPath;
+  // Room for `paths` paths' values, per_path each, from path 0.
+  void start(size_t paths, int per_path = kBounce) {
+    per_path_ = per_path;
+    const size_t n = paths * size_t(per_path);
     if (index_.size() < n) {
       index_.resize(n);
       seed_index_.resize(n);
@@ -40,21 +41,31 @@ class BounceSamples {
     }
     paths_ = 0;
   }
-  // Queues the next path's next kPerPath dimensions: `sampler` on the path's pixel, at `cursor`.
+  // Queues the next path's next per_path dimensions: `sampler` on the path's pixel, at `cursor`.
   void add(Sampler& sampler, const Sampler::Cursor& cursor) {
-    const size_t e = paths_++ * kPerPath;
-    for (int j = 0; j < kPerPath; ++j) index_[e + j] = cursor.index;
-    sampler.scrambles<kPerPath>(cursor.dimension, &seed_index_[e], &seed_x_[e], &seed_y_[e]);
+    const size_t e = paths_++ * size_t(per_path_);
+    for (int j = 0; j < per_path_; ++j) index_[e + j] = cursor.index;
+    if (per_path_ == kBounce)
+      sampler.scrambles<kBounce>(cursor.dimension, &seed_index_[e], &seed_x_[e], &seed_y_[e]);
+    else
+      for (int j = 0; j < per_path_; ++j) {
+        const DimensionScramble h = sampler.scramble(cursor.dimension + uint64_t(j));
+        seed_index_[e + j] = h.index;
+        seed_x_[e + j] = h.x;
+        seed_y_[e + j] = h.y;
+      }
   }
   // Computes every queued value.
   void compute() {
-    scrambled_sobol_batch(paths_ * kPerPath, index_.data(), seed_index_.data(), seed_x_.data(),
+    scrambled_sobol_batch(paths_ * size_t(per_path_), index_.data(), seed_index_.data(), seed_x_.data(),
                           seed_y_.data(), x_.data(), y_.data());
   }
-  const float* x(size_t path) const { return x_.data() + path * kPerPath; }
-  const float* y(size_t path) const { return y_.data() + path * kPerPath; }
+  const float* x(size_t path) const { return x_.data() + path * size_t(per_path_); }
+  const float* y(size_t path) const { return y_.data() + path * size_t(per_path_); }
+  int per_path() const { return per_path_; }
 
  private:
+  int per_path_ = kBounce;
   size_t paths_ = 0;
   std::vector<uint32_t> index_, seed_index_, seed_x_, seed_y_;
   std::vector<float> x_, y_;
@@ -64,11 +75,16 @@ class BounceSamples {
 // drop-in for Sampler in path_hit).
 class PrefetchedSampler {
  public:
-  PrefetchedSampler(Sampler& sampler, const Sampler::Cursor& cursor, const float* x, const float* y)
-      : sampler_(sampler), cursor_(cursor), x_(x), y_(y) {}
+  PrefetchedSampler(Sampler& sampler, const Sampler::Cursor& cursor, const BounceSamples& samples,
+                    size_t path)
+      : sampler_(sampler),
+        cursor_(cursor),
+        x_(samples.x(path)),
+        y_(samples.y(path)),
+        count_(samples.per_path()) {}
 
   float get_1d() {
-    if (used_ < BounceSamples::kPerPath) {
+    if (used_ < count_) {
       ++cursor_.dimension;
       return x_[used_++];
     }
@@ -78,7 +94,7 @@ class PrefetchedSampler {
     return u;
   }
   vec2 get_2d() {
-    if (used_ < BounceSamples::kPerPath) {
+    if (used_ < count_) {
       ++cursor_.dimension;
       const int j = used_++;
       return vec2(x_[j], y_[j]);
@@ -95,6 +111,7 @@ class PrefetchedSampler {
   Sampler::Cursor cursor_;
   const float* x_;
   const float* y_;
+  int count_;
   int used_ = 0;
 };
 

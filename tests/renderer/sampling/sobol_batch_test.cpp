@@ -64,11 +64,12 @@ TEST(SobolBatch, PrefetchedPathsSeeTheSamplersSequence) {
   for (int bounce = 0; bounce < 14; ++bounce) {
     const int takes = bounce % 2 ? 7 : 5;
     BounceSamples samples;
-    samples.start(kPaths);
+    // Five prefetched dimensions as a bounce has, or fewer as the camera stage asks for.
+    samples.start(kPaths, bounce % 3 == 2 ? 2 : BounceSamples::kBounce);
     for (int p = 0; p < kPaths; ++p) samples.add(shared, cursors[p]);
     samples.compute();
     for (int p = 0; p < kPaths; ++p) {
-      PrefetchedSampler s(shared, cursors[p], samples.x(size_t(p)), samples.y(size_t(p)));
+      PrefetchedSampler s(shared, cursors[p], samples, size_t(p));
       for (int j = 0; j < takes; ++j) {
         if (pattern[j] == 1) {
           got[p].push_back(s.get_1d());

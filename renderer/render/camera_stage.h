@@ -1,0 +1,41 @@
+#pragma once
+// The wavefront driver's camera stage: a batch's camera samples queued, then their sampler
+// dimensions (sobol_batch.h) and rays (ThinLensCamera::generate_rays) computed for all of them
+// at once, and handed to the PathBatch. Per sample the values and rays are those of the scalar
+// loop's start_pixel_sample, get_2d (film), get_2d (lens), get_1d (time), generate_ray, to the bit.
+#include <cstdint>
+#include <vector>
+
+#include "renderer/render/thin_lens_camera.h"
+#include "renderer/render/wavefront_integrator.h"
+#include "renderer/sampling/sobol_batch.h"
+
+namespace penumbra {
+
+class CameraStage {
+ public:
+  CameraStage(const ThinLensCamera& camera, bool sample_lens, bool sample_time, size_t capacity);
+
+  // Sample `index` of image pixel (x, y), with `sampler` on that pixel.
+  void add(Sampler* sampler, int x, int y, uint32_t index) {
+    queued_.push_back(Queued{sampler, x, y, index});
+  }
+  size_t size() const { return queued_.size(); }
+  // The queued samples' camera rays into `batch`, in the order they were queued; then empty.
+  void generate(PathBatch& batch);
+
+ private:
+  struct Queued {
+    Sampler* sampler;
+    int x, y;
+    uint32_t index;
+  };
+  const ThinLensCamera& camera_;
+  bool sample_lens_, sample_time_;
+  std::vector<Queued> queued_;
+  BounceSamples samples_;
+  std::vector<float> film_x_, film_y_, lens_x_, lens_y_, time_, rays_[6];
+  std::vector<Sampler::Cursor> cursors_;
+};
+
+}  // namespace penumbra
