@@ -8,7 +8,6 @@ CameraStage::CameraStage(const ThinLensCamera& camera, bool sample_lens, bool sa
   queued_.reserve(capacity);
   for (auto* v : {&film_x_, &film_y_, &lens_x_, &lens_y_, &time_}) v->resize(capacity);
   for (auto& v : rays_) v.resize(capacity);
-  cursors_.resize(capacity);
 }
 
 void CameraStage::generate(PathBatch& batch) {
@@ -16,24 +15,24 @@ void CameraStage::generate(PathBatch& batch) {
   if (n > film_x_.size()) {
     for (auto* v : {&film_x_, &film_y_, &lens_x_, &lens_y_, &time_}) v->resize(n);
     for (auto& v : rays_) v.resize(n);
-    cursors_.resize(n);
   }
   // The camera's dimensions, in the scalar loop's order: film, lens, time.
   const int dims = 1 + int(sample_lens_) + int(sample_time_);
   samples_.start(n, dims);
   for (const Queued& q : queued_) samples_.add(*q.sampler, Sampler::Cursor{q.index, 0});
   samples_.compute();
+  // The values in the order the scalar loop takes them: film (2D), lens (2D), time (1D).
+  const int lens_dim = 1, time_dim = sample_lens_ ? 2 : 1;
   for (size_t i = 0; i < n; ++i) {
     const Queued& q = queued_[i];
-    PrefetchedSampler sampler(*q.sampler, Sampler::Cursor{q.index, 0}, samples_, i);
-    const vec2 film = vec2(float(q.x), float(q.y)) + sampler.get_2d();
+    const float* x = samples_.x(i);
+    const float* y = samples_.y(i);
+    const vec2 film = vec2(float(q.x), float(q.y)) + vec2(x[0], y[0]);
     film_x_[i] = film.x;
     film_y_[i] = film.y;
-    const vec2 lens = sample_lens_ ? sampler.get_2d() : vec2(0.5f);
-    lens_x_[i] = lens.x;
-    lens_y_[i] = lens.y;
-    time_[i] = sample_time_ ? sampler.get_1d() : 0.f;
-    cursors_[i] = sampler.cursor();
+    lens_x_[i] = sample_lens_ ? x[lens_dim] : 0.5f;
+    lens_y_[i] = sample_lens_ ? y[lens_dim] : 0.5f;
+    time_[i] = sample_time_ ? x[time_dim] : 0.f;
   }
   float* const out[6] = {rays_[0].data(), rays_[1].data(), rays_[2].data(),
                          rays_[3].data(), rays_[4].data(), rays_[5].data()};
@@ -41,7 +40,7 @@ void CameraStage::generate(PathBatch& batch) {
   for (size_t i = 0; i < n; ++i) {
     const Ray ray{vec3(rays_[0][i], rays_[1][i], rays_[2][i]),
                   vec3(rays_[3][i], rays_[4][i], rays_[5][i]), time_[i]};
-    batch.add(ray, queued_[i].sampler, cursors_[i]);
+    batch.add(ray, queued_[i].sampler, Sampler::Cursor{queued_[i].index, uint64_t(dims)});
   }
   queued_.clear();
 }

@@ -35,7 +35,6 @@ class CameraStage {
   std::vector<Queued> queued_;
   BounceSamples samples_;
   std::vector<float> film_x_, film_y_, lens_x_, lens_y_, time_, rays_[6];
-  std::vector<Sampler::Cursor> cursors_;
 };
 
 }  // namespace penumbra

@@ -28,13 +28,6 @@ void PathBatch::clear() {
   firsts_.clear();
 }
 
-void PathBatch::add(const Ray& camera_ray, Sampler* sampler, const Sampler::Cursor& cursor) {
-  states_.emplace_back(camera_ray);
-  samplers_.push_back(sampler);
-  cursors_.push_back(cursor);
-  if (record_first_hits_) firsts_.emplace_back();
-}
-
 template <bool kDistributed, uint32_t kFeatures>
 void integrate_batch(const Scene& scene, const IntegratorSettings& settings, PathBatch& b,
                      PathCounters& counters) {

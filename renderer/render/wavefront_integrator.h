@@ -26,7 +26,12 @@ class PathBatch {
   // same pixel may share it).
   void add(const Ray& camera_ray, Sampler* sampler) { add(camera_ray, sampler, sampler->cursor()); }
   // The same with the sample's cursor given (the camera stage's samplers are not moved).
-  void add(const Ray& camera_ray, Sampler* sampler, const Sampler::Cursor& cursor);
+  void add(const Ray& camera_ray, Sampler* sampler, const Sampler::Cursor& cursor) {
+    states_.emplace_back(camera_ray);
+    samplers_.push_back(sampler);
+    cursors_.push_back(cursor);
+    if (record_first_hits_) firsts_.emplace_back();
+  }
 
   // After integrate: the path's radiance and, if recorded, its camera ray's first hit.
   const Spectrum& radiance(size_t i) const { return states_[i].radiance; }
