@@ -83,30 +83,39 @@ class PrefetchedSampler {
         y_(samples.y(path)),
         count_(samples.per_path()) {}
 
-  float get_1d() {
+  // The prefetched values inline, the rare rest out of line: inlined whole, the fallback's
+  // sampler code made GCC call these from the bounce step instead.
+  [[gnu::always_inline]] float get_1d() {
     if (used_ < count_) {
       ++cursor_.dimension;
       return x_[used_++];
     }
-    sampler_.resume(cursor_);
-    const float u = sampler_.get_1d();
-    cursor_ = sampler_.cursor();
-    return u;
+    return fallback_1d();
   }
-  vec2 get_2d() {
+  [[gnu::always_inline]] vec2 get_2d() {
     if (used_ < count_) {
       ++cursor_.dimension;
       const int j = used_++;
       return vec2(x_[j], y_[j]);
     }
+    return fallback_2d();
+  }
+  Sampler::Cursor cursor() const { return cursor_; }
+
+ private:
+  [[gnu::noinline]] float fallback_1d() {
+    sampler_.resume(cursor_);
+    const float u = sampler_.get_1d();
+    cursor_ = sampler_.cursor();
+    return u;
+  }
+  [[gnu::noinline]] vec2 fallback_2d() {
     sampler_.resume(cursor_);
     const vec2 u = sampler_.get_2d();
     cursor_ = sampler_.cursor();
     return u;
   }
-  Sampler::Cursor cursor() const { return cursor_; }
 
- private:
   Sampler& sampler_;
   Sampler::Cursor cursor_;
   const float* x_;
