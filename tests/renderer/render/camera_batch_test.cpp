@@ -2,29 +2,18 @@
 // same rays to the bit, for pinhole and thin-lens cameras, any batch size.
 #include <gtest/gtest.h>
 
-#include <cstring>
 #include <vector>
 
 #include "renderer/render/thin_lens_camera.h"
+#include "tests/bit_exact_util.h"
 
 namespace penumbra::test {
 namespace {
 
-uint32_t bits(float f) {
-  uint32_t u;
-  std::memcpy(&u, &f, sizeof u);
-  return u;
-}
-
 void expect_batch_is_scalar(const CameraDesc& desc, int width, int height) {
   const ThinLensCamera camera(desc, width, height);
-  uint32_t r = 88172645u;
-  auto uniform = [&r] {
-    r ^= r << 13;
-    r ^= r >> 17;
-    r ^= r << 5;
-    return float(r >> 8) * 0x1p-24f;
-  };
+  XorShift32 random{88172645u};
+  auto uniform = [&random] { return random.uniform(); };
   for (size_t n : {1u, 5u, 16u, 33u, 300u}) {
     std::vector<float> fx(n), fy(n), lx(n), ly(n);
     for (size_t i = 0; i < n; ++i) {
@@ -40,8 +29,8 @@ void expect_batch_is_scalar(const CameraDesc& desc, int width, int height) {
     for (size_t i = 0; i < n; ++i) {
       const CameraRay ray = camera.generate_ray(vec2(fx[i], fy[i]), vec2(lx[i], ly[i]), 0.25f);
       for (int c = 0; c < 3; ++c) {
-        ASSERT_EQ(bits(out[c][i]), bits(ray.origin[c])) << "n " << n << " ray " << i << " origin " << c;
-        ASSERT_EQ(bits(out[3 + c][i]), bits(ray.direction[c])) << "n " << n << " ray " << i << " dir " << c;
+        ASSERT_EQ(float_bits(out[c][i]), float_bits(ray.origin[c])) << "n " << n << " ray " << i << " origin " << c;
+        ASSERT_EQ(float_bits(out[3 + c][i]), float_bits(ray.direction[c])) << "n " << n << " ray " << i << " dir " << c;
       }
     }
   }

@@ -2,16 +2,26 @@
 
 #include <gtest/gtest.h>
 
-#include <cstring>
 #include <vector>
+
+#include "tests/bit_exact_util.h"
 
 namespace penumbra::test {
 namespace {
 
-uint32_t float_bits(float f) {
-  uint32_t u;
-  std::memcpy(&u, &f, sizeof u);
-  return u;
+// Takes one bounce's values from `sampler` in the order `pattern` says (1: get_1d, 2: get_2d),
+// appending them to `out`.
+template <class S>
+void take(S& sampler, const int* pattern, int count, std::vector<float>* out) {
+  for (int j = 0; j < count; ++j) {
+    if (pattern[j] == 1) {
+      out->push_back(sampler.get_1d());
+    } else {
+      const vec2 u = sampler.get_2d();
+      out->push_back(u.x);
+      out->push_back(u.y);
+    }
+  }
 }
 
 // The batch kernel runs whichever SIMD clone this CPU selects; its values must be the scalar
@@ -19,13 +29,8 @@ uint32_t float_bits(float f) {
 TEST(SobolBatch, KernelIsTheScalarSamplerToTheBit) {
   for (size_t n : {1u, 7u, 16u, 37u, 1280u}) {
     std::vector<uint32_t> index(n), si(n), sx(n), sy(n);
-    uint32_t r = 2463534242u + uint32_t(n);
-    auto next = [&r] {
-      r ^= r << 13;
-      r ^= r >> 17;
-      r ^= r << 5;
-      return r;
-    };
+    XorShift32 random{2463534242u + uint32_t(n)};
+    auto next = [&random] { return random.next(); };
     for (size_t i = 0; i < n; ++i) {
       index[i] = i % 3 == 0 ? uint32_t(i) : next();
       si[i] = next();
@@ -70,32 +75,13 @@ TEST(SobolBatch, PrefetchedPathsSeeTheSamplersSequence) {
     samples.compute();
     for (int p = 0; p < kPaths; ++p) {
       PrefetchedSampler s(shared, cursors[p], samples, size_t(p));
-      for (int j = 0; j < takes; ++j) {
-        if (pattern[j] == 1) {
-          got[p].push_back(s.get_1d());
-        } else {
-          const vec2 u = s.get_2d();
-          got[p].push_back(u.x);
-          got[p].push_back(u.y);
-        }
-      }
+      take(s, pattern, takes, &got[p]);
       cursors[p] = s.cursor();
     }
   }
   for (int p = 0; p < kPaths; ++p) {
     alone.start_pixel_sample(3, 5, uint32_t(p * 11));
-    for (int bounce = 0; bounce < 14; ++bounce) {
-      const int takes = bounce % 2 ? 7 : 5;
-      for (int j = 0; j < takes; ++j) {
-        if (pattern[j] == 1) {
-          expected[p].push_back(alone.get_1d());
-        } else {
-          const vec2 u = alone.get_2d();
-          expected[p].push_back(u.x);
-          expected[p].push_back(u.y);
-        }
-      }
-    }
+    for (int bounce = 0; bounce < 14; ++bounce) take(alone, pattern, bounce % 2 ? 7 : 5, &expected[p]);
     EXPECT_GT(alone.cursor().dimension, 64u);
     ASSERT_EQ(got[p].size(), expected[p].size());
     for (size_t i = 0; i < got[p].size(); ++i)
