@@ -69,6 +69,8 @@ inline uint32_t superset_parity(uint32_t x) {
 }
 inline uint32_t sobol_dimension1(uint32_t index) { return reverse_bits32(superset_parity(index)); }
 
+// The top 24 bits as a float in [0, 1). x >> 8 < 2^24 converts exactly; through int32, so that
+// vector code can use the signed conversion (SSE2 and AVX2 have no unsigned one).
 inline float fixed_to_unit_float(uint32_t x) { return float(int32_t(x >> 8)) * 0x1p-24f; }
 
 // The scrambling seeds of one (pixel, dimension): the sample index's shuffle and the two
