@@ -8,17 +8,12 @@
 #include <cmath>
 #include <vector>
 
+#include "renderer/core/simd_clones.h"
 #include "renderer/render/thin_lens_camera.h"
 #include "renderer/sampling/sampling.h"
 
 namespace penumbra {
 namespace {
-
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-#define PENUMBRA_SIMD_CLONES __attribute__((target_clones("default", "arch=x86-64-v3", "arch=x86-64-v4")))
-#else
-#define PENUMBRA_SIMD_CLONES
-#endif
 
 struct CameraFrame {
   float px, py, pz, rx, ry, rz, ux, uy, uz, fx, fy, fz;

@@ -6,13 +6,11 @@ CameraStage::CameraStage(const ThinLensCamera& camera, bool sample_lens, bool sa
                          size_t capacity)
     : camera_(camera), sample_lens_(sample_lens), sample_time_(sample_time) {
   queued_.reserve(capacity);
-  for (auto* v : {&film_x_, &film_y_, &lens_x_, &lens_y_, &time_}) v->resize(capacity);
-  for (auto& v : rays_) v.resize(capacity);
 }
 
 void CameraStage::generate(PathBatch& batch) {
   const size_t n = queued_.size();
-  if (n > film_x_.size()) {
+  if (n > film_x_.size()) {  // the arrays grow to the largest batch once
     for (auto* v : {&film_x_, &film_y_, &lens_x_, &lens_y_, &time_}) v->resize(n);
     for (auto& v : rays_) v.resize(n);
   }

@@ -21,11 +21,9 @@ class PathBatch {
   size_t size() const { return states_.size(); }
   bool full() const { return states_.size() >= capacity_; }
   void clear();
-  // A camera sample: its ray and its pixel's sampler, positioned after the dimensions the camera
-  // took. The sampler must stay on that pixel until the batch is integrated (other samples of the
-  // same pixel may share it).
-  void add(const Ray& camera_ray, Sampler* sampler) { add(camera_ray, sampler, sampler->cursor()); }
-  // The same with the sample's cursor given (the camera stage's samplers are not moved).
+  // A camera sample: its ray, its pixel's sampler and the sample's cursor after the dimensions
+  // the camera took. The sampler must stay on that pixel until the batch is integrated (other
+  // samples of the same pixel share it).
   void add(const Ray& camera_ray, Sampler* sampler, const Sampler::Cursor& cursor) {
     states_.emplace_back(camera_ray);
     samplers_.push_back(sampler);

@@ -155,6 +155,16 @@ class Sampler {
     return scramble_of(hash_combine(pixel_seed_, dimension));
   }
   // Those of `count` consecutive dimensions from `first`, as three arrays.
+  void scrambles(uint64_t first, int count, uint32_t* index, uint32_t* x, uint32_t* y) {
+    for (int j = 0; j < count; ++j) {
+      const DimensionScramble h = scramble(first + uint64_t(j));
+      index[j] = h.index;
+      x[j] = h.x;
+      y[j] = h.y;
+    }
+  }
+  // The same for a count known at compile time (a bounce's): a run already cached is copied in
+  // a few moves.
   template <int count>
   void scrambles(uint64_t first, uint32_t* index, uint32_t* x, uint32_t* y) {
     static_assert(count > 0 && count < int(kCachedDimensions));
@@ -165,12 +175,7 @@ class Sampler {
       std::memcpy(y, &cache_y_[first], sizeof(uint32_t) * count);
       return;
     }
-    for (int j = 0; j < count; ++j) {
-      const DimensionScramble h = scramble(first + uint64_t(j));
-      index[j] = h.index;
-      x[j] = h.x;
-      y[j] = h.y;
-    }
+    scrambles(first, count, index, x, y);
   }
 
  private:

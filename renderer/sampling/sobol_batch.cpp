@@ -1,17 +1,11 @@
 #include "renderer/sampling/sobol_batch.h"
 
+#include "renderer/core/simd_clones.h"
+
 namespace penumbra {
 
-// GCC compiles the loop once per target and picks one at load time (an ifunc): baseline x86-64
-// (SSE2) for any CPU, x86-64-v3 (AVX2) and x86-64-v4 (AVX-512). Only integer operations and an
-// exact int-to-float conversion (no table lookups, so no gathers), so every clone gives the same bits. Other compilers (the
-// libFuzzer build uses clang) get the portable loop.
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-#define PENUMBRA_SIMD_CLONES __attribute__((target_clones("default", "arch=x86-64-v3", "arch=x86-64-v4")))
-#else
-#define PENUMBRA_SIMD_CLONES
-#endif
-
+// The loop is integer arithmetic and an exact int-to-float conversion (no table lookups, so no
+// gathers): every SIMD clone gives the same bits.
 namespace {
 
 PENUMBRA_SIMD_CLONES

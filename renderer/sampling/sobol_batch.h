@@ -48,12 +48,7 @@ class BounceSamples {
     if (per_path_ == kBounce)
       sampler.scrambles<kBounce>(cursor.dimension, &seed_index_[e], &seed_x_[e], &seed_y_[e]);
     else
-      for (int j = 0; j < per_path_; ++j) {
-        const DimensionScramble h = sampler.scramble(cursor.dimension + uint64_t(j));
-        seed_index_[e + j] = h.index;
-        seed_x_[e + j] = h.x;
-        seed_y_[e + j] = h.y;
-      }
+      sampler.scrambles(cursor.dimension, per_path_, &seed_index_[e], &seed_x_[e], &seed_y_[e]);
   }
   // Computes every queued value.
   void compute() {
