@@ -17,13 +17,15 @@ using mesh_file_detail::fail;
 // 20-byte `t` (subdivision tag) line makes it allocate 8192 ints, floats and strings (~330 KB),
 // `g`/`o` lines copy whole shapes, `l`/`p` lines build their own index lists, `mtllib` opens
 // another file by any path. It stores a face's corner count in an unsigned char (a 256-gon reads
-// back as 0 corners) and reads indices with atoi (undefined beyond int). So before it sees the
+// back as 0 corners), reads indices with atoi and a number's decimal exponent into an int
+// (both undefined beyond int: "1e99999999999" overflows). So before it sees the
 // bytes, every line goes through the same line and statement rules tinyobjloader uses
 // (safeGetline: '\n', '\r' or "\r\n" ends a line; leading spaces and tabs skipped; a keyword is
 // followed by a space or tab), and
 //  - a line that is not v, vn, vt or f becomes a comment ('#' written over its first character);
 //  - v, vn, vt lines and faces are counted, and each face's corners (the runs of characters other
 //    than space, tab and '\r', which is how tinyobjloader splits them) recorded;
+//  - every digit run of a face and every exponent of a v, vn or vt line must fit an int;
 //  - the counts are held to the limits: then tinyobjloader's memory is a small multiple of them.
 
 struct Screened {
@@ -33,26 +35,50 @@ struct Screened {
 
 bool is_blank(char c) { return c == ' ' || c == '\t'; }
 
+// Steps over the digit run at p; false if its value does not fit an int.
+bool skip_int_digits(const char*& p, const char* end) {
+  uint64_t value = 0;
+  for (; p < end && *p >= '0' && *p <= '9'; ++p) {
+    value = value * 10 + uint64_t(*p - '0');
+    if (value > uint64_t(std::numeric_limits<int>::max())) return false;
+  }
+  return true;
+}
+
 // Counts a face's corners and checks that every number in it fits an int (tinyobjloader reads
 // them with atoi).
 uint64_t face_corners(const char* p, const char* end, uint64_t line, const std::string& name) {
   uint64_t corners = 0;
   bool in_corner = false;
-  for (; p < end && *p != '\0'; ++p) {
+  while (p < end && *p != '\0') {
     const bool separator = is_blank(*p) || *p == '\r';
     if (!separator && !in_corner) ++corners;
     in_corner = !separator;
     if (*p >= '0' && *p <= '9') {
-      uint64_t value = 0;
-      for (; p < end && *p >= '0' && *p <= '9'; ++p) {
-        value = value * 10 + uint64_t(*p - '0');
-        if (value > uint64_t(std::numeric_limits<int>::max()))
-          fail(name, "line " + std::to_string(line) + ": a face index is too large");
-      }
-      --p;
+      if (!skip_int_digits(p, end))
+        fail(name, "line " + std::to_string(line) + ": a face index is too large");
+    } else {
+      ++p;
     }
   }
   return corners;
+}
+
+// Checks that every exponent on a v, vn or vt line fits an int. tinyobjloader's number parser
+// accumulates the digits after 'e' or 'E' (and an optional sign) in an int; an 'e' right after a
+// digit or '.' is where it can get there. Any other 'e' is not a number to it, so stricter is
+// harmless.
+void check_exponents(const char* p, const char* end, uint64_t line, const std::string& name) {
+  for (const char* begin = p; p < end && *p != '\0'; ++p) {
+    if ((*p != 'e' && *p != 'E') || p == begin) continue;
+    const char before = p[-1];
+    if (!(before >= '0' && before <= '9') && before != '.') continue;
+    const char* q = p + 1;
+    if (q < end && (*q == '+' || *q == '-')) ++q;
+    if (!skip_int_digits(q, end))
+      fail(name, "line " + std::to_string(line) + ": a number's exponent is too large");
+    p = q - 1;
+  }
 }
 
 Screened screen(std::string& bytes, const std::string& name, const MeshFileLimits& limits) {
@@ -74,12 +100,15 @@ Screened screen(std::string& bytes, const std::string& name, const MeshFileLimit
     if (c0 == 'v' && is_blank(c1)) {
       if (++s.positions > max_vertices)
         fail(name, "more than " + std::to_string(max_vertices) + " vertex positions (the limit)");
+      check_exponents(data + k + 2, data + end, line, name);
     } else if (c0 == 'v' && c1 == 'n' && is_blank(c2)) {
       if (++s.normals > max_vertices)
         fail(name, "more than " + std::to_string(max_vertices) + " normals (the vertex limit)");
+      check_exponents(data + k + 3, data + end, line, name);
     } else if (c0 == 'v' && c1 == 't' && is_blank(c2)) {
       if (++s.uvs > max_vertices)
         fail(name, "more than " + std::to_string(max_vertices) + " uvs (the vertex limit)");
+      check_exponents(data + k + 3, data + end, line, name);
     } else if (c0 == 'f' && is_blank(c1)) {
       const uint64_t corners = face_corners(data + k + 2, data + end, line, name);
       if (corners < 3)

@@ -138,6 +138,23 @@ TEST(ObjReader, NonFiniteNumbersAreErrors) {
                   "the normal is not finite");
 }
 
+// tinyobjloader adds up an exponent's digits in an int: past INT_MAX that is undefined behaviour
+// (found by the obj_reader fuzzer), so the screening refuses such numbers first.
+TEST(ObjReader, ExponentsBeyondIntAreErrors) {
+  const std::string rest = "v 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  EXPECT_CONTAINS(obj_error("v 0 0 2.5e99999999999\n" + rest),
+                  "line 1: a number's exponent is too large");
+  EXPECT_CONTAINS(obj_error("v 0 0 0\n" + rest + "vn 0 0 1.E-2147483648\n"),
+                  "line 5: a number's exponent is too large");
+  EXPECT_CONTAINS(obj_error("v 0 0 0\n" + rest + "vt 0 7e+2147483648\n"),
+                  "line 5: a number's exponent is too large");
+  // The largest exponent an int holds still parses (to an infinite coordinate, reported later).
+  EXPECT_CONTAINS(obj_error("v 0 0 1e2147483647\n" + rest), "the position is not finite");
+  EXPECT_EQ(obj_error("v 0 0 1e-0000000000000000000038\n" + rest), "");
+  // An 'e' that cannot start an exponent is not held to it.
+  EXPECT_EQ(obj_error("v 0 0 0 e99999999999\n" + rest), "");
+}
+
 TEST(ObjReader, Limits) {
   const std::string quad = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n";
   MeshFileLimits limits;
