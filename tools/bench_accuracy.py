@@ -14,8 +14,13 @@ Mitsuba reference (and "penumbra adaptive": one point per render.noise_threshold
 
 * ``<out>/bench.csv``   one row per render;
 * ``<out>/bench.png``   relMSE against seconds, log-log, one panel per scene, one line per renderer;
-* ``<out>/bench.md``    per scene the seconds each renderer needs to reach the same relMSE (fitted
-  on the ladder) and the ratio penumbra / fastest Mitsuba; also printed.
+* ``<out>/bench.md``    per scene the seconds each renderer needs to reach the same relMSE
+  (penumbra's at its largest spp; interpolated on each curve) and the ratio penumbra / fastest
+  Mitsuba; also printed.
+
+A curve that has not reached penumbra's error by its last point is extended (spp doubled, or the
+adaptive threshold divided by sqrt 2; at most ``--extend`` points), so times are interpolated
+between measured points; a time that still had to be extrapolated is marked "~" in the table.
 
 Seconds are comparable work on both sides: for penumbra the scene build plus the render as its
 summary line reports them (not process start or JSON parsing); for Mitsuba ``load_dict`` plus
@@ -177,6 +182,21 @@ def curve(rows: list[dict]) -> list[tuple[float, float]]:
     return sorted(pts)
 
 
+def penumbra_target(rows: list[dict], scene: str) -> float:
+    """The relMSE the table compares at: penumbra's (uniform) seed mean at its largest spp."""
+    pen = [r for r in rows if r["scene"] == scene and r["renderer"] == "penumbra"]
+    if not pen:
+        return math.nan
+    top = max(r["spp"] for r in pen)
+    return float(np.mean([r["relmse"] for r in pen if r["spp"] == top]))
+
+
+def brackets(rows: list[dict], target: float) -> bool:
+    """Whether a curve reaches ``target`` within its measured points (no extrapolation)."""
+    pts = curve(rows)
+    return bool(pts) and min(e for _, e in pts) <= target <= max(e for _, e in pts)
+
+
 def time_to_reach(rows: list[dict], target: float) -> float:
     """Seconds to reach relMSE ``target``: log-log interpolation between the two points of the
     ladder (seed means) that bracket it, or, outside the ladder, a least-squares line through
@@ -201,27 +221,31 @@ def summarise(rows: list[dict], scenes: list[str], renderers: list[str]) -> list
     """Markdown table: per scene, seconds to the relMSE penumbra reaches at its largest spp, for
     each renderer, and penumbra / fastest Mitsuba (and penumbra / Cycles when Cycles ran)."""
     cycles = "cycles" in renderers
+    adaptive = "penumbra adaptive" in renderers
     lines = ["| scene | target relMSE | " + " | ".join(f"{r} (s)" for r in renderers) + " | penumbra / fastest Mitsuba |"
-             + (" penumbra / cycles |" if cycles else ""),
-             "| --- | ---: | " + " | ".join("---:" for _ in renderers) + " | ---: |" + (" ---: |" if cycles else "")]
+             + (" adaptive / fastest Mitsuba |" if adaptive else "") + (" penumbra / cycles |" if cycles else ""),
+             "| --- | ---: | " + " | ".join("---:" for _ in renderers) + " | ---: |" + (" ---: |" if adaptive else "")
+             + (" ---: |" if cycles else "")]
     for scene in scenes:
-        pen = [r for r in rows if r["scene"] == scene and r["renderer"] == "penumbra"]
-        if not pen:
+        target = penumbra_target(rows, scene)
+        if math.isnan(target):
             continue
-        top = max(r["spp"] for r in pen)
-        target = float(np.mean([r["relmse"] for r in pen if r["spp"] == top]))
-        secs = {name: time_to_reach([r for r in rows if r["scene"] == scene and r["renderer"] == name], target)
-                for name in renderers}
+        of = {name: [r for r in rows if r["scene"] == scene and r["renderer"] == name] for name in renderers}
+        secs = {name: time_to_reach(of[name], target) for name in renderers}
+        # "~": the curve did not reach the target, its time is extrapolated (less certain)
+        mark = {name: "" if brackets(of[name], target) else "~" for name in renderers}
         mitsuba = [v for k, v in secs.items() if k.startswith("mitsuba") and not math.isnan(v)]
         ratio = secs["penumbra"] / min(mitsuba) if mitsuba else math.nan
+        adaptive_ratio = secs["penumbra adaptive"] / min(mitsuba) if mitsuba and adaptive else math.nan
         moving = any(r["instants"] > 1 for r in rows if r["scene"] == scene)
         own = {r["reference"] for r in rows if r["scene"] == scene and r["renderer"] == "cycles"
                and r.get("reference", "mitsuba") != "mitsuba"}
         notes = (["motion: Mitsuba averages instants"] if moving else []) + \
                 [f"Cycles against its own {ref.removeprefix('cycles ')}" for ref in sorted(own)]
         lines.append(f"| {scene}{' (' + '; '.join(notes) + ')' if notes else ''} | {target:.2e} | "
-                     + " | ".join("–" if math.isnan(secs[n]) else f"{secs[n]:.2f}" for n in renderers)
+                     + " | ".join("–" if math.isnan(secs[n]) else f"{mark[n]}{secs[n]:.2f}" for n in renderers)
                      + f" | {ratio:.2f} |"
+                     + (f" {adaptive_ratio:.2f} |" if adaptive else "")
                      + (f" {secs['penumbra'] / secs['cycles']:.2f} |" if cycles and not math.isnan(secs["cycles"])
                         else " – |" if cycles else ""))
     return lines
@@ -275,6 +299,9 @@ def main(argv: list[str]) -> int:
     ap.add_argument("--adaptive", default="0.1,0.05,0.03",
                     help="render.noise_threshold values for the 'penumbra adaptive' curve ('' to skip)")
     ap.add_argument("--adaptive-cap", type=int, default=1024, help="spp cap of the adaptive renders")
+    ap.add_argument("--extend", type=int, default=4,
+                    help="at most this many extra points (spp doubled, or threshold / sqrt 2) for a "
+                         "curve that has not reached penumbra's error yet")
     ap.add_argument("--cycles", metavar="BLENDER", default="",
                     help="add Blender Cycles (this blender executable) for the scenes it translates")
     ap.add_argument("--cycles-sphere-mesh", type=int, default=0, metavar="N",
@@ -352,7 +379,9 @@ def main(argv: list[str]) -> int:
                 run_penumbra(args.penumbra, scene_path, ladder[0], 0, mi)
             else:
                 run_mitsuba(renderer.split()[1], scene, max(ladder[0], instants), 0, instants)
-            for spp, threshold in points:
+            def measure(spp: int, threshold: float) -> float:
+                """One point of the curve over all seeds; returns its mean relMSE."""
+                errs = []
                 for seed in range(args.seeds):
                     start = time.perf_counter()
                     if renderer.startswith("penumbra"):
@@ -367,8 +396,30 @@ def main(argv: list[str]) -> int:
                            "seed": seed, "seconds": seconds, "instants": used_instants, **errors(image, reference),
                            "process_seconds": process, "reference": "mitsuba"}
                     rows.append(row)
+                    errs.append(row["relmse"])
                     print(f"{scene_name:13s} {renderer:20s} spp {spp:5d} t {threshold:g} seed {seed}: {seconds:7.3f} s  "
                           f"relMSE {row['relmse']:.3e}  FLIP {row['flip']:.4f}", flush=True)
+                return float(np.mean(errs))
+
+            last = math.inf
+            for spp, threshold in points:
+                last = measure(spp, threshold)
+            # Extend the curve until it brackets the target (penumbra's relMSE at its top spp,
+            # measured first), so the time to reach it is interpolated, not extrapolated: a line
+            # through a ladder whose cheap points are mostly fixed cost (start-up, kernel
+            # compilation) overstates how fast a renderer's error falls with time.
+            target = penumbra_target(rows, scene_name)
+            spp, threshold = points[-1]
+            for _ in range(args.extend):
+                if renderer == "penumbra" or not last > target:
+                    break
+                if adaptive:
+                    threshold /= math.sqrt(2.0)
+                else:
+                    spp *= 2
+                previous, last = last, measure(spp, threshold)
+                if not last < previous:  # an adaptive cap reached: no lower error to be had
+                    break
 
     with open(os.path.join(args.out, "bench.csv"), "w", newline="", encoding="utf-8") as f:
         writer = csv.DictWriter(f, fieldnames=list(rows[0]), restval="")
