@@ -10,6 +10,7 @@
 //  * `sample` returns the sampling weight f * |cos theta_o| / pdf (for delta lobes: the lobe's
 //    reflectance / transmittance divided by the discrete probability of choosing it).
 //  * `pdf` is the solid-angle density of `sample` restricted to the same mask, 0 for delta lobes.
+//  * `eval_pdf` returns both at once (BsdfEvalPdf), equal to the bit to the separate calls.
 //  * Opaque materials are two-sided: when wi.z < 0 they mirror both directions to the front.
 //    Dielectrics use the orientation: +z points out of the medium (the side with ior 1).
 //  * Radiance transport only (no adjoint); the 1/eta^2 factor of refraction is applied to
@@ -48,6 +49,15 @@ struct BsdfSample {
   float pdf = 0.f;   // solid-angle pdf (restricted to the context mask); 0 marks a delta lobe
   uint32_t lobe = 0; // exactly one BsdfLobe bit: the lobe that was sampled
   float eta = 1.f;   // relative ior crossed along wo (1 for reflection), for Russian roulette
+};
+
+// f(wi, wo) |cos theta_o| and the pdf of the same direction pair under one context: what eval and
+// pdf return, from one call that computes the terms they share (the half vector, D, G1(wi),
+// Fresnel, a coating's transmittance) once, as Mitsuba 3's BSDF::eval_pdf. Every model's
+// eval_pdf gives exactly (bit for bit) its eval and its pdf: the three share one body.
+struct BsdfEvalPdf {
+  Spectrum f{0.f};
+  float pdf = 0.f;
 };
 
 // The capability answers shared by every opaque model (all but the dielectric): two-sided, no

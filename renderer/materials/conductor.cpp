@@ -9,24 +9,42 @@ ConductorBsdf::ConductorBsdf(const Spectrum& color, float roughness)
       smooth_(roughness_to_alpha(roughness) < kMinMicrofacetAlpha),
       distr_(roughness_to_alpha(roughness)) {}
 
-Spectrum ConductorBsdf::eval(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const {
-  if (smooth_ || !(ctx.lobes & kLobeGlossyReflection) || wi.z <= 0.f || wo.z <= 0.f)
-    return Spectrum(0.f);
+template <bool kEval, bool kPdf>
+BsdfEvalPdf ConductorBsdf::evaluate(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const {
+  BsdfEvalPdf r;
+  if (smooth_ || !(ctx.lobes & kLobeGlossyReflection) || wi.z <= 0.f || wo.z <= 0.f) return r;
   const vec3 h = glm::normalize(wi + wo);
-  // Torrance-Sparrow / Walter et al. 2007 eq. 20, times cos(theta_o):
-  // f cos_o = F D G / (4 cos_i).
-  const float value = distr_.ndf(h) * distr_.smith_g(wi, wo, h) / (4.f * wi.z);
-  return std::isfinite(value) ? color_ * value : Spectrum(0.f);
+  // Shared by value and density: D(h), G1(wi, h) and the 4 cos_i of both denominators.
+  const float d = distr_.ndf(h);
+  const float g1_i = distr_.smith_g1(wi, h);
+  const float denom = 4.f * wi.z;
+  if constexpr (kEval) {
+    // Torrance-Sparrow / Walter et al. 2007 eq. 20, times cos(theta_o):
+    // f cos_o = F D G / (4 cos_i), with G = G1(wi, h) G1(wo, h) (microfacet.h).
+    const float value = d * (g1_i * distr_.smith_g1(wo, h)) / denom;
+    if (std::isfinite(value)) r.f = color_ * value;
+  }
+  if constexpr (kPdf) {
+    if (glm::dot(wo, h) > 0.f) {
+      // Visible-normal density times the reflection Jacobian 1 / (4 |wo.h|) (Walter et al. 2007
+      // eq. 14); wi.h = wo.h cancels against the |wi.h| of the visible-normal density.
+      const float p = d * g1_i / denom;
+      if (std::isfinite(p)) r.pdf = p;
+    }
+  }
+  return r;
+}
+
+Spectrum ConductorBsdf::eval(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const {
+  return evaluate<true, false>(ctx, wi, wo).f;
 }
 
 float ConductorBsdf::pdf(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const {
-  if (smooth_ || !(ctx.lobes & kLobeGlossyReflection) || wi.z <= 0.f || wo.z <= 0.f) return 0.f;
-  const vec3 h = glm::normalize(wi + wo);
-  if (glm::dot(wo, h) <= 0.f) return 0.f;
-  // Visible-normal density times the reflection Jacobian 1 / (4 |wo.h|) (Walter et al. 2007
-  // eq. 14); wi.h = wo.h cancels against the |wi.h| of the visible-normal density.
-  const float p = distr_.ndf(h) * distr_.smith_g1(wi, h) / (4.f * wi.z);
-  return std::isfinite(p) ? p : 0.f;
+  return evaluate<false, true>(ctx, wi, wo).pdf;
+}
+
+BsdfEvalPdf ConductorBsdf::eval_pdf(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const {
+  return evaluate<true, true>(ctx, wi, wo);
 }
 
 std::optional<BsdfSample> ConductorBsdf::sample(const BsdfContext& ctx, const vec3& wi, float,

@@ -21,10 +21,15 @@ class ConductorBsdf : public OpaqueBsdf {
   Spectrum albedo() const { return color_; }
   Spectrum eval(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
   float pdf(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
+  BsdfEvalPdf eval_pdf(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
   std::optional<BsdfSample> sample(const BsdfContext& ctx, const vec3& wi, float u_lobe,
                                    const vec2& u) const;
 
  private:
+  // The one body of eval (kEval), pdf (kPdf) and eval_pdf (both).
+  template <bool kEval, bool kPdf>
+  BsdfEvalPdf evaluate(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
+
   Spectrum color_;
   bool smooth_;
   GgxDistribution distr_;

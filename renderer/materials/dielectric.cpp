@@ -40,61 +40,70 @@ bool DielectricBsdf::half_vector(const vec3& wi, const vec3& wo, vec3& m, float&
   return glm::dot(wi, m) * wi.z > 0.f && glm::dot(wo, m) * wo.z > 0.f;
 }
 
-Spectrum DielectricBsdf::eval(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const {
-  if (index_matched_ || smooth_ || wi.z == 0.f || wo.z == 0.f) return Spectrum(0.f);
+template <bool kEval, bool kPdf>
+BsdfEvalPdf DielectricBsdf::evaluate(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const {
+  BsdfEvalPdf r;
+  if (index_matched_ || smooth_ || wi.z == 0.f || wo.z == 0.f) return r;
   vec3 m;
   float eta;
   bool is_reflection;
-  if (!half_vector(wi, wo, m, eta, is_reflection)) return Spectrum(0.f);
-  if (is_reflection ? !(ctx.lobes & kLobeGlossyReflection)
-                    : !(ctx.lobes & kLobeGlossyTransmission))
-    return Spectrum(0.f);
+  if (!half_vector(wi, wo, m, eta, is_reflection)) return r;
+  const bool has_r = ctx.lobes & kLobeGlossyReflection;
+  const bool has_t = ctx.lobes & kLobeGlossyTransmission;
+  if (is_reflection ? !has_r : !has_t) return r;
 
+  // Shared by value and density: D(m), G1(wi, m) (the visible-normal density's G1 of the front
+  // copy of wi is the same number: G1 depends on v only through v.z^2, v.x^2 + v.y^2 and the sign
+  // of (v.m) v.z, none of which negating v changes), the Fresnel term and the dot products.
   const float d = distr_.ndf(m);
-  const float g = distr_.smith_g(wi, wo, m);
-  const float f = fresnel_dielectric(glm::dot(wi, m), eta_).reflectance;
-  float value;
-  if (is_reflection) {
-    // Walter et al. 2007 eq. 20 times |cos_o|.
-    value = f * d * g / (4.f * std::abs(wi.z));
-  } else {
-    // Walter et al. 2007 eq. 21 times |cos_o|:
-    //   |wi.m||wo.m| eta^2 (1 - F) D G / (|cos_i| (wi.m + eta wo.m)^2),
-    // and the radiance scaling 1/eta^2 cancels the eta^2.
-    const float dot_i = glm::dot(wi, m), dot_o = glm::dot(wo, m);
-    const float denom = dot_i + eta * dot_o;
-    value = std::abs((1.f - f) * d * g * dot_i * dot_o / (wi.z * denom * denom));
+  const float g1_i = distr_.smith_g1(wi, m);
+  const float dot_i = glm::dot(wi, m), dot_o = glm::dot(wo, m);
+  // The value needs F always, the density only to choose between two enabled lobes.
+  float f = 0.f;
+  if (kEval || (has_r && has_t)) f = fresnel_dielectric(dot_i, eta_).reflectance;
+  const float denom = dot_i + eta * dot_o;  // refraction only
+
+  if constexpr (kEval) {
+    const float g = g1_i * distr_.smith_g1(wo, m);
+    float value;
+    if (is_reflection) {
+      // Walter et al. 2007 eq. 20 times |cos_o|.
+      value = f * d * g / (4.f * std::abs(wi.z));
+    } else {
+      // Walter et al. 2007 eq. 21 times |cos_o|:
+      //   |wi.m||wo.m| eta^2 (1 - F) D G / (|cos_i| (wi.m + eta wo.m)^2),
+      // and the radiance scaling 1/eta^2 cancels the eta^2.
+      value = std::abs((1.f - f) * d * g * dot_i * dot_o / (wi.z * denom * denom));
+    }
+    if (std::isfinite(value)) r.f = Spectrum(value);
   }
-  return std::isfinite(value) ? Spectrum(value) : Spectrum(0.f);
+  if constexpr (kPdf) {
+    // Jacobians dm/dwo: reflection 1 / (4 |wo.m|) (eq. 14), refraction
+    // eta^2 |wo.m| / (wi.m + eta wo.m)^2 (eq. 17).
+    const float jacobian = is_reflection ? 1.f / (4.f * std::abs(dot_o))
+                                         : eta * eta * std::abs(dot_o) / (denom * denom);
+    // The visible-normal density of the side wi is on (GgxDistribution::pdf_visible):
+    // D(m) G1(wi, m) |wi.m| / |wi.z|.
+    const vec3 wi_front = wi.z > 0.f ? wi : -wi;
+    const float p_m =
+        wi_front.z <= 0.f ? 0.f : d * g1_i * std::abs(glm::dot(wi_front, m)) / wi_front.z;
+    float p = p_m * jacobian;
+    if (has_r && has_t) p *= is_reflection ? f : 1.f - f;
+    if (std::isfinite(p)) r.pdf = p;
+  }
+  return r;
+}
+
+Spectrum DielectricBsdf::eval(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const {
+  return evaluate<true, false>(ctx, wi, wo).f;
 }
 
 float DielectricBsdf::pdf(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const {
-  if (index_matched_ || smooth_ || wi.z == 0.f || wo.z == 0.f) return 0.f;
-  vec3 m;
-  float eta;
-  bool is_reflection;
-  if (!half_vector(wi, wo, m, eta, is_reflection)) return 0.f;
-  const bool has_r = ctx.lobes & kLobeGlossyReflection;
-  const bool has_t = ctx.lobes & kLobeGlossyTransmission;
-  if (is_reflection ? !has_r : !has_t) return 0.f;
+  return evaluate<false, true>(ctx, wi, wo).pdf;
+}
 
-  const float dot_o = glm::dot(wo, m);
-  // Jacobians dm/dwo: reflection 1 / (4 |wo.m|) (eq. 14), refraction
-  // eta^2 |wo.m| / (wi.m + eta wo.m)^2 (eq. 17).
-  float jacobian;
-  if (is_reflection) {
-    jacobian = 1.f / (4.f * std::abs(dot_o));
-  } else {
-    const float denom = glm::dot(wi, m) + eta * dot_o;
-    jacobian = eta * eta * std::abs(dot_o) / (denom * denom);
-  }
-  const vec3 wi_front = wi.z > 0.f ? wi : -wi;
-  float p = distr_.pdf_visible(wi_front, m) * jacobian;
-  if (has_r && has_t) {
-    const float f = fresnel_dielectric(glm::dot(wi, m), eta_).reflectance;
-    p *= is_reflection ? f : 1.f - f;
-  }
-  return std::isfinite(p) ? p : 0.f;
+BsdfEvalPdf DielectricBsdf::eval_pdf(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const {
+  return evaluate<true, true>(ctx, wi, wo);
 }
 
 std::optional<BsdfSample> DielectricBsdf::sample(const BsdfContext& ctx, const vec3& wi,

@@ -29,10 +29,14 @@ class DielectricBsdf {
   Spectrum albedo() const { return Spectrum(1.f); }
   Spectrum eval(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
   float pdf(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
+  BsdfEvalPdf eval_pdf(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
   std::optional<BsdfSample> sample(const BsdfContext& ctx, const vec3& wi, float u_lobe,
                                    const vec2& u) const;
 
  private:
+  // The one body of eval (kEval), pdf (kPdf) and eval_pdf (both).
+  template <bool kEval, bool kPdf>
+  BsdfEvalPdf evaluate(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
   std::optional<BsdfSample> sample_smooth(const BsdfContext& ctx, const vec3& wi,
                                           float u_lobe) const;
   std::optional<BsdfSample> sample_rough(const BsdfContext& ctx, const vec3& wi, float u_lobe,

@@ -24,13 +24,13 @@ class DiffuseBsdf : public OpaqueBsdf {
   Spectrum albedo() const { return color_; }
 
   Spectrum eval(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const {
-    if (!(ctx.lobes & kLobeDiffuseReflection) || wi.z <= 0.f || wo.z <= 0.f) return Spectrum(0.f);
-    return color_ * (kInvPi * wo.z);
+    return evaluate<true, false>(ctx, wi, wo).f;
   }
-
   float pdf(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const {
-    if (!(ctx.lobes & kLobeDiffuseReflection) || wi.z <= 0.f || wo.z <= 0.f) return 0.f;
-    return cosine_hemisphere_pdf(wo);
+    return evaluate<false, true>(ctx, wi, wo).pdf;
+  }
+  BsdfEvalPdf eval_pdf(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const {
+    return evaluate<true, true>(ctx, wi, wo);
   }
 
   std::optional<BsdfSample> sample(const BsdfContext& ctx, const vec3& wi, float,
@@ -48,6 +48,16 @@ class DiffuseBsdf : public OpaqueBsdf {
   }
 
  private:
+  // The one body of eval (kEval), pdf (kPdf) and eval_pdf (both).
+  template <bool kEval, bool kPdf>
+  BsdfEvalPdf evaluate(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const {
+    BsdfEvalPdf r;
+    if (!(ctx.lobes & kLobeDiffuseReflection) || wi.z <= 0.f || wo.z <= 0.f) return r;
+    if constexpr (kEval) r.f = color_ * (kInvPi * wo.z);
+    if constexpr (kPdf) r.pdf = cosine_hemisphere_pdf(wo);
+    return r;
+  }
+
   Spectrum color_;
 };
 

@@ -148,6 +148,10 @@ float Material::pdf(const BsdfContext& ctx, const vec3& wi, const vec3& wo) cons
   return bsdf_->pdf(ctx, wi, wo);
 }
 
+BsdfEvalPdf Material::eval_pdf(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const {
+  return bsdf_->eval_pdf(ctx, wi, wo);
+}
+
 std::optional<BsdfSample> Material::sample(const BsdfContext& ctx, const vec3& wi, float u_lobe,
                                            const vec2& u) const {
   return bsdf_->sample(ctx, wi, u_lobe, u);

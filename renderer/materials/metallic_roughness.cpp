@@ -47,20 +47,19 @@ Spectrum MetallicRoughnessBsdf::fresnel(float cos_ih) const {
   return (1.f - metallic_) * Spectrum(dielectric) + metallic_ * metal;
 }
 
-Spectrum MetallicRoughnessBsdf::specular_albedo(float mu) const {
-  const MicrofacetAlbedo a =
-      smooth_ ? MicrofacetAlbedo{1.f, pow5(1.f - mu)} : ggx_albedo(mu, roughness_);
+MicrofacetAlbedo MetallicRoughnessBsdf::lobe_albedo(float mu) const {
+  return smooth_ ? MicrofacetAlbedo{1.f, pow5(1.f - mu)} : ggx_albedo(mu, roughness_);
+}
+
+Spectrum MetallicRoughnessBsdf::specular_albedo(const MicrofacetAlbedo& a) const {
   // Schlick is linear in f0: \int F s cos = f0 (E - E5) + E5.
   const float dielectric = kDielectricF0 * (a.e - a.e5) + a.e5;
   const Spectrum metal = base_color_ * (a.e - a.e5) + Spectrum(a.e5);
   return (1.f - metallic_) * Spectrum(dielectric) + metallic_ * metal;
 }
 
-Spectrum MetallicRoughnessBsdf::diffuse_value(float mu_i, float mu_o) const {
-  const MicrofacetAlbedo ai =
-      smooth_ ? MicrofacetAlbedo{1.f, pow5(1.f - mu_i)} : ggx_albedo(mu_i, roughness_);
-  const MicrofacetAlbedo ao =
-      smooth_ ? MicrofacetAlbedo{1.f, pow5(1.f - mu_o)} : ggx_albedo(mu_o, roughness_);
+Spectrum MetallicRoughnessBsdf::diffuse_value(const MicrofacetAlbedo& ai,
+                                              const MicrofacetAlbedo& ao, float mu_o) const {
   Spectrum value(0.f);
   if (metallic_ < 1.f) {
     // Albedo scaling of the Lambertian base under the f0 = 0.04 specular layer.
@@ -79,51 +78,78 @@ Spectrum MetallicRoughnessBsdf::diffuse_value(float mu_i, float mu_o) const {
   return value * mu_o;
 }
 
-float MetallicRoughnessBsdf::specular_probability(const BsdfContext& ctx, float mu_i) const {
+float MetallicRoughnessBsdf::specular_probability(const BsdfContext& ctx, float mu_i,
+                                                  std::optional<MicrofacetAlbedo> ai) const {
   const bool specular = (ctx.lobes & specular_lobe()) != 0;
   const bool diffuse = (ctx.lobes & kLobeDiffuseReflection) != 0;
   if (!specular) return 0.f;
   if (!diffuse) return 1.f;
   // In proportion to the energy each part reflects from wi: the diffuse part's albedo is its
   // value integrated over mu_o, where the (1 - E(mu_o)) factor integrates to (1 - E_avg).
-  const MicrofacetAlbedo a =
-      smooth_ ? MicrofacetAlbedo{1.f, pow5(1.f - mu_i)} : ggx_albedo(mu_i, roughness_);
+  const MicrofacetAlbedo a = ai ? *ai : lobe_albedo(mu_i);
   const float ei = kDielectricF0 * (a.e - a.e5) + a.e5;
   const float d = mean((1.f - metallic_) * std::max(0.f, 1.f - ei) * base_color_ +
                        metallic_ * std::max(0.f, 1.f - a.e) * f_ms_);
-  const float s = mean(specular_albedo(mu_i));
+  const float s = mean(specular_albedo(a));
   if (!(d > 0.f)) return 1.f;
   if (!(s > 0.f)) return 0.f;
   return std::clamp(s / (s + d), 0.05f, 0.95f);
 }
 
-Spectrum MetallicRoughnessBsdf::eval(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const {
-  if (wi.z <= 0.f || wo.z <= 0.f) return Spectrum(0.f);
-  Spectrum value(0.f);
-  if (ctx.lobes & kLobeDiffuseReflection) value += diffuse_value(wi.z, wo.z);
-  if (!smooth_ && (ctx.lobes & kLobeGlossyReflection)) {
-    const vec3 h = glm::normalize(wi + wo);
-    // Walter et al. 2007 eq. 20 times cos theta_o: F D G / (4 cos_i).
-    const float s = distr_.ndf(h) * distr_.smith_g(wi, wo, h) / (4.f * wi.z);
-    if (std::isfinite(s)) value += fresnel(glm::dot(wi, h)) * s;
+template <bool kEval, bool kPdf>
+BsdfEvalPdf MetallicRoughnessBsdf::evaluate(const BsdfContext& ctx, const vec3& wi,
+                                            const vec3& wo) const {
+  BsdfEvalPdf r;
+  if (wi.z <= 0.f || wo.z <= 0.f) return r;
+  const bool diffuse = (ctx.lobes & kLobeDiffuseReflection) != 0;
+  const bool glossy = !smooth_ && (ctx.lobes & kLobeGlossyReflection);
+  // The lobe's albedo towards wi: a factor of the diffuse value, and what the lobe choice weighs
+  // when both lobes are enabled.
+  std::optional<MicrofacetAlbedo> ai;
+  if (diffuse && (kEval || (ctx.lobes & specular_lobe()))) ai = lobe_albedo(wi.z);
+  // The half vector, D and G1(wi), shared by value and density.
+  vec3 h(0.f);
+  float d = 0.f, g1_i = 0.f;
+  if (glossy) {
+    h = glm::normalize(wi + wo);
+    if (kEval || glm::dot(wo, h) > 0.f) {
+      d = distr_.ndf(h);
+      g1_i = distr_.smith_g1(wi, h);
+    }
   }
-  return value;
+  if constexpr (kEval) {
+    if (diffuse) r.f += diffuse_value(*ai, lobe_albedo(wo.z), wo.z);
+    if (glossy) {
+      // Walter et al. 2007 eq. 20 times cos theta_o: F D G / (4 cos_i), G = G1 G1.
+      const float s = d * (g1_i * distr_.smith_g1(wo, h)) / (4.f * wi.z);
+      if (std::isfinite(s)) r.f += fresnel(glm::dot(wi, h)) * s;
+    }
+  }
+  if constexpr (kPdf) {
+    const float p_spec = specular_probability(ctx, wi.z, ai);
+    float p = 0.f;
+    if (diffuse) p += (1.f - p_spec) * cosine_hemisphere_pdf(wo);
+    if (glossy && glm::dot(wo, h) > 0.f) {
+      // Visible normals times the reflection Jacobian 1 / (4 wo.h) (see conductor.cpp).
+      const float g = d * g1_i / (4.f * wi.z);
+      if (std::isfinite(g)) p += p_spec * g;
+    }
+    r.pdf = p;
+  }
+  return r;
+}
+
+Spectrum MetallicRoughnessBsdf::eval(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const {
+  return evaluate<true, false>(ctx, wi, wo).f;
 }
 
 float MetallicRoughnessBsdf::pdf(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const {
-  if (wi.z <= 0.f || wo.z <= 0.f) return 0.f;
-  const float p_spec = specular_probability(ctx, wi.z);
-  float p = 0.f;
-  if (ctx.lobes & kLobeDiffuseReflection) p += (1.f - p_spec) * cosine_hemisphere_pdf(wo);
-  if (!smooth_ && (ctx.lobes & kLobeGlossyReflection)) {
-    const vec3 h = glm::normalize(wi + wo);
-    if (glm::dot(wo, h) > 0.f) {
-      // Visible normals times the reflection Jacobian 1 / (4 wo.h) (see conductor.cpp).
-      const float g = distr_.ndf(h) * distr_.smith_g1(wi, h) / (4.f * wi.z);
-      if (std::isfinite(g)) p += p_spec * g;
-    }
-  }
-  return p;
+  return evaluate<false, true>(ctx, wi, wo).pdf;
+}
+
+BsdfEvalPdf MetallicRoughnessBsdf::eval_pdf(const BsdfContext& ctx, const vec3& wi,
+                                            const vec3& wo) const {
+  return evaluate<true, true>(ctx, wi, wo);
 }
 
 std::optional<BsdfSample> MetallicRoughnessBsdf::sample(const BsdfContext& ctx, const vec3& wi,
@@ -152,9 +178,10 @@ std::optional<BsdfSample> MetallicRoughnessBsdf::sample(const BsdfContext& ctx, 
   }
   if (bs.wo.z <= 0.f) return std::nullopt;
   // One-sample MIS over the lobes: the weight is f cos / (mixture pdf) (Veach 1997 ch. 9).
-  bs.pdf = pdf(ctx, wi, bs.wo);
+  const BsdfEvalPdf ep = eval_pdf(ctx, wi, bs.wo);
+  bs.pdf = ep.pdf;
   if (!(bs.pdf > 0.f) || !std::isfinite(bs.pdf)) return std::nullopt;
-  bs.weight = eval(ctx, wi, bs.wo) / bs.pdf;
+  bs.weight = ep.f / bs.pdf;
   return bs;
 }
 

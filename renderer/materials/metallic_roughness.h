@@ -27,6 +27,7 @@
 #include "renderer/materials/bsdf.h"
 #include "renderer/materials/material_params.h"
 #include "renderer/materials/microfacet.h"
+#include "renderer/materials/microfacet_albedo.h"
 
 namespace penumbra {
 
@@ -44,6 +45,7 @@ class MetallicRoughnessBsdf : public OpaqueBsdf {
   }
   Spectrum eval(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
   float pdf(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
+  BsdfEvalPdf eval_pdf(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
   std::optional<BsdfSample> sample(const BsdfContext& ctx, const vec3& wi, float u_lobe,
                                    const vec2& u) const;
 
@@ -55,15 +57,23 @@ class MetallicRoughnessBsdf : public OpaqueBsdf {
   static constexpr float kDielectricF0 = 0.04f;
 
  private:
-  // The specular layer's Fresnel-weighted directional albedo at cos theta = mu: dielectric and
-  // metal mixed by metallic.
-  Spectrum specular_albedo(float mu) const;
-  // f cos_o of the diffuse-like part (dielectric base and metal multiple scattering).
-  Spectrum diffuse_value(float mu_i, float mu_o) const;
+  // The one body of eval (kEval), pdf (kPdf) and eval_pdf (both).
+  template <bool kEval, bool kPdf>
+  BsdfEvalPdf evaluate(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
+  // E and E5 of the Fresnel-free specular lobe at cos theta = mu (the mirror's in closed form).
+  MicrofacetAlbedo lobe_albedo(float mu) const;
+  // The specular layer's Fresnel-weighted directional albedo, from lobe_albedo(mu): dielectric
+  // and metal mixed by metallic.
+  Spectrum specular_albedo(const MicrofacetAlbedo& a) const;
+  // f cos_o of the diffuse-like part (dielectric base and metal multiple scattering), from
+  // lobe_albedo of mu_i and of mu_o.
+  Spectrum diffuse_value(const MicrofacetAlbedo& ai, const MicrofacetAlbedo& ao, float mu_o) const;
   // Fresnel of the specular lobe at wi.h, dielectric and metal mixed by metallic.
   Spectrum fresnel(float cos_ih) const;
-  // Probability of sampling the specular lobe for wi given the enabled lobes.
-  float specular_probability(const BsdfContext& ctx, float mu_i) const;
+  // Probability of sampling the specular lobe for wi given the enabled lobes; `ai`, if the
+  // caller has it, is lobe_albedo(mu_i).
+  float specular_probability(const BsdfContext& ctx, float mu_i,
+                             std::optional<MicrofacetAlbedo> ai = std::nullopt) const;
   uint32_t specular_lobe() const { return smooth_ ? kLobeDeltaReflection : kLobeGlossyReflection; }
 
   Spectrum base_color_;

@@ -52,47 +52,75 @@ float PlasticBsdf::external_transmittance(float cos_theta) const {
   return (1.f - w) * tables_->transmittance[i] + w * tables_->transmittance[i + 1];
 }
 
-float PlasticBsdf::specular_probability(const BsdfContext& ctx, float cos_i) const {
+float PlasticBsdf::specular_probability(const BsdfContext& ctx, float cos_i,
+                                        std::optional<float> transmittance_i) const {
   const bool has_spec = ctx.lobes & coating_lobe();
   const bool has_diff = ctx.lobes & kLobeDiffuseReflection;
   if (has_spec != has_diff) return has_spec ? 1.f : 0.f;
   if (!has_spec) return 0.f;
   // Coating reflectance: F(cos_i) for the smooth coating, 1 - t(cos_i) for the rough one.
-  const float t_i = external_transmittance(cos_i);
+  const float t_i = transmittance_i ? *transmittance_i : external_transmittance(cos_i);
   const float p_spec = (1.f - t_i) * specular_sampling_weight_;
   const float p_diff = t_i * (1.f - specular_sampling_weight_);
   return p_spec + p_diff > 0.f ? p_spec / (p_spec + p_diff) : 0.f;
 }
 
+template <bool kEval, bool kPdf>
+BsdfEvalPdf PlasticBsdf::evaluate(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const {
+  BsdfEvalPdf r;
+  if (wi.z <= 0.f || wo.z <= 0.f) return r;
+  const bool has_diff = ctx.lobes & kLobeDiffuseReflection;
+  const bool rough_coating = !smooth_ && (ctx.lobes & kLobeGlossyReflection);
+  // The coating's transmittance towards wi: a factor of the base's value, and what the lobe
+  // choice weighs when both lobes are enabled.
+  std::optional<float> t_i;
+  if (has_diff && (kEval || (ctx.lobes & coating_lobe()))) t_i = external_transmittance(wi.z);
+  float p_spec = 0.f;
+  if constexpr (kPdf) p_spec = specular_probability(ctx, wi.z, t_i);
+  // The rough coating's half vector, D and G1(wi), shared by value and density (p_spec > 0
+  // implies the glossy lobe is enabled).
+  vec3 h(0.f);
+  float d = 0.f, g1_i = 0.f;
+  if (rough_coating && (kEval || p_spec > 0.f)) {
+    h = glm::normalize(wi + wo);
+    d = distr_.ndf(h);
+    g1_i = distr_.smith_g1(wi, h);
+  }
+  if constexpr (kEval) {
+    if (rough_coating) {
+      // Rough coating: Walter et al. 2007 eq. 20 with the dielectric Fresnel term, G = G1 G1.
+      const float f = fresnel_dielectric(glm::dot(wi, h), eta_).reflectance;
+      const float spec = f * d * (g1_i * distr_.smith_g1(wo, h)) / (4.f * wi.z);
+      if (std::isfinite(spec)) r.f += Spectrum(spec);
+    }
+    if (has_diff) {
+      const float t = *t_i * external_transmittance(wo.z);
+      r.f += color_ * (t * diffuse_scale_ * kInvPi * wo.z);
+    }
+  }
+  if constexpr (kPdf) {
+    const float p_diff = has_diff ? 1.f - p_spec : 0.f;
+    float p = p_diff * cosine_hemisphere_pdf(wo);
+    if (!smooth_ && p_spec > 0.f) {
+      // Visible-normal density times the reflection Jacobian 1 / (4 wo.h); wi.h = wo.h cancels.
+      const float ps = d * g1_i / (4.f * wi.z);
+      if (std::isfinite(ps)) p += p_spec * ps;
+    }
+    r.pdf = p;
+  }
+  return r;
+}
+
 Spectrum PlasticBsdf::eval(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const {
-  if (wi.z <= 0.f || wo.z <= 0.f) return Spectrum(0.f);
-  Spectrum value(0.f);
-  if (!smooth_ && (ctx.lobes & kLobeGlossyReflection)) {
-    // Rough coating: Walter et al. 2007 eq. 20 with the dielectric Fresnel term.
-    const vec3 h = glm::normalize(wi + wo);
-    const float f = fresnel_dielectric(glm::dot(wi, h), eta_).reflectance;
-    const float spec = f * distr_.ndf(h) * distr_.smith_g(wi, wo, h) / (4.f * wi.z);
-    if (std::isfinite(spec)) value += Spectrum(spec);
-  }
-  if (ctx.lobes & kLobeDiffuseReflection) {
-    const float t = external_transmittance(wi.z) * external_transmittance(wo.z);
-    value += color_ * (t * diffuse_scale_ * kInvPi * wo.z);
-  }
-  return value;
+  return evaluate<true, false>(ctx, wi, wo).f;
 }
 
 float PlasticBsdf::pdf(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const {
-  if (wi.z <= 0.f || wo.z <= 0.f) return 0.f;
-  const float p_spec = specular_probability(ctx, wi.z);
-  const float p_diff = (ctx.lobes & kLobeDiffuseReflection) ? 1.f - p_spec : 0.f;
-  float p = p_diff * cosine_hemisphere_pdf(wo);
-  if (!smooth_ && p_spec > 0.f) {
-    const vec3 h = glm::normalize(wi + wo);
-    // Visible-normal density times the reflection Jacobian 1 / (4 wo.h); wi.h = wo.h cancels.
-    const float ps = distr_.ndf(h) * distr_.smith_g1(wi, h) / (4.f * wi.z);
-    if (std::isfinite(ps)) p += p_spec * ps;
-  }
-  return p;
+  return evaluate<false, true>(ctx, wi, wo).pdf;
+}
+
+BsdfEvalPdf PlasticBsdf::eval_pdf(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const {
+  return evaluate<true, true>(ctx, wi, wo);
 }
 
 std::optional<BsdfSample> PlasticBsdf::sample(const BsdfContext& ctx, const vec3& wi, float u_lobe,
@@ -124,9 +152,10 @@ std::optional<BsdfSample> PlasticBsdf::sample(const BsdfContext& ctx, const vec3
   }
   if (bs.wo.z <= 0.f) return std::nullopt;
   // One-sample MIS over the lobes: pdf is the mixture density, weight eval / pdf.
-  bs.pdf = pdf(ctx, wi, bs.wo);
+  const BsdfEvalPdf ep = eval_pdf(ctx, wi, bs.wo);
+  bs.pdf = ep.pdf;
   if (!(bs.pdf > 0.f)) return std::nullopt;
-  bs.weight = eval(ctx, wi, bs.wo) / bs.pdf;
+  bs.weight = ep.f / bs.pdf;
   if (!is_finite(bs.weight)) return std::nullopt;
   return bs;
 }

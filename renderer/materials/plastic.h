@@ -38,6 +38,7 @@ class PlasticBsdf : public OpaqueBsdf {
   Spectrum albedo() const { return color_; }
   Spectrum eval(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
   float pdf(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
+  BsdfEvalPdf eval_pdf(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
   std::optional<BsdfSample> sample(const BsdfContext& ctx, const vec3& wi, float u_lobe,
                                    const vec2& u) const;
 
@@ -46,8 +47,13 @@ class PlasticBsdf : public OpaqueBsdf {
   float external_transmittance(float cos_theta) const;
 
  private:
-  // Probability of sampling the coating lobe given the enabled lobes.
-  float specular_probability(const BsdfContext& ctx, float cos_i) const;
+  // The one body of eval (kEval), pdf (kPdf) and eval_pdf (both).
+  template <bool kEval, bool kPdf>
+  BsdfEvalPdf evaluate(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
+  // Probability of sampling the coating lobe given the enabled lobes; `t_i`, if the caller has
+  // it, is external_transmittance(cos_i).
+  float specular_probability(const BsdfContext& ctx, float cos_i,
+                             std::optional<float> t_i = std::nullopt) const;
   uint32_t coating_lobe() const { return smooth_ ? kLobeDeltaReflection : kLobeGlossyReflection; }
 
   void set_color(const Spectrum& color);

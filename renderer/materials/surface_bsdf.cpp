@@ -21,6 +21,19 @@ float shadow_terminator(const vec3& perturbed_n, const vec3& wo) {
   return 2.f / (1.f + std::sqrt(1.f + alpha2 * tan2_theta(wo)));
 }
 
+// The model's answer to eval, pdf or both, as a BsdfEvalPdf.
+template <bool kEval, bool kPdf, class Model>
+[[gnu::always_inline]] inline BsdfEvalPdf model_evaluate(const Model& m, const BsdfContext& ctx,
+                                                        const vec3& wi, const vec3& wo) {
+  if constexpr (kEval && kPdf) {
+    return m.eval_pdf(ctx, wi, wo);
+  } else if constexpr (kEval) {
+    return BsdfEvalPdf{m.eval(ctx, wi, wo), 0.f};
+  } else {
+    return BsdfEvalPdf{Spectrum(0.f), m.pdf(ctx, wi, wo)};
+  }
+}
+
 }  // namespace
 
 SurfaceBsdf::SurfaceBsdf(const BsdfModel& model)
@@ -48,19 +61,16 @@ Frame SurfaceBsdf::perturbed_frame(const vec3& wi) const {
   return f;
 }
 
-Spectrum SurfaceBsdf::eval_mapped(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const {
+template <bool kEval, bool kPdf>
+BsdfEvalPdf SurfaceBsdf::evaluate_mapped(const BsdfContext& ctx, const vec3& wi,
+                                         const vec3& wo) const {
   const Frame f = perturbed_frame(wi);
   const vec3 wo_p = f.to_local(wo), wi_p = f.to_local(wi);
-  if (!(wo.z * wo_p.z > 0.f)) return Spectrum(0.f);
-  const Spectrum value = std::visit([&](const auto& m) { return m.eval(ctx, wi_p, wo_p); }, model_);
-  return value * shadow_terminator(f.n, wo);
-}
-
-float SurfaceBsdf::pdf_mapped(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const {
-  const Frame f = perturbed_frame(wi);
-  const vec3 wo_p = f.to_local(wo), wi_p = f.to_local(wi);
-  if (!(wo.z * wo_p.z > 0.f)) return 0.f;
-  return std::visit([&](const auto& m) { return m.pdf(ctx, wi_p, wo_p); }, model_);
+  if (!(wo.z * wo_p.z > 0.f)) return BsdfEvalPdf{};
+  BsdfEvalPdf r = std::visit(
+      [&](const auto& m) { return model_evaluate<kEval, kPdf>(m, ctx, wi_p, wo_p); }, model_);
+  if constexpr (kEval) r.f = r.f * shadow_terminator(f.n, wo);
+  return r;
 }
 
 std::optional<BsdfSample> SurfaceBsdf::sample_mapped(const BsdfContext& ctx, const vec3& wi,
@@ -76,22 +86,34 @@ std::optional<BsdfSample> SurfaceBsdf::sample_mapped(const BsdfContext& ctx, con
   return bs;
 }
 
-Spectrum SurfaceBsdf::eval(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const {
+template <bool kEval, bool kPdf>
+BsdfEvalPdf SurfaceBsdf::evaluate(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const {
   const bool flip = two_sided_ && wi.z < 0.f;
   const vec3 a = flip ? flip_z(wi) : wi, b = flip ? flip_z(wo) : wo;
-  const Spectrum f = normal_mapped_
-                         ? eval_mapped(ctx, a, b)
-                         : std::visit([&](const auto& m) { return m.eval(ctx, a, b); }, model_);
-  return is_finite(f) ? f : Spectrum(0.f);
+  BsdfEvalPdf r =
+      normal_mapped_
+          ? evaluate_mapped<kEval, kPdf>(ctx, a, b)
+          : std::visit([&](const auto& m) { return model_evaluate<kEval, kPdf>(m, ctx, a, b); },
+                       model_);
+  if constexpr (kEval) {
+    if (!is_finite(r.f)) r.f = Spectrum(0.f);
+  }
+  if constexpr (kPdf) {
+    if (!std::isfinite(r.pdf)) r.pdf = 0.f;
+  }
+  return r;
+}
+
+Spectrum SurfaceBsdf::eval(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const {
+  return evaluate<true, false>(ctx, wi, wo).f;
 }
 
 float SurfaceBsdf::pdf(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const {
-  const bool flip = two_sided_ && wi.z < 0.f;
-  const vec3 a = flip ? flip_z(wi) : wi, b = flip ? flip_z(wo) : wo;
-  const float p = normal_mapped_
-                      ? pdf_mapped(ctx, a, b)
-                      : std::visit([&](const auto& m) { return m.pdf(ctx, a, b); }, model_);
-  return std::isfinite(p) ? p : 0.f;
+  return evaluate<false, true>(ctx, wi, wo).pdf;
+}
+
+BsdfEvalPdf SurfaceBsdf::eval_pdf(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const {
+  return evaluate<true, true>(ctx, wi, wo);
 }
 
 std::optional<BsdfSample> SurfaceBsdf::sample(const BsdfContext& ctx, const vec3& wi, float u_lobe,

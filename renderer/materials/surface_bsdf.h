@@ -40,6 +40,8 @@ class SurfaceBsdf {
 
   Spectrum eval(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
   float pdf(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
+  // Both at once, equal to the bit to eval and pdf (next-event estimation asks for both).
+  BsdfEvalPdf eval_pdf(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
   // u_lobe picks a lobe, u the direction; both in [0,1).
   std::optional<BsdfSample> sample(const BsdfContext& ctx, const vec3& wi, float u_lobe,
                                    const vec2& u) const;
@@ -57,11 +59,15 @@ class SurfaceBsdf {
   const BsdfModel& model() const { return model_; }
 
  private:
+  // The one body of eval (kEval), pdf (kPdf) and eval_pdf (both): two-sided handling, then the
+  // model directly or through the normal map.
+  template <bool kEval, bool kPdf>
+  BsdfEvalPdf evaluate(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
   // The front-side answers with a normal map (wi mirrored to the front already for two-sided
   // models). Without one, eval / pdf / sample visit the model directly: the common case stays
   // one call deep, with the inline models (DiffuseBsdf) inlined into it (docs/performance.md).
-  Spectrum eval_mapped(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
-  float pdf_mapped(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
+  template <bool kEval, bool kPdf>
+  BsdfEvalPdf evaluate_mapped(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
   std::optional<BsdfSample> sample_mapped(const BsdfContext& ctx, const vec3& wi, float u_lobe,
                                           const vec2& u) const;
   // The normal map's frame in shading-frame coordinates, for incident direction wi.

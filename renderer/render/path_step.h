@@ -221,18 +221,21 @@ inline bool path_hit(const Scene& scene, const IntegratorSettings& settings, Pat
       ls.pdf *= lights.pmf(light);
       const vec3 wo = frame.to_local(ls.wi);
       if (geometry_agrees(wi_world, ls.wi, hit.ng, wi, wo)) {
+        // The BSDF's value and, for MIS against its own sampling, its pdf, from one call that
+        // computes their shared terms once (a delta light needs no pdf).
+        const auto eval_mis = [&](const BsdfContext& ctx) {
+          if (ls.is_delta) return bsdf->eval(ctx, wi, wo);
+          const BsdfEvalPdf e = bsdf->eval_pdf(ctx, wi, wo);
+          return e.f * power_heuristic(ls.pdf, e.pdf);
+        };
         Spectrum f;
         if constexpr (kDistributed) {
           // Diffuse lobes see direct light through light sampling alone; the other lobes
           // share it with their own sampling by MIS.
           const BsdfContext diffuse{kLobeDiffuse}, rest{kLobeNonDiffuse};
-          const Spectrum f_rest = bsdf->eval(rest, wi, wo);
-          const float w = ls.is_delta ? 1.f : power_heuristic(ls.pdf, bsdf->pdf(rest, wi, wo));
-          f = bsdf->eval(diffuse, wi, wo) + f_rest * w;
+          f = bsdf->eval(diffuse, wi, wo) + eval_mis(rest);
         } else {
-          const BsdfContext all{};
-          const float w = ls.is_delta ? 1.f : power_heuristic(ls.pdf, bsdf->pdf(all, wi, wo));
-          f = bsdf->eval(all, wi, wo) * w;
+          f = eval_mis(BsdfContext{});
         }
         if (!is_black(f)) {
           const vec3 origin = offset_ray_origin(hit.p, hit.p_error, hit.ng, ls.wi);
