@@ -90,8 +90,8 @@ void ThinLensCamera::generate_rays(size_t n, const float* film_x, const float* f
     pinhole_rays(c, n, film_x, film_y, out[3], out[4], out[5]);
     return;
   }
-  // The concentric map's sine and cosine stay scalar (libm's; a vector version would round
-  // differently).
+  // The concentric map per sample, as generate_ray takes it (its polynomial sine and cosine
+  // round the same in a lane, but its two wedges branch).
   std::vector<float> disk(2 * n);
   for (size_t i = 0; i < n; ++i) {
     const vec2 d = square_to_disk_concentric(vec2(lens_x[i], lens_y[i])) * aperture_radius_;
