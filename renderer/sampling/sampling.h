@@ -17,6 +17,24 @@ inline void sincos_quarter_pi(float x, float* s, float* c) {
                                                                           x2 * (-1.f / 3628800.f)))));
 }
 
+// Sine and cosine of 2 pi u (u in [0, 1) for the warps; any |u| < 2^29 works): 2 pi u = (pi/2)(k + f)
+// with k the integer nearest 4u and f = 4u - k in [-1/2, 1/2], both exact in float (4u is a
+// power-of-two scaling, and subtracting an integer within one half of it loses no bits), so the
+// reduction adds no error and the quarter turn k only swaps and negates; one rounding of the
+// angle f pi/2 plus sincos_quarter_pi's remains.
+inline void sincos_two_pi(float u, float* s, float* c) {
+  const float t = 4.f * u;
+  const int k = int(t + std::copysign(0.5f, t));  // rounded half away from zero
+  float a, b;
+  sincos_quarter_pi((t - float(k)) * (kPi / 2.f), &a, &b);
+  switch (k & 3) {
+    case 0: *s = a, *c = b; break;
+    case 1: *s = b, *c = -a; break;
+    case 2: *s = -a, *c = -b; break;
+    default: *s = -b, *c = a; break;
+  }
+}
+
 // Shirley & Chiu 1997 concentric map, unit disk. The second wedge's angle pi/2 - t is folded
 // into t, swapping sine and cosine, so both wedges take angles within [-pi/4, pi/4].
 inline vec2 square_to_disk_concentric(const vec2& u) {
@@ -41,8 +59,9 @@ inline float cosine_hemisphere_pdf(const vec3& w) { return w.z > 0.f ? w.z * kIn
 inline vec3 square_to_uniform_sphere(const vec2& u) {
   const float z = 1.f - 2.f * u.x;
   const float r = safe_sqrt(1.f - z * z);
-  const float phi = 2.f * kPi * u.y;
-  return vec3(r * std::cos(phi), r * std::sin(phi), z);
+  float s, c;
+  sincos_two_pi(u.y, &s, &c);
+  return vec3(r * c, r * s, z);
 }
 inline constexpr float uniform_sphere_pdf() { return kInv4Pi; }
 
@@ -50,8 +69,9 @@ inline constexpr float uniform_sphere_pdf() { return kInv4Pi; }
 inline vec3 square_to_uniform_cone(const vec2& u, float cos_max) {
   const float cos_t = 1.f - u.x * (1.f - cos_max);
   const float sin_t = safe_sqrt(1.f - cos_t * cos_t);
-  const float phi = 2.f * kPi * u.y;
-  return vec3(sin_t * std::cos(phi), sin_t * std::sin(phi), cos_t);
+  float s, c;
+  sincos_two_pi(u.y, &s, &c);
+  return vec3(sin_t * c, sin_t * s, cos_t);
 }
 inline float uniform_cone_pdf(float cos_max) { return 1.f / (2.f * kPi * (1.f - cos_max)); }
 

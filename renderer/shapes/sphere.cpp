@@ -198,8 +198,9 @@ ShapeSample sample_sphere(const vec3& center, float radius, const vec3& ref, con
   const float ds = dc * cos_t - safe_sqrt(r2 - dc2 * sin2);
   const float ca = std::clamp((dc2 + r2 - ds * ds) / (2.f * dc * radius), -1.f, 1.f);
   const float sa = safe_sqrt(1.f - ca * ca);
-  const float phi = 2.f * kPi * u.y;
-  const vec3 n_local(sa * std::cos(phi), sa * std::sin(phi), ca);
+  float sin_phi, cos_phi;
+  sincos_two_pi(u.y, &sin_phi, &cos_phi);
+  const vec3 n_local(sa * cos_phi, sa * sin_phi, ca);
   const vec3 n = -frame.to_world(n_local);
   s.n = glm::normalize(n);
   s.p = center + radius * s.n;

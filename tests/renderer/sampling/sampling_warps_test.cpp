@@ -1,5 +1,5 @@
-// The warps' own arithmetic: the polynomial sine and cosine of the concentric map against libm in
-// double, and the map itself against its polar definition.
+// The warps' own arithmetic: the polynomial sines and cosines (of the concentric map's angles and
+// of 2 pi u) against libm in double, and the concentric map against its polar definition.
 #include "renderer/sampling/sampling.h"
 
 #include <gtest/gtest.h>
@@ -35,6 +35,38 @@ TEST(SamplingWarps, SinCosQuarterPi) {
   sincos_quarter_pi(0.f, &s, &c);
   EXPECT_EQ(s, 0.f);
   EXPECT_EQ(c, 1.f);
+}
+
+TEST(SamplingWarps, SinCosTwoPi) {
+  // Against sin and cos of 2 pi u in double: the reduction is exact, so the error is the
+  // polynomial's plus one rounding of the reduced angle, in absolute terms (the result's ulp near
+  // a zero crossing is far below the input's resolution, which no float method has either).
+  double worst = 0.0;
+  const int n = 1 << 20;
+  for (int i = -n; i <= 2 * n; ++i) {
+    const float u = float(i) / n + 0.3f / n;
+    float s, c;
+    sincos_two_pi(u, &s, &c);
+    const double a = 2.0 * M_PI * double(u);
+    worst = std::max({worst, std::abs(s - std::sin(a)), std::abs(c - std::cos(a))});
+  }
+  EXPECT_LT(worst, 1.3e-7);
+  // Quarter turns exactly, the quadrant order included (a swapped case fails these).
+  const float quarter[][3] = {{0.f, 0.f, 1.f}, {0.25f, 1.f, 0.f}, {0.5f, 0.f, -1.f},
+                              {0.75f, -1.f, 0.f}, {1.f, 0.f, 1.f}, {-0.25f, -1.f, 0.f}};
+  for (const auto& q : quarter) {
+    float s, c;
+    sincos_two_pi(q[0], &s, &c);
+    EXPECT_EQ(s, q[1]) << q[0];
+    EXPECT_EQ(c, q[2]) << q[0];
+  }
+  float s, c;
+  sincos_two_pi(0.125f, &s, &c);
+  EXPECT_NEAR(s, std::sqrt(0.5), 1e-7);
+  EXPECT_NEAR(c, std::sqrt(0.5), 1e-7);
+  sincos_two_pi(0.625f, &s, &c);
+  EXPECT_NEAR(s, -std::sqrt(0.5), 1e-7);
+  EXPECT_NEAR(c, -std::sqrt(0.5), 1e-7);
 }
 
 TEST(SamplingWarps, ConcentricMapMatchesItsPolarForm) {
