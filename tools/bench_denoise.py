@@ -3,7 +3,7 @@
 ``--denoise`` (Open Image Denoise, albedo and normal guided) at a ladder of sample counts, and
 the time each needs to reach the relMSE that 1024 undenoised spp give.
 
-    /work/venv-mitsuba/bin/python tools/bench_denoise.py --penumbra build/app/penumbra \
+    .venv-mitsuba/bin/python tools/bench_denoise.py --penumbra build/app/penumbra \
         [--scenes cornell,textured_diffuse,glass_rough,environment_map,dof] [--seeds 3] \
         [--out bench/out/denoise]
 
