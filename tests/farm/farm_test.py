@@ -596,8 +596,14 @@ def split_job(farm, kill_one=False):
         "SELECT kind, count(*) FROM tasks WHERE job_id = '%s' AND state = 'done' GROUP BY kind" % job))
     check(kinds == {"tile": "16", "merge": "1"}, "16 tiles and one merge done: %s" % kinds)
     left = [f for f in result_files(farm) if f.endswith(".tile.exr") and f.startswith(job)]
-    check(left == ([job + "." + "f" * 24 + ".tile.exr"] if kill_one else []),
-          "the committed tiles' files are gone after the merge: %s" % left)
+    committed = {job + "." + token + ".tile.exr" for token, in farm.psql(
+        "SELECT result_token FROM tasks WHERE job_id = '%s' AND kind = 'tile' AND state = 'done'" % job)}
+    check(not committed & set(left), "the committed tiles' files are gone after the merge: %s"
+          % sorted(committed & set(left)))
+    # Files of attempts that never committed stay until the job's retention (split_retention):
+    # the planted orphan, and the killed worker's own tile if it was written before the kill.
+    planted = job + "." + "f" * 24 + ".tile.exr"
+    check((planted in left) == kill_one, "the merge leaves uncommitted files alone: %s" % left)
     check(j["stats"].get("tasks") == 16, "the job's stats sum its tiles: %s" % j["stats"])
     # Where the wall time went: tiles (first start to last end), the merge, from the attempt log.
     (tiles_span, merge_span, tile_sum), = farm.psql(
