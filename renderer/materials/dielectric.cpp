@@ -82,11 +82,9 @@ BsdfEvalPdf DielectricBsdf::evaluate(const BsdfContext& ctx, const vec3& wi, con
     // eta^2 |wo.m| / (wi.m + eta wo.m)^2 (eq. 17).
     const float jacobian = is_reflection ? 1.f / (4.f * std::abs(dot_o))
                                          : eta * eta * std::abs(dot_o) / (denom * denom);
-    // The visible-normal density of the side wi is on (GgxDistribution::pdf_visible):
-    // D(m) G1(wi, m) |wi.m| / |wi.z|.
+    // The visible-normal density of the side wi is on (GgxDistribution::pdf_visible).
     const vec3 wi_front = wi.z > 0.f ? wi : -wi;
-    const float p_m =
-        wi_front.z <= 0.f ? 0.f : d * g1_i * std::abs(glm::dot(wi_front, m)) / wi_front.z;
+    const float p_m = GgxDistribution::visible_density(d, g1_i, wi_front, m);
     float p = p_m * jacobian;
     if (has_r && has_t) p *= is_reflection ? f : 1.f - f;
     if (std::isfinite(p)) r.pdf = p;

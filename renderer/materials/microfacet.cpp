@@ -36,11 +36,6 @@ vec3 GgxDistribution::sample_visible(const vec3& wi, const vec2& u) const {
   return glm::normalize(vec3(alpha_ * nh.x, alpha_ * nh.y, std::max(0.f, nh.z)));
 }
 
-float GgxDistribution::pdf_visible(const vec3& wi, const vec3& m) const {
-  if (wi.z <= 0.f) return 0.f;
-  return ndf(m) * smith_g1(wi, m) * std::abs(glm::dot(wi, m)) / wi.z;
-}
-
 namespace {
 
 // Integrates fn(m, wi) over the visible-normal distribution of wi with a tensor Gauss-Legendre

@@ -45,17 +45,21 @@ class GgxDistribution {
   float ndf(const vec3& m) const;
 
   // Smith masking G1(v, m); zero when v sees the back of the microfacet (v.m and v.z differ in sign).
+  // The models take the separable masking-shadowing G = G1(wi, m) G1(wo, m).
   float smith_g1(const vec3& v, const vec3& m) const;
-
-  float smith_g(const vec3& wi, const vec3& wo, const vec3& m) const {
-    return smith_g1(wi, m) * smith_g1(wo, m);
-  }
 
   // A microfacet normal distributed as D_wi (visible normals). Requires wi.z > 0.
   vec3 sample_visible(const vec3& wi, const vec2& u) const;
 
   // Density of sample_visible: D(m) G1(wi, m) |wi.m| / wi.z. Requires wi.z > 0.
-  float pdf_visible(const vec3& wi, const vec3& m) const;
+  float pdf_visible(const vec3& wi, const vec3& m) const {
+    return wi.z <= 0.f ? 0.f : visible_density(ndf(m), smith_g1(wi, m), wi, m);
+  }
+  // The same from D(m) and G1(wi, m) already at hand (a model's eval_pdf shares them with its
+  // value).
+  static float visible_density(float d, float g1_wi, const vec3& wi, const vec3& m) {
+    return wi.z <= 0.f ? 0.f : d * g1_wi * std::abs(glm::dot(wi, m)) / wi.z;
+  }
 
  private:
   float alpha_;
