@@ -9,16 +9,16 @@
 #   bench/bit_identity.sh BASE_BINARY NEW_BINARY        (exit 1 if any image differs)
 # A binary may be given as ENV=VALUE:PATH to run it with one environment variable set.
 set -euo pipefail
+source "$(dirname "$0")/binary_spec.sh"
 base=$1
 new=$2
 spp=${SPP:-16}
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 run() {  # binary-spec scene integrator output
-  local env_kv=() path=$1
-  if [[ $1 == *=*:* ]]; then env_kv=("${1%%:*}"); path=${1#*:}; fi
-  env "${env_kv[@]}" "$path" render "$2" --spp "$spp" --integrator "$3" -o "$4" >"$4.log" 2>&1 ||
-    { echo "render failed: $path $2 $3" >&2; cat "$4.log" >&2; return 1; }
+  split_binary "$1"
+  env "${binary_env[@]}" "$binary_path" render "$2" --spp "$spp" --integrator "$3" -o "$4" >"$4.log" 2>&1 ||
+    { echo "render failed: $binary_path $2 $3" >&2; cat "$4.log" >&2; return 1; }
 }
 images=0
 differ=0

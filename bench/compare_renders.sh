@@ -8,6 +8,7 @@
 # environment variable set. From the repository root:
 #   bench/compare_renders.sh "SCENE..." BINARY [BINARY...]      (REPEAT=5, extra render flags in ARGS)
 set -euo pipefail
+source "$(dirname "$0")/binary_spec.sh"
 scenes=$1; shift
 repeat=${REPEAT:-5}
 read -r -a extra <<<"${ARGS:-}"
@@ -20,9 +21,8 @@ for scene in $scenes; do
   for ((r = 0; r < repeat; ++r)); do
     i=0
     for bin in "$@"; do
-      env_kv=(); path=$bin
-      if [[ $bin == *=*:* ]]; then env_kv=("${bin%%:*}"); path=${bin#*:}; fi
-      env "${env_kv[@]}" /usr/bin/time -o "$out/cpu" -f "%U %S" "$path" render "$scene" -o "$out/img.exr" \
+      split_binary "$bin"
+      env "${binary_env[@]}" /usr/bin/time -o "$out/cpu" -f "%U %S" "$binary_path" render "$scene" -o "$out/img.exr" \
         "${extra[@]}" >"$out/log" 2>&1
       sed -n 's/.*spp (min [0-9]*, max [0-9]*), \([0-9.]*\) s.*/\1/p' "$out/log" >>"$out/$name.$i"
       awk '{print $1 + $2}' "$out/cpu" >>"$out/$name.cpu.$i"

@@ -7,6 +7,7 @@
 # be given as ENV=VALUE:PATH to run it with one environment variable set. From the repo root:
 #   bench/perf_counts.sh "SCENE..." BINARY [BINARY...]      (SPP=16 by default)
 set -euo pipefail
+source "$(dirname "$0")/binary_spec.sh"
 scenes=$1; shift
 spp=${SPP:-16}
 out=$(mktemp -d)
@@ -14,10 +15,9 @@ trap 'rm -rf "$out"' EXIT
 printf '| scene (%s spp, 1 thread) | binary | instructions (1e9) |\n| --- | --- | ---: |\n' "$spp"
 for scene in $scenes; do
   for bin in "$@"; do
-    env_kv=(); path=$bin
-    if [[ $bin == *=*:* ]]; then env_kv=("${bin%%:*}"); path=${bin#*:}; fi
-    env "${env_kv[@]}" valgrind --tool=callgrind --callgrind-out-file="$out/cg" \
-      "$path" render "$scene" -o "$out/img.exr" --spp "$spp" --threads 1 -q >"$out/log" 2>&1
+    split_binary "$bin"
+    env "${binary_env[@]}" valgrind --tool=callgrind --callgrind-out-file="$out/cg" \
+      "$binary_path" render "$scene" -o "$out/img.exr" --spp "$spp" --threads 1 -q >"$out/log" 2>&1
     ir=$(sed -n 's/.*Collected : \([0-9]*\).*/\1/p' "$out/log")
     printf '| %s | %s | %.4f |\n' "$(basename "$scene" .json)" "$bin" "$(echo "$ir" | awk '{print $1 / 1e9}')"
   done
