@@ -191,30 +191,25 @@ def penumbra_target(rows: list[dict], scene: str) -> float:
     return float(np.mean([r["relmse"] for r in pen if r["spp"] == top]))
 
 
-def brackets(rows: list[dict], target: float) -> bool:
-    """Whether a curve reaches ``target`` within its measured points (no extrapolation)."""
-    pts = curve(rows)
-    return bool(pts) and min(e for _, e in pts) <= target <= max(e for _, e in pts)
-
-
-def time_to_reach(rows: list[dict], target: float) -> float:
-    """Seconds to reach relMSE ``target``: log-log interpolation between the two points of the
-    ladder (seed means) that bracket it, or, outside the ladder, a least-squares line through
-    log(relMSE) against log(seconds) evaluated at the target. (A line through the whole ladder
-    is biased where fixed costs dominate its cheapest points.)"""
+def time_to_reach(rows: list[dict], target: float) -> tuple[float, bool]:
+    """Seconds to reach relMSE ``target``, and whether they were interpolated: log-log
+    interpolation between the two points of the ladder (seed means) that bracket it, or, outside
+    the ladder, a least-squares line through log(relMSE) against log(seconds) evaluated at the
+    target. (A line through the whole ladder is biased where fixed costs dominate its cheapest
+    points, hence the curves are extended until they bracket the target.)"""
     pts = curve(rows)
     if len(pts) < 2:
-        return math.nan
+        return math.nan, False
     for (s0, e0), (s1, e1) in zip(pts, pts[1:]):
         if e1 < e0 and e1 <= target <= e0:
             f = math.log(target / e0) / math.log(e1 / e0)
-            return float(math.exp(math.log(s0) + f * math.log(s1 / s0)))
+            return float(math.exp(math.log(s0) + f * math.log(s1 / s0))), True
     x = np.log([p[0] for p in pts])
     y = np.log([p[1] for p in pts])
     slope, intercept = np.polyfit(x, y, 1)
     if slope >= 0:
-        return math.nan
-    return float(math.exp((math.log(target) - intercept) / slope))
+        return math.nan, False
+    return float(math.exp((math.log(target) - intercept) / slope)), False
 
 
 def summarise(rows: list[dict], scenes: list[str], renderers: list[str]) -> list[str]:
@@ -230,10 +225,11 @@ def summarise(rows: list[dict], scenes: list[str], renderers: list[str]) -> list
         target = penumbra_target(rows, scene)
         if math.isnan(target):
             continue
-        of = {name: [r for r in rows if r["scene"] == scene and r["renderer"] == name] for name in renderers}
-        secs = {name: time_to_reach(of[name], target) for name in renderers}
+        reached = {name: time_to_reach([r for r in rows if r["scene"] == scene and r["renderer"] == name], target)
+                   for name in renderers}
+        secs = {name: t for name, (t, _) in reached.items()}
         # "~": the curve did not reach the target, its time is extrapolated (less certain)
-        mark = {name: "" if brackets(of[name], target) else "~" for name in renderers}
+        mark = {name: "" if interpolated else "~" for name, (_, interpolated) in reached.items()}
         mitsuba = [v for k, v in secs.items() if k.startswith("mitsuba") and not math.isnan(v)]
         ratio = secs["penumbra"] / min(mitsuba) if mitsuba else math.nan
         adaptive_ratio = secs["penumbra adaptive"] / min(mitsuba) if mitsuba and adaptive else math.nan
