@@ -42,7 +42,10 @@ Corners corners(const TriangleMesh& mesh, uint32_t prim, int step) {
   std::array<std::array<uint32_t, 3>, 3> p;
   for (int k = 0; k < 3; ++k)
     for (int c = 0; c < 3; ++c) p[k][c] = std::bit_cast<uint32_t>(v[k][c] + 0.f);  // -0 + 0 = +0
-  std::sort(p.begin(), p.end());
+  // Three compare-exchanges sort three points.
+  if (p[1] < p[0]) std::swap(p[0], p[1]);
+  if (p[2] < p[1]) std::swap(p[1], p[2]);
+  if (p[1] < p[0]) std::swap(p[0], p[1]);
   Corners out;
   for (int k = 0; k < 3; ++k)
     for (int c = 0; c < 3; ++c) out[size_t(3 * k + c)] = p[k][c];
@@ -60,8 +63,8 @@ uint64_t mix(uint64_t x) {  // splitmix64's finaliser
 uint64_t triangle_hash(const TriangleMesh& mesh, uint32_t prim) {
   uint64_t h = uint64_t(mesh.time_steps());
   for (int s = 0; s < mesh.time_steps(); ++s)
-    for (uint32_t w : corners(mesh, prim, s)) h = mix(h ^ w) + 0x9e3779b97f4a7c15ull;
-  return h;
+    for (uint32_t w : corners(mesh, prim, s)) h = (h ^ w) * 0x9e3779b97f4a7c15ull;
+  return mix(h);
 }
 
 bool same_triangle(const TriangleMesh& a, uint32_t pa, const TriangleMesh& b, uint32_t pb) {
