@@ -44,8 +44,12 @@ BaselineResult trace_embree_baseline(const Scene& scene, const RenderSettings& s
                     camera.generate_ray(vec2(x, y) + sampler.get_2d(), vec2(0.5f), 0.f);
                 vec3 org = cr.origin, dir = cr.direction;
                 for (int depth = 1; depth <= max_depth; ++depth) {
-                  RTCIntersectContext ctx;
-                  rtcInitIntersectContext(&ctx);
+                  // Rays from a surface through the exact-t context filter, as the renderer
+                  // traces them (scene/exact_t_check.h); the camera ray through Embree alone.
+                  ExactTContext exact = scene.exact_t_check().context(RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT);
+                  RTCIntersectContext plain;
+                  rtcInitIntersectContext(&plain);
+                  RTCIntersectContext* ctx = depth == 1 ? &plain : &exact.embree;
                   RTCRayHit rh{};
                   rh.ray.org_x = org.x, rh.ray.org_y = org.y, rh.ray.org_z = org.z;
                   rh.ray.dir_x = dir.x, rh.ray.dir_y = dir.y, rh.ray.dir_z = dir.z;
@@ -54,7 +58,7 @@ BaselineResult trace_embree_baseline(const Scene& scene, const RenderSettings& s
                   rh.ray.mask = 0xFFFFFFFFu;
                   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
                   ++rays;
-                  rtcIntersect1(scene.embree_scene(), &ctx, &rh);
+                  rtcIntersect1(scene.embree_scene(), ctx, &rh);
                   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID || depth == max_depth) break;
                   const vec3 p = org + dir * rh.ray.tfar;
                   vec3 n = glm::normalize(vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z));
@@ -70,7 +74,7 @@ BaselineResult trace_embree_baseline(const Scene& scene, const RenderSettings& s
                   shadow.tfar = dist * 0.999f;
                   shadow.mask = 0xFFFFFFFFu;
                   ++rays;
-                  rtcOccluded1(scene.embree_scene(), &ctx, &shadow);
+                  rtcOccluded1(scene.embree_scene(), &exact.embree, &shadow);
                   org = origin;
                   dir = glm::normalize(Frame(n).to_world(square_to_cosine_hemisphere(sampler.get_2d())));
                 }

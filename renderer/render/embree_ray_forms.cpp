@@ -32,6 +32,9 @@ struct RaySet {
   std::vector<RTCRayHit> rays;  // for shadow rays only .ray is used
   bool occlusion = false;
   bool coherent = false;
+  // Rays that leave a surface: traced with the scene's exact-t context filter, as the renderer
+  // traces them (scene/exact_t_check.h), or they would stop on the surface they leave.
+  bool from_surface = false;
 };
 
 RTCRayHit make_ray(const vec3& o, const vec3& d, float t_max, float time) {
@@ -77,6 +80,8 @@ void make_rays(const Scene& scene, const RenderSettings& settings, RaySet* camer
       }
   camera_rays->coherent = true;
   shadow_rays->occlusion = true;
+  shadow_rays->from_surface = true;
+  bounce_rays->from_surface = true;
 }
 
 void to_packet(const RTCRayHit* in, unsigned count, RTCRayHit16* out, int* valid) {
@@ -115,41 +120,48 @@ Packets make_packets(const std::vector<RTCRayHit>& rays) {
   return p;
 }
 
-RTCIntersectContext make_context(bool coherent) {
-  RTCIntersectContext ctx;
-  rtcInitIntersectContext(&ctx);
-  ctx.flags = coherent ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
-  return ctx;
+// Camera rays go through Embree alone, as the renderer's first trace of them does; rays from a
+// surface through the exact-t context filter (the renderer's retrace and occlusion queries).
+ExactTContext make_context(const Scene& scene, const RaySet& set) {
+  const RTCIntersectContextFlags flags =
+      set.coherent ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+  if (set.from_surface) return scene.exact_t_check().context(flags);
+  ExactTContext c{};
+  rtcInitIntersectContext(&c.embree);
+  c.embree.flags = flags;
+  return c;
 }
 
 // Traces a working copy of `set` in `form` on every thread of `arena`; returns seconds and
 // counts the hits.
-double trace(RTCScene scene, const RaySet& set, RayForm form, tbb::task_arena& arena, uint64_t* hits) {
+double trace(const Scene& source, const RaySet& set, RayForm form, tbb::task_arena& arena, uint64_t* hits) {
+  RTCScene scene = source.embree_scene();
   std::vector<RTCRayHit> rays = set.rays;  // tracing overwrites tfar and the hit
   Packets packets = form == RayForm::kPacket16 ? make_packets(set.rays) : Packets{};
   const size_t chunks = (rays.size() + kChunk - 1) / kChunk;
   const auto start = std::chrono::steady_clock::now();
   arena.execute([&] {
     tbb::parallel_for(tbb::blocked_range<size_t>(0, chunks), [&](const tbb::blocked_range<size_t>& r) {
-      RTCIntersectContext ctx = make_context(set.coherent);
+      ExactTContext context = make_context(source, set);
+      RTCIntersectContext* ctx = &context.embree;
       for (size_t c = r.begin(); c != r.end(); ++c) {
         const size_t lo = c * kChunk, hi = std::min(rays.size(), lo + kChunk);
         switch (form) {
           case RayForm::kSingle:
             for (size_t i = lo; i < hi; ++i) {
-              if (set.occlusion) rtcOccluded1(scene, &ctx, &rays[i].ray);
-              else rtcIntersect1(scene, &ctx, &rays[i]);
+              if (set.occlusion) rtcOccluded1(scene, ctx, &rays[i].ray);
+              else rtcIntersect1(scene, ctx, &rays[i]);
             }
             break;
           case RayForm::kPacket16:
             for (size_t k = lo / kPacket; k < (hi + kPacket - 1) / kPacket; ++k) {
-              if (set.occlusion) rtcOccluded16(packets.valid[k].data(), scene, &ctx, &packets.rays[k].ray);
-              else rtcIntersect16(packets.valid[k].data(), scene, &ctx, &packets.rays[k]);
+              if (set.occlusion) rtcOccluded16(packets.valid[k].data(), scene, ctx, &packets.rays[k].ray);
+              else rtcIntersect16(packets.valid[k].data(), scene, ctx, &packets.rays[k]);
             }
             break;
           case RayForm::kStream:
-            if (set.occlusion) rtcOccluded1M(scene, &ctx, &rays[lo].ray, unsigned(hi - lo), sizeof(RTCRayHit));
-            else rtcIntersect1M(scene, &ctx, &rays[lo], unsigned(hi - lo), sizeof(RTCRayHit));
+            if (set.occlusion) rtcOccluded1M(scene, ctx, &rays[lo].ray, unsigned(hi - lo), sizeof(RTCRayHit));
+            else rtcIntersect1M(scene, ctx, &rays[lo], unsigned(hi - lo), sizeof(RTCRayHit));
             break;
         }
       }
@@ -203,7 +215,7 @@ std::vector<RayFormResult> trace_embree_ray_forms(const Scene& scene, const Rend
       RayFormResult r{kind, form};
       r.rays = set.rays.size();
       r.seconds = INFINITY;
-      for (int i = 0; i < std::max(1, repeat); ++i) r.seconds = std::min(r.seconds, trace(scene.embree_scene(), set, form, arena, &r.hits));
+      for (int i = 0; i < std::max(1, repeat); ++i) r.seconds = std::min(r.seconds, trace(scene, set, form, arena, &r.hits));
       results.push_back(r);
     }
   }

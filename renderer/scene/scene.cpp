@@ -20,6 +20,13 @@ bool Scene::intersect(const Ray& ray, SurfaceHit* hit) const {
   RTCRayHit rh = embree_ray_hit(ray);
   rtcIntersect1(rtc_scene_, &context, &rh);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+  // A re-hit of the surface the ray leaves: trace again with the test on every candidate
+  // (scene/exact_t_check.h).
+  if (exact_t_.rejects(rh.hit.geomID, rh.hit.instID[0], rh.hit.primID, ray.origin, ray.direction,
+                       ray.time)) {
+    rh = exact_t_retrace(rtc_scene_, exact_t_, ray);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+  }
   complete_hit(ray, rh.ray.tfar, rh.hit.geomID, rh.hit.instID[0], rh.hit.primID,
                vec2(rh.hit.u, rh.hit.v), hit);
   return true;
@@ -81,19 +88,30 @@ void Scene::intersect_packet(const Ray* rays, int count, bool coherent, SurfaceH
   rtcIntersect16(valid, rtc_scene_, &context, &rh);
   for (int i = 0; i < count; ++i) {
     found[i] = rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
-    if (found[i])
-      complete_hit(rays[i], rh.ray.tfar[i], rh.hit.geomID[i], rh.hit.instID[0][i], rh.hit.primID[i],
-                   vec2(rh.hit.u[i], rh.hit.v[i]), &hits[i]);
+    if (!found[i]) continue;
+    if (exact_t_.rejects(rh.hit.geomID[i], rh.hit.instID[0][i], rh.hit.primID[i], rays[i].origin,
+                         rays[i].direction, rays[i].time)) {
+      // A re-hit of the surface the ray leaves: trace this ray again, alone, with the test on
+      // every candidate (scene/exact_t_check.h).
+      const RTCRayHit one = exact_t_retrace(rtc_scene_, exact_t_, rays[i]);
+      found[i] = one.hit.geomID != RTC_INVALID_GEOMETRY_ID;
+      if (found[i])
+        complete_hit(rays[i], one.ray.tfar, one.hit.geomID, one.hit.instID[0], one.hit.primID,
+                     vec2(one.hit.u, one.hit.v), &hits[i]);
+      continue;
+    }
+    complete_hit(rays[i], rh.ray.tfar[i], rh.hit.geomID[i], rh.hit.instID[0][i], rh.hit.primID[i],
+                 vec2(rh.hit.u[i], rh.hit.v[i]), &hits[i]);
   }
 }
 
 void Scene::occluded_packet(const Ray* rays, int count, bool* occluded) const {
-  RTCIntersectContext context;
-  rtcInitIntersectContext(&context);
+  // Occlusion runs the exact-t test on every candidate (scene/exact_t_check.h).
+  ExactTContext context = exact_t_.context(RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT);
   alignas(64) int valid[kPacketSize];
   alignas(64) RTCRay16 r;
   fill_packet_rays(rays, count, valid, &r);
-  rtcOccluded16(valid, rtc_scene_, &context, &r);
+  rtcOccluded16(valid, rtc_scene_, &context.embree, &r);
   for (int i = 0; i < count; ++i) occluded[i] = r.tfar[i] < 0.f;
 }
 
@@ -105,8 +123,7 @@ void Scene::surface_derivatives(float time, SurfaceHit* hit) const {
 }
 
 bool Scene::occluded(const vec3& origin, const vec3& dir, float t_max, float time) const {
-  RTCIntersectContext context;
-  rtcInitIntersectContext(&context);
+  ExactTContext context = exact_t_.context(RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT);
   RTCRay r;
   r.org_x = origin.x;
   r.org_y = origin.y;
@@ -120,7 +137,7 @@ bool Scene::occluded(const vec3& origin, const vec3& dir, float t_max, float tim
   r.mask = 0xFFFFFFFFu;
   r.id = 0;
   r.flags = 0;
-  rtcOccluded1(rtc_scene_, &context, &r);
+  rtcOccluded1(rtc_scene_, &context.embree, &r);
   return r.tfar < 0.f;
 }
 

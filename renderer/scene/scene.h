@@ -11,6 +11,7 @@
 #include "renderer/lights/environment_light.h"
 #include "renderer/lights/light_sampler.h"
 #include "renderer/materials/material.h"
+#include "renderer/scene/exact_t_check.h"
 #include "renderer/scene/scene_features.h"
 #include "renderer/scene/scene_input.h"
 #include "renderer/scene/scene_object.h"
@@ -69,8 +70,12 @@ class Scene {
   const EnvironmentLight* environment() const { return environment_; }
   int environment_light() const { return environment_light_; }
 
-  // The Embree scene, for the Embree-only benchmark (render/embree_baseline.cpp).
+  // The Embree scene, for the Embree-only benchmark (render/embree_baseline.cpp). Rays that
+  // leave a surface must be traced with exact_t_check().context(...) to skip re-hits of it.
   RTCSceneTy* embree_scene() const { return rtc_scene_; }
+  // Where the exact-t test of triangle hits runs (scene/exact_t_check.h): enabled() if plain
+  // meshes are checked after traversal, off if every mesh filters in traversal.
+  const ExactTCheck& exact_t_check() const { return exact_t_; }
 
  private:
   // The hit record of Embree's answer: which object or copy, and its geometry from the shape.
@@ -99,6 +104,7 @@ class Scene {
   LightSampler light_sampler_;
   const EnvironmentLight* environment_ = nullptr;
   int environment_light_ = -1;
+  ExactTCheck exact_t_;
   RTCSceneTy* rtc_scene_ = nullptr;  // owned; released before the shapes it points into
 };
 

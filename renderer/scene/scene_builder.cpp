@@ -10,6 +10,7 @@
 #include "renderer/materials/coating_tables.h"
 #include "renderer/scene/scene.h"
 #include "renderer/shapes/make_shape.h"
+#include "renderer/shapes/triangle_mesh.h"
 #include "renderer/textures/image_texture.h"
 #include "renderer/textures/texture_image_cache.h"
 
@@ -159,14 +160,14 @@ class SceneBuilder {
 
   // One child scene per instanced mesh, holding the mesh's own geometry; then one Embree
   // instance per copy, with ids after the objects'.
-  void attach_instances(RTCDevice device, RTCScene scene, const std::vector<EmbreeGeometry>& geometries,
-                        EmbreeErrorScope& errors) {
+  void attach_instances(RTCDevice device, RTCScene scene, RTCSceneFlags flags,
+                        const std::vector<EmbreeGeometry>& geometries, EmbreeErrorScope& errors) {
     std::vector<RTCScene> child_of(s_.objects_.size(), nullptr);
     for (size_t k = 0; k < s_.instances_.size(); ++k) {
       const Instance& copy = s_.instances_[k];
       RTCScene& child = child_of[copy.object()];
       if (!child) {
-        EmbreeScene made = make_instanced_scene(device, geometries[copy.object()].get());
+        EmbreeScene made = make_instanced_scene(device, geometries[copy.object()].get(), flags);
         if (!made) throw SceneBuildError("Embree could not create a scene: " + errors.first_error());
         child = made.get();
         s_.instanced_scenes_.push_back(std::move(made));
@@ -179,16 +180,47 @@ class SceneBuilder {
     }
   }
 
+  // Where each mesh's exact-t test runs (scene/exact_t_check.h): a mesh without a cutout and
+  // without copies is checked after traversal, unless two triangles of the scene coincide:
+  // Embree's filter-free kernels break their exact-t ties differently in packets and in single
+  // rays, so then every mesh keeps its geometry filter, whose kernels agree. Copies keep it
+  // because Embree hands the filter the ray mapped by its own float inverse, which a check
+  // after the fact could not reproduce bit for bit.
+  void exact_t_check() {
+    std::vector<bool> copied(s_.objects_.size(), false);
+    for (const Instance& copy : s_.instances_) copied[copy.object()] = true;
+    std::vector<const TriangleMesh*> meshes, plain(s_.objects_.size(), nullptr);
+    bool any_plain = false;
+    for (size_t i = 0; i < s_.shapes_.size(); ++i) {
+      const TriangleMesh* mesh = s_.shapes_[i]->triangle_mesh();
+      if (!mesh) continue;
+      meshes.push_back(mesh);
+      if (!mesh->has_cutout() && !copied[i]) {
+        plain[i] = mesh;
+        any_plain = true;
+      }
+    }
+    if (!any_plain || has_coincident_triangles(meshes)) return;  // every mesh filters
+    for (size_t i = 0; i < plain.size(); ++i)
+      if (plain[i]) s_.shapes_[i]->triangle_mesh()->set_filter_in_traversal(false);
+    s_.exact_t_ = ExactTCheck(std::move(plain));
+  }
+
   void embree_scene() {
+    exact_t_check();
     RTCDevice device = embree_device();
     EmbreeErrorScope errors;
     EmbreeScene scene(rtcNewScene(device));
     if (!scene) throw SceneBuildError("Embree could not create a scene: " + errors.first_error());
     rtcSetSceneBuildQuality(scene.get(), RTC_BUILD_QUALITY_HIGH);
-    // Watertight triangle tests (shapes/triangle_mesh.cpp filters their hits so rays do not
-    // re-hit the surface they leave). The Embree-only benchmark traces this same scene, so it
-    // pays for both too.
-    rtcSetSceneFlags(scene.get(), RTC_SCENE_FLAG_ROBUST);
+    // Watertight triangle tests (shapes/triangle_mesh.cpp rejects their re-hits of the surface a
+    // ray leaves, in traversal or after it) and, when meshes are checked after traversal, the
+    // context filter that retraces and occlusion queries run. The Embree-only benchmark traces
+    // this same scene, so it pays for them too.
+    const RTCSceneFlags flags = s_.exact_t_.enabled()
+        ? RTCSceneFlags(RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION)
+        : RTC_SCENE_FLAG_ROBUST;
+    rtcSetSceneFlags(scene.get(), flags);
     std::vector<EmbreeGeometry> geometries(s_.shapes_.size());  // kept for the instances
     for (size_t i = 0; i < s_.shapes_.size(); ++i) {
       geometries[i] = s_.shapes_[i]->make_geometry(device);
@@ -197,7 +229,7 @@ class SceneBuilder {
                               ": " + errors.first_error());
       rtcAttachGeometryByID(scene.get(), geometries[i].get(), unsigned(i));
     }
-    attach_instances(device, scene.get(), geometries, errors);
+    attach_instances(device, scene.get(), flags, geometries, errors);
     rtcCommitScene(scene.get());
     const std::string error = errors.first_error();
     if (!error.empty()) throw SceneBuildError(error);

@@ -117,13 +117,13 @@ void Instance::surface_derivatives(float time, SurfaceHit* hit) const {
   hit->dpdv = linear_ * local.dpdv;
 }
 
-EmbreeScene make_instanced_scene(RTCDevice device, RTCGeometry geometry) {
+EmbreeScene make_instanced_scene(RTCDevice device, RTCGeometry geometry, RTCSceneFlags flags) {
   EmbreeScene scene(rtcNewScene(device));
   if (!scene) return scene;
   // As the top-level scene (scene_builder.cpp): the triangles' watertight test and filter
   // behave the same inside a copy.
   rtcSetSceneBuildQuality(scene.get(), RTC_BUILD_QUALITY_HIGH);
-  rtcSetSceneFlags(scene.get(), RTC_SCENE_FLAG_ROBUST);
+  rtcSetSceneFlags(scene.get(), flags);
   rtcAttachGeometryByID(scene.get(), geometry, 0);
   rtcCommitScene(scene.get());
   return scene;

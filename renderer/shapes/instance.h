@@ -56,7 +56,9 @@ class Instance {
 
 // A committed child scene holding `geometry` alone (a mesh's geometry, attached to the top-level
 // scene too: Embree lets one geometry belong to several scenes, so the copies add no vertex
-// buffers). Its geometry id is 0.
-EmbreeScene make_instanced_scene(RTCDevice device, RTCGeometry geometry);
+// buffers). Its geometry id is 0. `flags` are the top-level scene's (Embree needs
+// RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION on every scene a context filter should reach).
+EmbreeScene make_instanced_scene(RTCDevice device, RTCGeometry geometry,
+                                 RTCSceneFlags flags = RTC_SCENE_FLAG_ROBUST);
 
 }  // namespace penumbra

@@ -14,6 +14,8 @@
 
 namespace penumbra {
 
+class TriangleMesh;
+
 struct ShapeSample {
   vec3 p;           // point on the surface
   vec3 p_error;     // its absolute error bound
@@ -82,6 +84,10 @@ class Shape {
   virtual float pdf(const vec3& ref, const vec3& p, const vec3& n, float time) const = 0;
   // A point on the shape at time 0 (the Embree-only benchmark aims its shadow rays at it).
   virtual vec3 reference_point() const = 0;
+  // The shape as Embree triangles (meshes and quads), else nullptr: the scene build decides
+  // where their exact-t test runs (scene/exact_t_check.h) and looks for coincident triangles.
+  virtual TriangleMesh* triangle_mesh() { return nullptr; }
+  const TriangleMesh* triangle_mesh() const { return const_cast<Shape*>(this)->triangle_mesh(); }
 };
 
 // Solid-angle density of picking point p (normal n) uniformly by area on a surface of `area`:

@@ -22,7 +22,8 @@ namespace {
 // == 0 for a ray starting exactly on the plane (an exact hit point has a zero offset), and
 // Embree's plane distance carries an error of order eps times the distance of the triangle's
 // first vertex from the ray origin (docs/design-notes.md has the measurements).
-// So every triangle hit passes this filter, which re-evaluates the sign of
+// So every triangle hit passes this test (here as Embree's geometry filter, or, for meshes the
+// scene checks after traversal, through scene/exact_t_check.h), which re-evaluates the sign of
 // t = ((p0 - o) . n) / (d . n) in double precision from the same float vertices hit points are
 // rebuilt from and keeps the hit only if t > 0. Products of floats are exact to 2^-53 in
 // double, so the sign is right far below any spawn offset; a hit with t > 0 is never dropped,
@@ -133,8 +134,10 @@ vec3 TriangleMesh::interpolated_displacement(float time) const {
 EmbreeGeometry TriangleMesh::make_geometry(RTCDevice device) const {
   EmbreeGeometry geom(rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE));
   if (!geom) return geom;
-  rtcSetGeometryIntersectFilterFunction(geom.get(), triangle_filter_fn);
-  rtcSetGeometryOccludedFilterFunction(geom.get(), triangle_filter_fn);
+  if (filter_in_traversal()) {
+    rtcSetGeometryIntersectFilterFunction(geom.get(), triangle_filter_fn);
+    rtcSetGeometryOccludedFilterFunction(geom.get(), triangle_filter_fn);
+  }
   rtcSetGeometryTimeStepCount(geom.get(), unsigned(time_steps_));
   static_assert(sizeof(vec3) == 12, "vertex layout");
   for (int k = 0; k < time_steps_; ++k) {

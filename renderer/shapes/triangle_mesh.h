@@ -22,6 +22,24 @@ class TriangleMesh : public Shape {
   bool sample(const vec3& ref, float time, const vec2& u, ShapeSample* out) const override;
   float pdf(const vec3& ref, const vec3& p, const vec3& n, float time) const override;
   vec3 reference_point() const override { return positions_[indices_[0]]; }
+  TriangleMesh* triangle_mesh() override { return this; }
+
+  // Whether Embree calls the exact-t test below on every candidate hit (a geometry filter, the
+  // default) or the scene checks closest hits after traversal (scene/exact_t_check.h). Set
+  // before make_geometry; a mesh with a cutout always filters in traversal (a hole must let
+  // the ray through to what lies behind).
+  void set_filter_in_traversal(bool on) { filter_in_traversal_ = on; }
+  bool filter_in_traversal() const { return filter_in_traversal_ || has_cutout(); }
+
+  // The vertices Embree is given: triangle `prim`'s three at time step `step` (of time_steps();
+  // one for a static mesh).
+  size_t triangle_count() const { return indices_.size() / 3; }
+  int time_steps() const { return time_steps_; }
+  void step_triangle(uint32_t prim, int step, vec3 out[3]) const {
+    const uint32_t* tri = indices_.data() + size_t(prim) * 3;
+    const vec3 d = time_steps_ > 1 ? step_displacement_[size_t(step)] : vec3(0.f);
+    for (int k = 0; k < 3; ++k) out[k] = positions_[tri[k]] + d;
+  }
 
   // The displacement of every vertex at normalised shutter time `time`, as Embree interpolates
   // it between its time steps (not the exact quadratic path): hit points must lie on the
@@ -79,6 +97,7 @@ class TriangleMesh : public Shape {
   int time_steps_ = 1;
   std::vector<vec3> step_displacement_;
   bool need_uv_ = false;  // something reads SurfaceHit::uv (ShapeContext::need_uv)
+  bool filter_in_traversal_ = true;
 };
 
 }  // namespace penumbra
