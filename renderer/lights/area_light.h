@@ -30,6 +30,7 @@ class AreaLight final : public Light {
     return shape_.pdf(ref, p, n, time);
   }
   const Shape& shape() const { return shape_; }
+  bool textured() const { return texture_ != nullptr; }
 
  private:
   const Shape& shape_;

@@ -17,6 +17,8 @@ class LightSampler {
   int choose(float u) const;
   // Probability that choose() returns `light`.
   float pmf(int light) const { return pmf_[light]; }
+  // The cumulative probabilities choose() searches (the last is 1), for choosing in SIMD.
+  const std::vector<float>& cdf() const { return cdf_; }
 
  private:
   std::vector<float> pmf_, cdf_;

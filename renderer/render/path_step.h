@@ -164,22 +164,17 @@ inline void path_escaped(const Scene& scene, PathState& s, FirstHit* first) {
   }
 }
 
-// The path's ray hit `hit`: emission, next-event estimation (its visibility test returned in
-// *shadow when `*has_shadow`), then the BSDF's sample for the next segment and Russian roulette.
-// Returns whether the path goes on with s.ray.
-// `sampler`: a Sampler, or anything with its get_1d/get_2d (the wavefront driver's
-// PrefetchedSampler hands out values computed for a whole bounce at once).
-template <bool kDistributed, uint32_t kFeatures, class PathSampler>
-inline bool path_hit(const Scene& scene, const IntegratorSettings& settings, PathState& s,
-                     SurfaceHit& hit, PathSampler& sampler, PathCounters& counters, FirstHit* first,
-                     ShadowQuery* shadow, bool* has_shadow) {
+// The path's ray hit `hit`, first part: the first-hit record, Beer-Lambert absorption and the
+// emission it sees. False if the path ends here (it reached max_depth); else path_scatter goes
+// on from the same hit.
+template <uint32_t kFeatures>
+[[gnu::always_inline]] inline bool path_arrive(const Scene& scene, const IntegratorSettings& settings,
+                                               PathState& s, const SurfaceHit& hit,
+                                               FirstHit* first) {
   using namespace path_step_detail;
-  *has_shadow = false;
   const int max_depth = settings.max_depth < 0 ? INT_MAX : settings.max_depth;
   const LightSampler& lights = scene.light_sampler();
-  constexpr uint32_t kContinueLobes = kDistributed ? uint32_t(kLobeNonDiffuse) : uint32_t(kLobeAll);
   const Ray& ray = s.ray;
-
   const SceneObject& obj = scene.object(hit.object);
   const Material& material = scene.material(obj.material);
   const bool front = glm::dot(ray.direction, hit.ng) < 0.f;
@@ -199,7 +194,24 @@ inline bool path_hit(const Scene& scene, const IntegratorSettings& settings, Pat
                                           obj.area_light->pdf(s.prev_p, hit.p, hit.ng, ray.time));
     s.radiance += s.beta * obj.area_light->radiance(TextureQuery{hit.p, hit.uv, ray.time}) * w;
   }
-  if (s.depth >= max_depth) return false;
+  return s.depth < max_depth;
+}
+
+// Second part, after path_arrive: next-event estimation (its visibility test returned in
+// *shadow when `*has_shadow`), then the BSDF's sample for the next segment and Russian
+// roulette. Returns whether the path goes on with s.ray.
+// `sampler`: a Sampler, or anything with its get_1d/get_2d (the wavefront driver's
+// PrefetchedSampler hands out values computed for a whole bounce at once).
+template <bool kDistributed, uint32_t kFeatures, class PathSampler>
+inline bool path_scatter(const Scene& scene, const IntegratorSettings& settings, PathState& s,
+                         SurfaceHit& hit, PathSampler& sampler, PathCounters& counters,
+                         ShadowQuery* shadow, bool* has_shadow) {
+  using namespace path_step_detail;
+  *has_shadow = false;
+  const LightSampler& lights = scene.light_sampler();
+  constexpr uint32_t kContinueLobes = kDistributed ? uint32_t(kLobeNonDiffuse) : uint32_t(kLobeAll);
+  const Ray& ray = s.ray;
+  const Material& material = scene.material(scene.object(hit.object).material);
 
   // The BSDF here: the material's own where nothing varies over its surface (no lookup, the
   // path untextured scenes take), else the one with its textures looked up at this point.
@@ -292,6 +304,17 @@ inline bool path_hit(const Scene& scene, const IntegratorSettings& settings, Pat
   }
   ++s.depth;
   return true;
+}
+
+// A whole step at a hit: path_arrive, then path_scatter.
+template <bool kDistributed, uint32_t kFeatures, class PathSampler>
+inline bool path_hit(const Scene& scene, const IntegratorSettings& settings, PathState& s,
+                     SurfaceHit& hit, PathSampler& sampler, PathCounters& counters,
+                     FirstHit* first, ShadowQuery* shadow, bool* has_shadow) {
+  *has_shadow = false;
+  if (!path_arrive<kFeatures>(scene, settings, s, hit, first)) return false;
+  return path_scatter<kDistributed, kFeatures>(scene, settings, s, hit, sampler, counters,
+                                               shadow, has_shadow);
 }
 
 }  // namespace penumbra

@@ -54,8 +54,23 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
       if (b.found_[k]) samples.add(*b.samplers_[live[k]], b.cursors_[live[k]]);
     samples.compute();
 
-    // Shade: every live path takes its step; the survivors are kept in order.
-    size_t survivors = 0, shadows = 0, hit_index = 0;
+    // Shade: every live path takes its step. Paths on plain Lambertian surfaces (path
+    // integrator) take theirs in the diffuse stage, the others one by one; each path's results
+    // go to its own slot k, and the survivors and shadow queries are then gathered in path
+    // order, as the scalar loop would leave them.
+    constexpr bool kStage = !kDistributed;
+    if (kStage && (!b.diffuse_stage_ || &b.diffuse_stage_->scene() != &scene))
+      b.diffuse_stage_ = std::make_unique<DiffuseStage>(scene);
+    DiffuseStage* stage = kStage ? b.diffuse_stage_.get() : nullptr;
+    const bool next_event = (kFeatures & kFeatureLights) != 0 && !scene.light_sampler().empty();
+    if (stage) stage->start(live.size());
+    std::vector<uint8_t>& goes_on = b.goes_on_;
+    std::vector<uint8_t>& has_shadow = b.has_shadow_;
+    goes_on.assign(live.size(), 0);
+    has_shadow.assign(live.size(), 0);
+    std::vector<uint32_t>& hit_of = b.hit_of_;
+    hit_of.resize(live.size());
+    size_t hit_index = 0;
     for (size_t k = 0; k < live.size(); ++k) {
       const uint32_t p = live[k];
       PathState& s = b.states_[p];
@@ -64,13 +79,56 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
         path_escaped<kFeatures>(scene, s, first);
         continue;
       }
-      PrefetchedSampler sampler(*b.samplers_[p], b.cursors_[p], samples, hit_index++);
-      bool has_shadow;
-      const bool goes_on = path_hit<kDistributed, kFeatures>(
-          scene, settings, s, b.hits_[k], sampler, counters, first, &b.shadows_[shadows], &has_shadow);
+      const size_t j = hit_index++;
+      hit_of[k] = uint32_t(j);
+      SurfaceHit& hit = b.hits_[k];
+      if (stage && stage->takes(hit.object)) {
+        if (path_arrive<kFeatures>(scene, settings, s, hit, first))
+          stage->add(uint32_t(k), s, hit, samples.x(j), samples.y(j), next_event);
+        continue;
+      }
+      PrefetchedSampler sampler(*b.samplers_[p], b.cursors_[p], samples, j);
+      bool shadow;
+      goes_on[k] = path_hit<kDistributed, kFeatures>(scene, settings, s, hit, sampler, counters,
+                                                     first, &b.shadows_[k], &shadow);
+      has_shadow[k] = shadow;
       b.cursors_[p] = sampler.cursor();
-      if (has_shadow) b.shadow_paths_[shadows++] = p;
-      if (goes_on) live[survivors++] = p;  // survivors <= k: reads stay ahead of writes
+    }
+    if (stage) {
+      stage->compute(settings, next_event);
+      for (size_t lane = 0; lane < stage->size(); ++lane) {
+        const size_t k = stage->slot(lane);
+        const uint32_t p = live[k];
+        PathState& s = b.states_[p];
+        if (!stage->staged(lane)) {  // its light has no kernel: the step one path at a time
+          PrefetchedSampler sampler(*b.samplers_[p], b.cursors_[p], samples, hit_of[k]);
+          bool shadow;
+          goes_on[k] = path_scatter<kDistributed, kFeatures>(scene, settings, s, b.hits_[k],
+                                                             sampler, counters, &b.shadows_[k],
+                                                             &shadow);
+          has_shadow[k] = shadow;
+          b.cursors_[p] = sampler.cursor();
+          continue;
+        }
+        if (stage->counted_ray(lane)) ++counters.rays;
+        if (stage->has_shadow(lane)) {
+          has_shadow[k] = 1;
+          b.shadows_[k] = stage->shadow(lane);
+        }
+        if (stage->alive(lane)) {
+          goes_on[k] = 1;
+          stage->apply(lane, s, b.cursors_[p]);
+        }
+      }
+    }
+    size_t survivors = 0, shadows = 0;
+    for (size_t k = 0; k < live.size(); ++k) {
+      const uint32_t p = live[k];
+      if (has_shadow[k]) {  // shadows <= k: reads stay ahead of writes
+        b.shadows_[shadows] = b.shadows_[k];
+        b.shadow_paths_[shadows++] = p;
+      }
+      if (goes_on[k]) live[survivors++] = p;  // survivors <= k likewise
     }
     live.resize(survivors);
 

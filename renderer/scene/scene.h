@@ -66,6 +66,7 @@ class Scene {
 
   const LightSampler& light_sampler() const { return light_sampler_; }
   const Light& light(int index) const { return *lights_[size_t(index)]; }
+  int light_count() const { return int(lights_.size()); }
   // The environment (nullptr if rays that escape see black) and its index among the lights.
   const EnvironmentLight* environment() const { return environment_; }
   int environment_light() const { return environment_light_; }

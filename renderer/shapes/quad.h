@@ -12,6 +12,11 @@ class Quad final : public TriangleMesh {
   bool sample(const vec3& ref, float time, const vec2& u, ShapeSample* out) const override;
   vec3 reference_point() const override { return quad_.origin + 0.5f * (quad_.u + quad_.v); }
 
+  // What sample() reads, for the wavefront driver's light kernels (render/light_kernels.h).
+  const QuadDesc& desc() const { return quad_; }
+  const vec3& normal() const { return normal_; }
+  using TriangleMesh::moving;
+
  private:
   QuadDesc quad_;  // origin moved by the context's offset
   // Its unit normal, computed once: light sampling asks for it on every shadow ray, and the

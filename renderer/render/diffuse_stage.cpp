@@ -1,0 +1,381 @@
+#include "renderer/render/diffuse_stage.h"
+
+#include <cmath>
+#include <cstring>
+
+#include "renderer/core/simd_clones.h"
+#include "renderer/materials/diffuse.h"
+#include "renderer/sampling/sampling.h"
+
+namespace penumbra {
+namespace {
+
+[[gnu::always_inline]] inline uint32_t bits_of(float f) {
+  uint32_t b;
+  std::memcpy(&b, &f, sizeof b);
+  return b;
+}
+[[gnu::always_inline]] inline float float_of(uint32_t b) {
+  float f;
+  std::memcpy(&f, &b, sizeof f);
+  return f;
+}
+
+// One component of offset_ray_origin after p + offset: next_float_up where the offset is
+// positive, next_float_down where it is negative (core/ray.h), as selects.
+[[gnu::always_inline]] inline float step_away(float po, float offset) {
+  const float vu = po == 0.f ? 0.f : po;  // -0 becomes +0 (and +0 stays)
+  const uint32_t bu = bits_of(vu);
+  const float up = po == kInfinity ? po : float_of(vu >= 0.f ? bu + 1u : bu - 1u);
+  const float vd = po == 0.f ? -0.f : po;
+  const uint32_t bd = bits_of(vd);
+  const float down = po == -kInfinity ? po : float_of(vd > 0.f ? bd - 1u : bd + 1u);
+  return offset > 0.f ? up : (offset < 0.f ? down : po);
+}
+
+// offset_ray_origin(p, e, n, w) (core/ray.h, pbrt-v4 section 6.8.6).
+[[gnu::always_inline]] inline void offset_origin(float px, float py, float pz, float ex, float ey,
+                                                 float ez, float nx, float ny, float nz, float wx,
+                                                 float wy, float wz, float* ox, float* oy,
+                                                 float* oz) {
+  const float d = (std::fabs(nx) * ex + std::fabs(ny) * ey) + std::fabs(nz) * ez;
+  const bool flip = ((wx * nx + wy * ny) + wz * nz) < 0.f;
+  const float fx = d * nx, fy = d * ny, fz = d * nz;
+  const float dx = flip ? -fx : fx, dy = flip ? -fy : fy, dz = flip ? -fz : fz;
+  *ox = step_away(px + dx, dx);
+  *oy = step_away(py + dy, dy);
+  *oz = step_away(pz + dz, dz);
+}
+
+// A lane's condition as an integer mask (all bits or none): conditions combine with integer
+// &, | and ~, and only selects read them. (Combined as bools, GCC 12 turns some of them into
+// selects between bools, which its vectoriser does not support.)
+using Mask = int32_t;
+[[gnu::always_inline]] inline Mask mask(bool b) { return b ? -1 : 0; }
+template <class T>
+[[gnu::always_inline]] inline T when(Mask m, T a, T b) {
+  return m != 0 ? a : b;
+}
+
+// path_step_detail::geometry_agrees.
+[[gnu::always_inline]] inline Mask agrees(float ax, float ay, float az, float bx, float by,
+                                          float bz, float nx, float ny, float nz, float a_z_local,
+                                          float b_z_local) {
+  const float geo = ((ax * nx + ay * ny) + az * nz) * ((bx * nx + by * ny) + bz * nz);
+  const float shade = a_z_local * b_z_local;
+  return mask(geo != 0.f) & ~(mask(geo > 0.f) ^ mask(shade > 0.f));
+}
+
+[[gnu::always_inline]] inline Mask finite(float x) { return mask(std::fabs(x) < kInfinity); }
+
+// The arrays of a stage's lanes, inputs and results (DiffuseStage's members).
+struct Lanes {
+  const float *p[3], *e[3], *ng[3], *ns[3], *dir[3], *beta[3], *colour[3];
+  const float *time, *eta, *u_dir[2], *u_rr;
+  const int32_t* depth;
+  const int32_t* light_ok;
+  const float *l_wi[3], *l_distance, *l_pdf, *l_p[3], *l_error[3], *l_n[3], *l_value[3], *l_pmf;
+  int32_t *alive, *has_shadow, *nee_ray, *dims;
+  float *s_origin[3], *s_dir[3], *s_t_max, *s_contrib[3];
+  float *origin[3], *wo[3], *beta_out[3], *prev_pdf;
+};
+
+// path_scatter of the path integrator on a two-sided DiffuseBsdf without a normal map, lane by
+// lane (see the header). `next_event`: whether the step samples a light.
+template <bool kNextEvent>
+[[gnu::always_inline]] inline void diffuse_step(const Lanes& lanes, size_t n, int32_t rr_depth) {
+  // A local copy: stores through the result pointers cannot then change the pointers, which
+  // GCC would otherwise reload every iteration (and not vectorise).
+  const Lanes L = lanes;
+  constexpr float kShadowScale = 1.f - kShadowEpsilon;
+#pragma GCC ivdep
+  for (size_t i = 0; i < n; ++i) {
+    const float px = L.p[0][i], py = L.p[1][i], pz = L.p[2][i];
+    const float ex = L.e[0][i], ey = L.e[1][i], ez = L.e[2][i];
+    const float gx = L.ng[0][i], gy = L.ng[1][i], gz = L.ng[2][i];
+    const float nx = L.ns[0][i], ny = L.ns[1][i], nz = L.ns[2][i];
+    const float bx = L.beta[0][i], by = L.beta[1][i], bz = L.beta[2][i];
+    const float cx = L.colour[0][i], cy = L.colour[1][i], cz = L.colour[2][i];
+    // Frame(ns): Duff et al. 2017 (core/frame.h).
+    const float sign = std::copysign(1.f, nz);
+    const float fa = -1.f / (sign + nz);
+    const float fb = nx * ny * fa;
+    const float sx = 1.f + sign * nx * nx * fa, sy = sign * fb, sz = -sign * nx;
+    const float tx = fb, ty = sign + ny * ny * fa, tz = -ny;
+    // wi = -direction, in world and local coordinates.
+    const float wx = -L.dir[0][i], wy = -L.dir[1][i], wz = -L.dir[2][i];
+    // (Only the local z of wi matters to a Lambertian surface.)
+    const float wi_z = (wx * nx + wy * ny) + wz * nz;
+
+    // Next-event estimation.
+    const float lx = L.l_wi[0][i], ly = L.l_wi[1][i], lz = L.l_wi[2][i];
+    const float l_pdf = L.l_pdf[i] * L.l_pmf[i];
+    const float lo_z = (lx * nx + ly * ny) + lz * nz;
+    const Mask l_agrees = agrees(wx, wy, wz, lx, ly, lz, gx, gy, gz, wi_z, lo_z);
+    // SurfaceBsdf::evaluate: the back side mirrored to the front; DiffuseBsdf::evaluate.
+    const Mask flip = mask(wi_z < 0.f);
+    const float a_z = when(flip, -wi_z, wi_z), b_z = when(flip, -lo_z, lo_z);
+    const Mask zero = mask(a_z <= 0.f) | mask(b_z <= 0.f);
+    // Zero where the model answers zero. (SurfaceBsdf also zeroes an answer that is not finite;
+    // with b_z > 0 a cosine and the colour finite, which the stage requires, it always is.)
+    const float cos_term = kInvPi * b_z;
+    float f_x = when(zero, 0.f, cx * cos_term), f_y = when(zero, 0.f, cy * cos_term),
+          f_z = when(zero, 0.f, cz * cos_term);
+    const float e_pdf = when(zero, 0.f, b_z * kInvPi);
+    // power_heuristic(l_pdf, e_pdf).
+    const float h_a = l_pdf * l_pdf, h_b = e_pdf * e_pdf;
+    const float h_ratio = h_a / (h_a + h_b);
+    const float mis = h_a + h_b > 0.f ? h_ratio : 0.f;
+    f_x = f_x * mis;
+    f_y = f_y * mis;
+    f_z = f_z * mis;
+    const Mask black = mask(f_x == 0.f) & mask(f_y == 0.f) & mask(f_z == 0.f);
+    const Mask nee = mask(kNextEvent) & mask(L.light_ok[i] != 0) & l_agrees & ~black;
+    // The shadow ray: from the offset hit point to the light point offset off the light.
+    float so_x, so_y, so_z;
+    offset_origin(px, py, pz, ex, ey, ez, gx, gy, gz, lx, ly, lz, &so_x, &so_y, &so_z);
+    const float lnx = L.l_n[0][i], lny = L.l_n[1][i], lnz = L.l_n[2][i];
+    const Mask point = mask(lnx == 0.f) & mask(lny == 0.f) & mask(lnz == 0.f);
+    float tg_x, tg_y, tg_z;
+    offset_origin(L.l_p[0][i], L.l_p[1][i], L.l_p[2][i], L.l_error[0][i], L.l_error[1][i],
+                  L.l_error[2][i], lnx, lny, lnz, -lx, -ly, -lz, &tg_x, &tg_y, &tg_z);
+    tg_x = when(point, L.l_p[0][i], tg_x);
+    tg_y = when(point, L.l_p[1][i], tg_y);
+    tg_z = when(point, L.l_p[2][i], tg_z);
+    const float dx = tg_x - so_x, dy = tg_y - so_y, dz = tg_z - so_z;
+    const float dist = std::sqrt((dx * dx + dy * dy) + dz * dz);
+    const float qx = dx / dist, qy = dy / dist, qz = dz / dist;
+    const Mask far_end = finite(L.l_distance[i]);
+    const Mask positive = mask(dist > 0.f);
+    const float t_max = when(far_end, when(point, dist, dist * kShadowScale), kInfinity);
+    L.s_origin[0][i] = so_x;
+    L.s_origin[1][i] = so_y;
+    L.s_origin[2][i] = so_z;
+    L.s_dir[0][i] = when(far_end & positive, qx, lx);
+    L.s_dir[1][i] = when(far_end & positive, qy, ly);
+    L.s_dir[2][i] = when(far_end & positive, qz, lz);
+    L.s_t_max[i] = t_max;
+    L.s_contrib[0][i] = bx * f_x * L.l_value[0][i] / l_pdf;
+    L.s_contrib[1][i] = by * f_y * L.l_value[1][i] / l_pdf;
+    L.s_contrib[2][i] = bz * f_z * L.l_value[2][i] / l_pdf;
+    L.nee_ray[i] = nee;
+    L.has_shadow[i] = nee & mask(t_max > 0.f);
+
+    // The BSDF's sample: DiffuseBsdf::sample on the front-mirrored wi, square_to_cosine_hemisphere.
+    const float ox = 2.f * L.u_dir[0][i] - 1.f, oy = 2.f * L.u_dir[1][i] - 1.f;
+    const Mask centre = mask(ox == 0.f) & mask(oy == 0.f);
+    const Mask wide = mask(std::fabs(ox) > std::fabs(oy));
+    const float num = when(wide, oy, ox), den = when(wide, ox, oy), r = when(wide, ox, oy);
+    float sn, cs;
+    sincos_quarter_pi((kPi / 4.f) * (num / den), &sn, &cs);
+    const float d_x = when(centre, 0.f, when(wide, r * cs, r * sn));
+    const float d_y = when(centre, 0.f, when(wide, r * sn, r * cs));
+    const float h = 1.f - d_x * d_x - d_y * d_y;
+    const float o_z = std::sqrt(0.f < h ? h : 0.f);  // safe_sqrt: std::max(0.f, h)
+    const float pdf = o_z > 0.f ? o_z * kInvPi : 0.f;
+    // (SurfaceBsdf::sample's finiteness checks always pass here: the colour is finite, which the
+    // stage requires, and for the sampler's values in [0, 1) so are d, o_z and the pdf.)
+    const Mask sampled = ~mask(a_z <= 0.f) & mask(pdf > 0.f);
+    const float wo_z = when(flip, -o_z, o_z);
+    const float ww_x = (sx * d_x + tx * d_y) + nx * wo_z;
+    const float ww_y = (sy * d_x + ty * d_y) + ny * wo_z;
+    const float ww_z = (sz * d_x + tz * d_y) + nz * wo_z;
+    const Mask o_agrees = agrees(wx, wy, wz, ww_x, ww_y, ww_z, gx, gy, gz, wi_z, wo_z);
+    const float nb_x = bx * cx, nb_y = by * cy, nb_z = bz * cz;
+    float o_x, o_y, o_z2;
+    offset_origin(px, py, pz, ex, ey, ez, gx, gy, gz, ww_x, ww_y, ww_z, &o_x, &o_y, &o_z2);
+    // max_component (std::max as its comparison), then Russian roulette as path_scatter.
+    const float m_yz = nb_y < nb_z ? nb_z : nb_y;
+    const float beta_max = nb_x < m_yz ? m_yz : nb_x;
+    const Mask roulette = mask(L.depth[i] >= rr_depth);
+    const float q_raw = beta_max * L.eta[i] * L.eta[i];
+    const float q = 0.95f < q_raw ? 0.95f : q_raw;
+    const Mask killed = roulette & mask(L.u_rr[i] >= q);
+    L.beta_out[0][i] = when(roulette, nb_x / q, nb_x);
+    L.beta_out[1][i] = when(roulette, nb_y / q, nb_y);
+    L.beta_out[2][i] = when(roulette, nb_z / q, nb_z);
+    L.alive[i] = sampled & o_agrees & mask(beta_max > 0.f) & ~killed;
+    L.dims[i] = (kNextEvent ? 4 : 2) + (roulette & 1);
+    L.origin[0][i] = o_x;
+    L.origin[1][i] = o_y;
+    L.origin[2][i] = o_z2;
+    L.wo[0][i] = ww_x;
+    L.wo[1][i] = ww_y;
+    L.wo[2][i] = ww_z;
+    L.prev_pdf[i] = pdf;
+  }
+}
+
+// The loop compiled for each case (a flag inside the loop kept GCC from vectorising it).
+PENUMBRA_SIMD_CLONES
+void diffuse_step_kernel(const Lanes& lanes, size_t n, bool next_event, int32_t rr_depth) {
+  if (next_event)
+    diffuse_step<true>(lanes, n, rr_depth);
+  else
+    diffuse_step<false>(lanes, n, rr_depth);
+}
+
+}  // namespace
+
+DiffuseStage::DiffuseStage(const Scene& scene) : scene_(scene), lights_(scene) {
+  colour_of_.assign(scene.object_count(), -1);
+  for (size_t o = 0; o < scene.object_count(); ++o) {
+    const Material& m = scene.material(scene.object(uint32_t(o)).material);
+    if (m.varies() || m.normal_mapped() || m.bsdf().normal_mapped() || !m.bsdf().two_sided())
+      continue;
+    const auto* diffuse = std::get_if<DiffuseBsdf>(&m.bsdf().model());
+    if (!diffuse || !is_finite(diffuse->albedo())) continue;
+    colour_of_[o] = int32_t(colours_.size());
+    colours_.push_back(diffuse->albedo());
+  }
+}
+
+void DiffuseStage::start(size_t paths) {
+  count_ = 0;
+  if (slot_.size() >= paths) return;
+  slot_.resize(paths);
+  for (int c = 0; c < 3; ++c)
+    for (auto* a : {&p_[c], &p_error_[c], &ng_[c], &ns_[c], &dir_[c], &beta_[c], &colour_[c],
+                    &l_wi_[c], &l_p_[c], &l_error_[c], &l_n_[c], &l_value_[c], &s_origin_[c],
+                    &s_dir_[c], &s_contrib_[c], &origin_[c], &wo_[c], &beta_out_[c]})
+      a->resize(paths);
+  for (auto* a : {&time_, &eta_, &u_light_, &u_point_[0], &u_point_[1], &u_dir_[0], &u_dir_[1],
+                  &u_rr_, &l_distance_, &l_pdf_, &l_pmf_, &s_t_max_, &prev_pdf_})
+    a->resize(paths);
+  for (auto* a : {&depth_, &light_, &light_ok_, &staged_, &alive_, &has_shadow_, &nee_ray_, &dims_})
+    a->resize(paths);
+}
+
+void DiffuseStage::add(uint32_t slot, const PathState& s, const SurfaceHit& hit, const float* x,
+                       const float* y, bool next_event) {
+  const size_t i = count_++;
+  slot_[i] = slot;
+  const Spectrum& colour = colours_[size_t(colour_of_[hit.object])];
+  for (int c = 0; c < 3; ++c) {
+    p_[c][i] = hit.p[c];
+    p_error_[c][i] = hit.p_error[c];
+    ng_[c][i] = hit.ng[c];
+    ns_[c][i] = hit.ns[c];
+    dir_[c][i] = s.ray.direction[c];
+    beta_[c][i] = s.beta[c];
+    colour_[c][i] = colour[c];
+  }
+  time_[i] = s.ray.time;
+  eta_[i] = s.eta;
+  depth_[i] = s.depth;
+  // The step's values in the order path_scatter takes them: light choice and point (with next-
+  // event estimation), lobe (unused by a single lobe), direction, roulette.
+  const int d = next_event ? 2 : 0;
+  u_light_[i] = x[0];
+  u_point_[0][i] = x[1];
+  u_point_[1][i] = y[1];
+  u_dir_[0][i] = x[d + 1];
+  u_dir_[1][i] = y[d + 1];
+  u_rr_[i] = x[d + 2];
+}
+
+void DiffuseStage::compute(const IntegratorSettings& settings, bool next_event) {
+  const size_t n = count_;
+  if (n == 0) return;
+  for (size_t i = 0; i < n; ++i) staged_[i] = 1;
+  if (next_event) {
+    choose_lights(lights_.cdf.data(), int32_t(lights_.cdf.size()), n, u_light_.data(),
+                  light_.data());
+    for (const StagedLights::QuadLight& q : lights_.quads)
+      quad_light_samples(q.origin, q.u, q.v, q.n, q.area, q.light, n, light_.data(), p_[0].data(),
+                         p_[1].data(), p_[2].data(), u_point_[0].data(), u_point_[1].data(),
+                         light_ok_.data(), l_wi_[0].data(), l_wi_[1].data(), l_wi_[2].data(),
+                         l_distance_.data(), l_pdf_.data(), l_p_[0].data(), l_p_[1].data(),
+                         l_p_[2].data(), l_error_[0].data(), l_error_[1].data(),
+                         l_error_[2].data());
+    if (lights_.environment_id >= 0)
+      uniform_sphere_samples(lights_.environment_id, n, light_.data(), u_point_[0].data(),
+                             u_point_[1].data(), light_ok_.data(), l_wi_[0].data(),
+                             l_wi_[1].data(), l_wi_[2].data());
+    // Each lane's light constants: a quad's normal and radiance, or the environment's (no far
+    // end: infinite distance, zero point and normal, as ConstantEnvironment::sample leaves them).
+    for (size_t i = 0; i < n; ++i) {
+      const int32_t light = light_[i];
+      const int32_t source = lights_.source[size_t(light)];
+      l_pmf_[i] = lights_.pmf[size_t(light)];
+      if (source >= 0) {
+        const StagedLights::QuadLight& q = lights_.quads[size_t(source)];
+        for (int c = 0; c < 3; ++c) {
+          l_n_[c][i] = q.n[c];
+          l_value_[c][i] = q.radiance[c];
+        }
+      } else if (source == StagedLights::kEnvironment) {
+        l_distance_[i] = kInfinity;
+        l_pdf_[i] = uniform_sphere_pdf();
+        for (int c = 0; c < 3; ++c) {
+          l_n_[c][i] = 0.f;
+          l_p_[c][i] = 0.f;
+          l_error_[c][i] = 0.f;
+          l_value_[c][i] = lights_.environment[c];
+        }
+      } else {
+        staged_[i] = 0;  // path_scatter samples this light itself
+        light_ok_[i] = 0;
+      }
+    }
+  }
+  Lanes L;
+  for (int c = 0; c < 3; ++c) {
+    L.p[c] = p_[c].data();
+    L.e[c] = p_error_[c].data();
+    L.ng[c] = ng_[c].data();
+    L.ns[c] = ns_[c].data();
+    L.dir[c] = dir_[c].data();
+    L.beta[c] = beta_[c].data();
+    L.colour[c] = colour_[c].data();
+    L.l_wi[c] = l_wi_[c].data();
+    L.l_p[c] = l_p_[c].data();
+    L.l_error[c] = l_error_[c].data();
+    L.l_n[c] = l_n_[c].data();
+    L.l_value[c] = l_value_[c].data();
+    L.s_origin[c] = s_origin_[c].data();
+    L.s_dir[c] = s_dir_[c].data();
+    L.s_contrib[c] = s_contrib_[c].data();
+    L.origin[c] = origin_[c].data();
+    L.wo[c] = wo_[c].data();
+    L.beta_out[c] = beta_out_[c].data();
+  }
+  L.time = time_.data();
+  L.eta = eta_.data();
+  L.u_dir[0] = u_dir_[0].data();
+  L.u_dir[1] = u_dir_[1].data();
+  L.u_rr = u_rr_.data();
+  L.depth = depth_.data();
+  L.light_ok = light_ok_.data();
+  L.l_distance = l_distance_.data();
+  L.l_pdf = l_pdf_.data();
+  L.l_pmf = l_pmf_.data();
+  L.alive = alive_.data();
+  L.has_shadow = has_shadow_.data();
+  L.nee_ray = nee_ray_.data();
+  L.dims = dims_.data();
+  L.s_t_max = s_t_max_.data();
+  L.prev_pdf = prev_pdf_.data();
+  diffuse_step_kernel(L, n, next_event, int32_t(settings.rr_depth));
+}
+
+ShadowQuery DiffuseStage::shadow(size_t i) const {
+  ShadowQuery q;
+  q.ray = Ray{vec3(s_origin_[0][i], s_origin_[1][i], s_origin_[2][i]),
+              vec3(s_dir_[0][i], s_dir_[1][i], s_dir_[2][i]), time_[i], s_t_max_[i]};
+  q.contribution = Spectrum(s_contrib_[0][i], s_contrib_[1][i], s_contrib_[2][i]);
+  return q;
+}
+
+void DiffuseStage::apply(size_t i, PathState& s, Sampler::Cursor& cursor) const {
+  s.beta = Spectrum(beta_out_[0][i], beta_out_[1][i], beta_out_[2][i]);
+  s.prev_pdf = prev_pdf_[i];
+  s.prev_delta = false;
+  s.prev_p = vec3(p_[0][i], p_[1][i], p_[2][i]);
+  s.ray = Ray{vec3(origin_[0][i], origin_[1][i], origin_[2][i]),
+              vec3(wo_[0][i], wo_[1][i], wo_[2][i]), time_[i]};
+  ++s.depth;
+  cursor.dimension += uint64_t(dims_[i]);
+}
+
+}  // namespace penumbra

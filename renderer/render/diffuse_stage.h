@@ -1,0 +1,79 @@
+#pragma once
+// The wavefront driver's diffuse stage: the step of every path that hit a plain Lambertian
+// surface (constant colour, no normal map), after its emission, as loops over arrays: the light
+// choice and light sample (light_kernels.h), the BSDF's value, pdf and MIS weight towards the
+// light, the shadow ray and its contribution, then the cosine-weighted sample, the throughput,
+// the spawned ray and Russian roulette. One path at a time these are many short dependent
+// chains; the diffuse surfaces of a bounce are usually most of its paths, so the stage carries
+// a whole step per path against the arrays it fills and reads back (the light stage alone,
+// a third of this, did not pay: docs/performance.md).
+//
+// The results are path_scatter's to the bit for the path integrator: the same operations in the
+// same order (glm's dot is (x + y) + z, to_world is (s x + t y) + n z, std::max and std::min
+// as their comparisons), the branches as selects between values all lanes compute, the file
+// compiled without contraction into fused multiply-adds (renderer/CMakeLists.txt). A path whose
+// chosen light has no kernel (point, spot, sphere, mesh and image lights) takes path_scatter
+// itself (`staged(lane)` false).
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "renderer/render/light_kernels.h"
+#include "renderer/render/path_step.h"
+
+namespace penumbra {
+
+class DiffuseStage {
+ public:
+  explicit DiffuseStage(const Scene& scene);
+  const Scene& scene() const { return scene_; }
+
+  // Whether the stage can take hits on `object`: its material is a plain Lambertian one.
+  bool takes(uint32_t object) const { return colour_of_[object] >= 0; }
+
+  // Empty, with room for `paths` lanes.
+  void start(size_t paths);
+  // Queues a path after path_arrive: its state, hit, and the step's prefetched sampler values
+  // x[0..4], y[0..4] (BounceSamples); `slot` is the caller's index for it. `next_event`: whether
+  // the step estimates direct light (path_scatter's condition for a surface with a diffuse
+  // lobe: the scene has lights), which decides which values are whose.
+  void add(uint32_t slot, const PathState& s, const SurfaceHit& hit, const float* x,
+           const float* y, bool next_event);
+  // Takes every queued path's step (`next_event` as for add).
+  void compute(const IntegratorSettings& settings, bool next_event);
+
+  size_t size() const { return count_; }
+  uint32_t slot(size_t lane) const { return slot_[lane]; }
+  // False if the lane's chosen light has no kernel: the caller takes the step with
+  // path_scatter instead of the results below.
+  bool staged(size_t lane) const { return staged_[lane] != 0; }
+  // The step's results, as path_scatter leaves them: whether the path goes on (then `apply`
+  // updates its state and sampler cursor), whether it has a shadow query, and whether it
+  // counted a next-event ray.
+  bool alive(size_t lane) const { return alive_[lane] != 0; }
+  bool has_shadow(size_t lane) const { return has_shadow_[lane] != 0; }
+  bool counted_ray(size_t lane) const { return nee_ray_[lane] != 0; }
+  ShadowQuery shadow(size_t lane) const;
+  void apply(size_t lane, PathState& s, Sampler::Cursor& cursor) const;
+
+ private:
+  const Scene& scene_;
+  StagedLights lights_;
+  std::vector<int32_t> colour_of_;  // per object: index into colours_, or -1
+  std::vector<Spectrum> colours_;
+  size_t count_ = 0;
+  std::vector<uint32_t> slot_;
+  // Inputs per lane.
+  std::vector<float> p_[3], p_error_[3], ng_[3], ns_[3], dir_[3], beta_[3], colour_[3];
+  std::vector<float> time_, eta_, u_light_, u_point_[2], u_dir_[2], u_rr_;
+  std::vector<int32_t> depth_;
+  // The light sample per lane.
+  std::vector<int32_t> light_, light_ok_;
+  std::vector<float> l_wi_[3], l_distance_, l_pdf_, l_p_[3], l_error_[3], l_n_[3], l_value_[3], l_pmf_;
+  // Results per lane.
+  std::vector<int32_t> staged_, alive_, has_shadow_, nee_ray_, dims_;
+  std::vector<float> s_origin_[3], s_dir_[3], s_t_max_, s_contrib_[3];
+  std::vector<float> origin_[3], wo_[3], beta_out_[3], prev_pdf_;
+};
+
+}  // namespace penumbra

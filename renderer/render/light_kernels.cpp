@@ -1,0 +1,149 @@
+#include "renderer/render/light_kernels.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "renderer/core/simd_clones.h"
+#include "renderer/lights/area_light.h"
+#include "renderer/lights/environment_light.h"
+#include "renderer/lights/light_sampler.h"
+#include "renderer/sampling/sampling.h"
+#include "renderer/shapes/quad.h"
+
+namespace penumbra {
+
+// Quad::sample followed by AreaLight::sample for the entries whose light is `id`, over arrays;
+// other entries keep what they hold. Operation for operation as the scalar code: glm's dot sums
+// x, y, z in that order, length is sqrt(dot), a vector divided by a scalar divides each
+// component, and every comparison that rejects a sample is the scalar one (NaNs included).
+PENUMBRA_SIMD_CLONES
+void quad_light_samples(const float* __restrict q_origin, const float* __restrict q_u,
+                        const float* __restrict q_v, const float* __restrict q_n, float q_area,
+                        int32_t id, size_t n, const int32_t* __restrict light,
+                        const float* __restrict ref_x, const float* __restrict ref_y,
+                        const float* __restrict ref_z, const float* __restrict u_x,
+                        const float* __restrict u_y, int32_t* __restrict ok,
+                        float* __restrict wi_x, float* __restrict wi_y, float* __restrict wi_z,
+                        float* __restrict distance, float* __restrict pdf, float* __restrict p_x,
+                        float* __restrict p_y, float* __restrict p_z, float* __restrict e_x,
+                        float* __restrict e_y, float* __restrict e_z) {
+  constexpr float g6 = gamma_bound(6);
+  const float ox = q_origin[0], oy = q_origin[1], oz = q_origin[2];
+  const float ux = q_u[0], uy = q_u[1], uz = q_u[2], vx = q_v[0], vy = q_v[1], vz = q_v[2];
+  const float nx = q_n[0], ny = q_n[1], nz = q_n[2];
+  for (size_t i = 0; i < n; ++i) {
+    // Quad::sample: p = o + s u + t v and its error bound (pbrt-v4 section 6.8.1).
+    const float sux = u_x[i] * ux, suy = u_x[i] * uy, suz = u_x[i] * uz;
+    const float svx = u_y[i] * vx, svy = u_y[i] * vy, svz = u_y[i] * vz;
+    const float px = (ox + sux) + svx, py = (oy + suy) + svy, pz = (oz + suz) + svz;
+    const float ex = g6 * ((std::fabs(ox) + std::fabs(sux)) + std::fabs(svx));
+    const float ey = g6 * ((std::fabs(oy) + std::fabs(suy)) + std::fabs(svy));
+    const float ez = g6 * ((std::fabs(oz) + std::fabs(suz)) + std::fabs(svz));
+    // area_to_solid_angle (shapes/shape.h). Divided in every lane and then selected: a division
+    // under a condition is not if-converted; the selected value is the scalar one.
+    const float wx = px - ref_x[i], wy = py - ref_y[i], wz = pz - ref_z[i];
+    const float dist2 = (wx * wx + wy * wy) + wz * wz;
+    const float cos_l = std::fabs((nx * wx + ny * wy) + nz * wz) / std::sqrt(dist2);
+    const float ratio = dist2 / (cos_l * q_area);
+    const float density = (cos_l > 0.f) & (q_area > 0.f) ? ratio : 0.f;
+    // AreaLight::sample: a finite positive density, a positive distance, the front side (&
+    // rather than &&: no branches in the loop).
+    const float dist = std::sqrt(dist2);
+    const float dx = wx / dist, dy = wy / dist, dz = wz / dist;
+    const bool good = (density > 0.f) & (density < kInfinity) & (dist > 0.f) &
+                      !(((nx * dx + ny * dy) + nz * dz) >= 0.f);
+    const bool mine = light[i] == id;
+    ok[i] = pick(mine, int32_t(good), ok[i]);
+    wi_x[i] = pick(mine, dx, wi_x[i]);
+    wi_y[i] = pick(mine, dy, wi_y[i]);
+    wi_z[i] = pick(mine, dz, wi_z[i]);
+    distance[i] = pick(mine, dist, distance[i]);
+    pdf[i] = pick(mine, density, pdf[i]);
+    p_x[i] = pick(mine, px, p_x[i]);
+    p_y[i] = pick(mine, py, p_y[i]);
+    p_z[i] = pick(mine, pz, p_z[i]);
+    e_x[i] = pick(mine, ex, e_x[i]);
+    e_y[i] = pick(mine, ey, e_y[i]);
+    e_z[i] = pick(mine, ez, e_z[i]);
+  }
+}
+
+// ConstantEnvironment::sample for the entries whose light is `id`: square_to_uniform_sphere,
+// with sincos_two_pi's quarter turn as selects and negations instead of its switch (exact:
+// negation does not round), so the values are the scalar ones.
+PENUMBRA_SIMD_CLONES
+void uniform_sphere_samples(int32_t id, size_t n, const int32_t* __restrict light,
+                            const float* __restrict u_x, const float* __restrict u_y,
+                            int32_t* __restrict ok, float* __restrict wi_x,
+                            float* __restrict wi_y, float* __restrict wi_z) {
+  for (size_t i = 0; i < n; ++i) {
+    const float z = 1.f - 2.f * u_x[i];
+    const float r = std::sqrt(std::max(0.f, 1.f - z * z));  // safe_sqrt
+    const float t = 4.f * u_y[i];
+    const int k = int(t + std::copysign(0.5f, t));
+    float a, b;
+    sincos_quarter_pi((t - float(k)) * (kPi / 2.f), &a, &b);
+    // Quarter turn k: (s, c) = (a, b), (b, -a), (-a, -b), (-b, a) for k mod 4 = 0, 1, 2, 3.
+    const bool swap = (k & 1) != 0;
+    const float s0 = swap ? b : a, c0 = swap ? a : b;
+    const float s = (k & 2) != 0 ? -s0 : s0;
+    const float c = ((k + 1) & 2) != 0 ? -c0 : c0;
+    const bool mine = light[i] == id;
+    ok[i] = pick(mine, int32_t(1), ok[i]);
+    wi_x[i] = pick(mine, r * c, wi_x[i]);
+    wi_y[i] = pick(mine, r * s, wi_y[i]);
+    wi_z[i] = pick(mine, z, wi_z[i]);
+  }
+}
+
+// LightSampler::choose for every entry: the first light whose cumulative probability exceeds
+// u is the number of lights whose cumulative probability does not (the table is sorted), and
+// the last light if rounding left u past them all.
+PENUMBRA_SIMD_CLONES
+void choose_lights(const float* __restrict cdf, int32_t lights, size_t n,
+                   const float* __restrict u, int32_t* __restrict light) {
+  for (size_t i = 0; i < n; ++i) light[i] = 0;
+  for (int32_t l = 0; l < lights; ++l) {
+    const float c = cdf[l];
+    for (size_t i = 0; i < n; ++i) light[i] += int32_t(c <= u[i]);
+  }
+  for (size_t i = 0; i < n; ++i) light[i] = std::min(light[i], lights - 1);
+}
+
+StagedLights::StagedLights(const Scene& scene) {
+  const size_t lights = size_t(scene.light_count());
+  source.assign(lights, kNotStaged);
+  const std::vector<float>& table = scene.light_sampler().cdf();
+  cdf.assign(table.begin(), table.end());
+  for (size_t l = 0; l < lights; ++l) pmf.push_back(scene.light_sampler().pmf(int(l)));
+  for (size_t l = 0; l < lights; ++l) {
+    const Light& light = scene.light(int(l));
+    if (const auto* env = dynamic_cast<const ConstantEnvironment*>(&light)) {
+      source[l] = kEnvironment;
+      environment = env->radiance(vec3(0.f, 0.f, 1.f));
+      environment_id = int32_t(l);
+      continue;
+    }
+    const auto* area = dynamic_cast<const AreaLight*>(&light);
+    if (!area || area->textured()) continue;
+    const auto* quad = dynamic_cast<const Quad*>(&area->shape());
+    if (!quad || quad->moving()) continue;
+    StagedLights::QuadLight q;
+    q.light = int32_t(l);
+    const QuadDesc& d = quad->desc();
+    const vec3 n = quad->normal();
+    const Spectrum r = area->radiance(TextureQuery{});
+    for (int c = 0; c < 3; ++c) {
+      q.origin[c] = d.origin[c];
+      q.u[c] = d.u[c];
+      q.v[c] = d.v[c];
+      q.n[c] = n[c];
+      q.radiance[c] = r[c];
+    }
+    q.area = quad->area();
+    source[l] = int32_t(quads.size());
+    quads.push_back(q);
+  }
+}
+
+}  // namespace penumbra

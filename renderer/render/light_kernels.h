@@ -1,0 +1,62 @@
+#pragma once
+// Next-event light choices and light samples over arrays, for the wavefront driver's SIMD
+// stages: one path at a time a quad light's sample is a dependent chain of multiplies, a square
+// root and two divisions; over arrays eight or sixteen paths go at once. Static, untextured quad
+// lights (the emitters of most scenes) and a constant environment have kernels; a path that
+// chose any other light samples it with its scalar code. The values are the scalar code's to
+// the bit: the kernels are LightSampler::choose, Quad::sample with AreaLight::sample, and
+// ConstantEnvironment::sample operation for operation, compiled without contraction into fused
+// multiply-adds (renderer/CMakeLists.txt).
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "renderer/core/math.h"
+#include "renderer/scene/scene.h"
+
+namespace penumbra {
+
+// `mine ? a : b` with both evaluated: no control flow, so loops over arrays if-convert.
+template <class T>
+[[gnu::always_inline]] inline T pick(bool mine, T a, T b) {
+  return mine ? a : b;
+}
+
+// The scene's lights as the kernels see them.
+struct StagedLights {
+  explicit StagedLights(const Scene& scene);
+
+  static constexpr int32_t kNotStaged = -1, kEnvironment = -2;
+  // A static, untextured quad light: what Quad::sample and AreaLight::sample read.
+  struct QuadLight {
+    int32_t light;
+    float origin[3], u[3], v[3], n[3], area, radiance[3];
+  };
+  std::vector<QuadLight> quads;
+  std::vector<int32_t> source;  // per light: its index in quads, kEnvironment or kNotStaged
+  Spectrum environment{0.f};    // a ConstantEnvironment's radiance
+  int32_t environment_id = -1;  // its light index
+  std::vector<float> cdf, pmf;  // the LightSampler's, per light
+
+  bool staged(int32_t light) const { return source[size_t(light)] != kNotStaged; }
+};
+
+// LightSampler::choose of u[i] into light[i], i < n (`cdf`: its table of `lights` entries).
+void choose_lights(const float* cdf, int32_t lights, size_t n, const float* u, int32_t* light);
+
+// Quad::sample then AreaLight::sample from ref at (u_x, u_y), for the entries whose light is
+// `id`; other entries keep what they hold. ok = whether the light gave a sample.
+void quad_light_samples(const float* q_origin, const float* q_u, const float* q_v,
+                        const float* q_n, float q_area, int32_t id, size_t n, const int32_t* light,
+                        const float* ref_x, const float* ref_y, const float* ref_z,
+                        const float* u_x, const float* u_y, int32_t* ok, float* wi_x, float* wi_y,
+                        float* wi_z, float* distance, float* pdf, float* p_x, float* p_y,
+                        float* p_z, float* e_x, float* e_y, float* e_z);
+
+// ConstantEnvironment::sample's direction (square_to_uniform_sphere) for the entries whose
+// light is `id`; its distance, value and pdf are the light's constants.
+void uniform_sphere_samples(int32_t id, size_t n, const int32_t* light, const float* u_x,
+                            const float* u_y, int32_t* ok, float* wi_x, float* wi_y,
+                            float* wi_z);
+
+}  // namespace penumbra

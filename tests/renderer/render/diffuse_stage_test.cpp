@@ -1,0 +1,225 @@
+// The wavefront driver's diffuse stage (renderer/render/diffuse_stage.h) against path_scatter,
+// the scalar step it repeats in SIMD lanes: for real hits on a Lambertian floor and ball (front
+// and back side, at every depth around the roulette depth, with the sampler's corner values), every
+// result must be path_scatter's to the bit: whether the path goes on, its new state and how
+// many sampler values it took, its shadow ray and contribution, and the ray count. Lanes whose
+// chosen light has no kernel (the point light here) must say so.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <random>
+#include <vector>
+
+#include "renderer/render/diffuse_stage.h"
+#include "renderer/render/path_step.h"
+#include "renderer/sampling/sobol_batch.h"
+#include "renderer/scene/scene.h"
+#include "tests/renderer/render/render_test_util.h"
+
+namespace penumbra::test {
+namespace {
+
+template <class T>
+bool same_bits(const T& a, const T& b) {
+  return std::memcmp(&a, &b, sizeof(T)) == 0;
+}
+
+// Hands out a lane's prefetched values in order, as PrefetchedSampler does: a 1D value is x[j],
+// a 2D one (x[j], y[j]).
+class ListSampler {
+ public:
+  ListSampler(const float* x, const float* y) : x_(x), y_(y) {}
+  float get_1d() { return x_[used_++]; }
+  vec2 get_2d() {
+    const int j = used_++;
+    return vec2(x_[j], y_[j]);
+  }
+  int used() const { return used_; }
+
+ private:
+  const float* x_;
+  const float* y_;
+  int used_ = 0;
+};
+
+// A tilted floor: no component of its normal is 0 or 1, so the shading frame's arithmetic is
+// all exercised.
+const vec3 kFloorOrigin(-2.f, -0.3f, 2.f), kFloorU(4.f, 0.5f, 0.3f), kFloorV(0.2f, 0.4f, -4.f);
+// And a ball of the same material, for normals in every direction (hit from outside and inside).
+const vec3 kBallCentre(0.3f, 1.2f, -0.2f);
+constexpr float kBallRadius = 0.6f;
+
+SceneInput floor_scene(bool lights) {
+  SceneInput in;
+  in.camera = camera_looking({0, 2, 4}, {0, 0, 0}, 40.f);
+  in.materials = {DiffuseParams{Spectrum(0.7f, 0.5f, 0.3f)}, DiffuseParams{Spectrum(0.f)}};
+  in.objects = {quad_object(kFloorOrigin, kFloorU, kFloorV, 0),
+                sphere_object(kBallCentre, kBallRadius, 0)};
+  if (lights) {
+    in.environment = Spectrum(0.2f, 0.3f, 0.4f);
+    // Two quad lights of different power and orientation, one seen from below the floor too.
+    in.objects.push_back(quad_object({-0.5f, 2, -0.5f}, {1, 0, 0}, {0, 0, 1}, 1, Spectrum(5.f)));
+    in.objects.push_back(
+        quad_object({1.5f, -1, 1}, {0, 0, -2}, {0, 1.5f, 0}, 1, Spectrum(1.f, 2.f, 3.f)));
+    in.lights = {PointLightDesc{{-1, 1, 1}, Spectrum(2.f)}};
+  }
+  return in;
+}
+
+struct Lane {
+  PathState state;
+  SurfaceHit hit;
+  float x[BounceSamples::kBounce], y[BounceSamples::kBounce];
+};
+
+// Rays onto the floor from above and below, from random points, with random path states and
+// sampler values (a tenth of them set to the concentric map's centre and other edges).
+std::vector<Lane> floor_hits(const Scene& scene, size_t count, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(0.f, 1.f);
+  std::vector<Lane> lanes;
+  while (lanes.size() < count) {
+    vec3 from, to;
+    const float pick = u(rng);
+    if (pick < 0.5f) {  // the floor, from above (mostly) or below
+      const float side = u(rng) < 0.7f ? 1.f : -1.f;
+      to = kFloorOrigin + (0.05f + 0.9f * u(rng)) * kFloorU + (0.05f + 0.9f * u(rng)) * kFloorV;
+      from = to + vec3(4.f * u(rng) - 2.f, side * (0.2f + 3.f * u(rng)), 4.f * u(rng) - 2.f);
+    } else {  // the ball, from outside or from inside
+      const vec3 d = glm::normalize(vec3(u(rng) - 0.5f, u(rng) - 0.5f, u(rng) - 0.5f));
+      to = kBallCentre + kBallRadius * d;
+      const vec3 e = vec3(u(rng) - 0.5f, u(rng) - 0.5f, u(rng) - 0.5f);
+      from = pick < 0.8f ? to + 2.f * d + e : kBallCentre + 0.5f * kBallRadius * e;
+    }
+    Lane lane;
+    lane.state = PathState(Ray{from, glm::normalize(to - from), u(rng)});
+    if (!scene.intersect(lane.state.ray, &lane.hit) || lane.hit.object > 1) continue;
+    lane.state.beta = Spectrum(u(rng), u(rng), u(rng)) * (u(rng) < 0.2f ? 0.02f : 1.f);
+    lane.state.eta = u(rng) < 0.5f ? 1.f : 1.5f;
+    lane.state.depth = 1 + int(rng() % 8);
+    lane.state.prev_pdf = u(rng);
+    lane.state.prev_delta = u(rng) < 0.5f;
+    for (int j = 0; j < BounceSamples::kBounce; ++j) {
+      lane.x[j] = u(rng);
+      lane.y[j] = u(rng);
+    }
+    if (lanes.size() % 10 == 3) lane.x[3] = lane.y[3] = 0.5f;  // the disk's centre
+    if (lanes.size() % 10 == 5) lane.x[1] = lane.y[1] = 0.5f;
+    if (lanes.size() % 10 == 7) lane.x[3] = 0.f, lane.y[3] = 0.5f;
+    if (lanes.size() % 10 == 9) lane.x[3] = lane.y[3] = 0.f;
+    lanes.push_back(lane);
+  }
+  return lanes;
+}
+
+struct Coverage {
+  int staged = 0, fallback = 0, alive = 0, dead = 0, shadows = 0, back = 0, ball = 0;
+};
+
+Coverage expect_stage_matches_scatter(bool lights, uint32_t seed) {
+  const auto scene = Scene::build(floor_scene(lights));
+  IntegratorSettings settings;
+  settings.max_depth = 16;
+  settings.rr_depth = 4;
+  const bool next_event = !scene->light_sampler().empty();
+  EXPECT_EQ(next_event, lights);
+  const std::vector<Lane> lanes = floor_hits(*scene, 2000, seed);
+  DiffuseStage stage(*scene);
+  EXPECT_TRUE(stage.takes(0));
+  EXPECT_TRUE(stage.takes(1));
+  stage.start(lanes.size());
+  for (size_t k = 0; k < lanes.size(); ++k)
+    stage.add(uint32_t(k), lanes[k].state, lanes[k].hit, lanes[k].x, lanes[k].y, next_event);
+  stage.compute(settings, next_event);
+  EXPECT_EQ(stage.size(), lanes.size());
+
+  Coverage cover;
+  for (size_t lane = 0; lane < stage.size(); ++lane) {
+    const size_t k = stage.slot(lane);
+    PathState s = lanes[k].state;
+    SurfaceHit hit = lanes[k].hit;
+    ListSampler sampler(lanes[k].x, lanes[k].y);
+    PathCounters counters;
+    ShadowQuery shadow;
+    bool has_shadow = false;
+    const bool goes_on = path_scatter<false, kFeatureAll>(*scene, settings, s, hit, sampler,
+                                                          counters, &shadow, &has_shadow);
+    if (!stage.staged(lane)) {
+      ++cover.fallback;
+      continue;
+    }
+    ++cover.staged;
+    cover.back += glm::dot(lanes[k].state.ray.direction, hit.ng) > 0.f;
+    cover.ball += hit.object == 1;
+    SCOPED_TRACE("lane " + std::to_string(lane));
+    EXPECT_EQ(stage.counted_ray(lane) ? uint64_t(1) : uint64_t(0), counters.rays);
+    EXPECT_EQ(stage.has_shadow(lane), has_shadow);
+    EXPECT_EQ(stage.alive(lane), goes_on);
+    if (stage.has_shadow(lane) != has_shadow || stage.alive(lane) != goes_on) continue;
+    if (has_shadow) {
+      ++cover.shadows;
+      const ShadowQuery q = stage.shadow(lane);
+      EXPECT_TRUE(same_bits(q.ray.origin, shadow.ray.origin));
+      EXPECT_TRUE(same_bits(q.ray.direction, shadow.ray.direction));
+      EXPECT_TRUE(same_bits(q.ray.t_max, shadow.ray.t_max));
+      EXPECT_TRUE(same_bits(q.ray.time, shadow.ray.time));
+      EXPECT_TRUE(same_bits(q.contribution, shadow.contribution));
+    }
+    if (!goes_on) {
+      ++cover.dead;
+      continue;
+    }
+    ++cover.alive;
+    PathState staged = lanes[k].state;
+    Sampler::Cursor cursor{0, 100};
+    stage.apply(lane, staged, cursor);
+    EXPECT_EQ(cursor.dimension, 100u + uint64_t(sampler.used()));
+    EXPECT_TRUE(same_bits(staged.beta, s.beta));
+    EXPECT_TRUE(same_bits(staged.prev_pdf, s.prev_pdf));
+    EXPECT_EQ(staged.prev_delta, s.prev_delta);
+    EXPECT_TRUE(same_bits(staged.prev_p, s.prev_p));
+    EXPECT_TRUE(same_bits(staged.ray.origin, s.ray.origin));
+    EXPECT_TRUE(same_bits(staged.ray.direction, s.ray.direction));
+    EXPECT_TRUE(same_bits(staged.ray.time, s.ray.time));
+    EXPECT_TRUE(same_bits(staged.ray.t_max, s.ray.t_max));
+    EXPECT_EQ(staged.depth, s.depth);
+    EXPECT_TRUE(same_bits(staged.eta, s.eta));
+    EXPECT_TRUE(same_bits(staged.radiance, s.radiance));
+  }
+  return cover;
+}
+
+TEST(DiffuseStage, StepIsPathScatterToTheBitWithQuadLightsEnvironmentAndAPointLight) {
+  const Coverage c = expect_stage_matches_scatter(true, 7);
+  // Every branch of the step was taken: lanes on both sides, paths that die (roulette, the
+  // disk's edge) and go on, shadow rays, and lanes left to path_scatter for the point light.
+  EXPECT_GT(c.staged, 1000);
+  EXPECT_GT(c.fallback, 50);
+  EXPECT_GT(c.alive, 500);
+  EXPECT_GT(c.dead, 50);
+  EXPECT_GT(c.shadows, 500);
+  EXPECT_GT(c.back, 200);
+  EXPECT_GT(c.ball, 500);
+}
+
+TEST(DiffuseStage, StepIsPathScatterToTheBitWithoutLights) {
+  const Coverage c = expect_stage_matches_scatter(false, 11);
+  EXPECT_EQ(c.fallback, 0);
+  EXPECT_EQ(c.shadows, 0);
+  EXPECT_GT(c.alive, 500);
+  EXPECT_GT(c.dead, 50);
+}
+
+TEST(DiffuseStage, TakesOnlyPlainLambertianSurfaces) {
+  SceneInput in = floor_scene(false);
+  in.materials.push_back(ConductorParams{});
+  in.objects.push_back(quad_object({-2, 1, 2}, {4, 0, 0}, {0, 0, -4}, 2));
+  const auto scene = Scene::build(in);
+  DiffuseStage stage(*scene);
+  EXPECT_TRUE(stage.takes(0));
+  EXPECT_TRUE(stage.takes(1));
+  EXPECT_FALSE(stage.takes(2));
+}
+
+}  // namespace
+}  // namespace penumbra::test
