@@ -88,7 +88,10 @@ template <bool kNextEvent>
   // GCC would otherwise reload every iteration (and not vectorise).
   const Lanes L = lanes;
   constexpr float kShadowScale = 1.f - kShadowEpsilon;
+  // The result arrays never overlap the inputs, which GCC cannot prove for pointers in a struct.
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC ivdep
+#endif
   for (size_t i = 0; i < n; ++i) {
     const float px = L.p[0][i], py = L.p[1][i], pz = L.p[2][i];
     const float ex = L.e[0][i], ey = L.e[1][i], ez = L.e[2][i];

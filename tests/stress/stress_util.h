@@ -128,15 +128,8 @@ inline ObjectDesc sphere(const vec3& center, float radius, uint32_t material,
 }
 
 inline ObjectDesc box(const vec3& lo, const vec3& hi, uint32_t material) {
-  MeshDesc m;
-  for (int i = 0; i < 8; ++i)
-    m.positions.push_back(vec3(i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z));
-  // Each face: four corners counter-clockwise seen from outside.
-  const uint32_t faces[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4},
-                                {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
-  for (const auto& f : faces) m.indices.insert(m.indices.end(), {f[0], f[1], f[2], f[0], f[2], f[3]});
   ObjectDesc o;
-  o.shape = std::move(m);
+  o.shape = box_mesh(lo, hi);
   o.material = material;
   return o;
 }

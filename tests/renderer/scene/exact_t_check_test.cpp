@@ -18,17 +18,6 @@
 namespace penumbra::test {
 namespace {
 
-// An axis-aligned box of 12 triangles, each face's corners counter-clockwise seen from outside.
-MeshDesc box_mesh(const vec3& lo, const vec3& hi) {
-  MeshDesc m;
-  for (int i = 0; i < 8; ++i)
-    m.positions.push_back(vec3(i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z));
-  const uint32_t faces[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4},
-                                {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
-  for (const auto& f : faces) m.indices.insert(m.indices.end(), {f[0], f[1], f[2], f[0], f[2], f[3]});
-  return m;
-}
-
 ObjectDesc box(const vec3& lo, const vec3& hi, uint32_t material) {
   ObjectDesc o;
   o.shape = box_mesh(lo, hi);
