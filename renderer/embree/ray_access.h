@@ -28,6 +28,18 @@ inline RTCRayHit embree_ray_hit(const Ray& ray) {
   return rh;
 }
 
+// Calls fn(n, i) for every lane i of a filter call over n rays; a single ray (rtcIntersect1,
+// rtcOccluded1) as fn(1, 0), so the RTCRayN/RTCHitN accessors fold to plain fields.
+template <class Fn>
+[[gnu::always_inline]] inline void for_each_filter_lane(const RTCFilterFunctionNArguments* args,
+                                                        Fn&& fn) {
+  if (args->N == 1) {
+    fn(1u, 0u);
+    return;
+  }
+  for (unsigned i = 0; i < args->N; ++i) fn(args->N, i);
+}
+
 inline vec3 embree_ray_origin(RTCRayN* ray, unsigned n, unsigned i) {
   return vec3(RTCRayN_org_x(ray, n, i), RTCRayN_org_y(ray, n, i), RTCRayN_org_z(ray, n, i));
 }

@@ -47,16 +47,6 @@ namespace {
   *oz = step_away(pz + dz, dz);
 }
 
-// A lane's condition as an integer mask (all bits or none): conditions combine with integer
-// &, | and ~, and only selects read them. (Combined as bools, GCC 12 turns some of them into
-// selects between bools, which its vectoriser does not support.)
-using Mask = int32_t;
-[[gnu::always_inline]] inline Mask mask(bool b) { return b ? -1 : 0; }
-template <class T>
-[[gnu::always_inline]] inline T when(Mask m, T a, T b) {
-  return m != 0 ? a : b;
-}
-
 // path_step_detail::geometry_agrees.
 [[gnu::always_inline]] inline Mask agrees(float ax, float ay, float az, float bx, float by,
                                           float bz, float nx, float ny, float nz, float a_z_local,
@@ -281,8 +271,9 @@ void DiffuseStage::compute(const IntegratorSettings& settings, bool next_event) 
   const size_t n = count_;
   if (n == 0) return;
   for (size_t i = 0; i < n; ++i) staged_[i] = 1;
+  const LightSampler& sampler = scene_.light_sampler();
   if (next_event) {
-    choose_lights(lights_.cdf.data(), int32_t(lights_.cdf.size()), n, u_light_.data(),
+    choose_lights(sampler.cdf().data(), int32_t(sampler.cdf().size()), n, u_light_.data(),
                   light_.data());
     for (const StagedLights::QuadLight& q : lights_.quads)
       quad_light_samples(q.origin, q.u, q.v, q.n, q.area, q.light, n, light_.data(), p_[0].data(),
@@ -300,7 +291,7 @@ void DiffuseStage::compute(const IntegratorSettings& settings, bool next_event) 
     for (size_t i = 0; i < n; ++i) {
       const int32_t light = light_[i];
       const int32_t source = lights_.source[size_t(light)];
-      l_pmf_[i] = lights_.pmf[size_t(light)];
+      l_pmf_[i] = sampler.pmf(light);
       if (source >= 0) {
         const StagedLights::QuadLight& q = lights_.quads[size_t(source)];
         for (int c = 0; c < 3; ++c) {

@@ -52,19 +52,19 @@ void quad_light_samples(const float* __restrict q_origin, const float* __restric
     const float dx = wx / dist, dy = wy / dist, dz = wz / dist;
     const bool good = (density > 0.f) & (density < kInfinity) & (dist > 0.f) &
                       !(((nx * dx + ny * dy) + nz * dz) >= 0.f);
-    const bool mine = light[i] == id;
-    ok[i] = pick(mine, int32_t(good), ok[i]);
-    wi_x[i] = pick(mine, dx, wi_x[i]);
-    wi_y[i] = pick(mine, dy, wi_y[i]);
-    wi_z[i] = pick(mine, dz, wi_z[i]);
-    distance[i] = pick(mine, dist, distance[i]);
-    pdf[i] = pick(mine, density, pdf[i]);
-    p_x[i] = pick(mine, px, p_x[i]);
-    p_y[i] = pick(mine, py, p_y[i]);
-    p_z[i] = pick(mine, pz, p_z[i]);
-    e_x[i] = pick(mine, ex, e_x[i]);
-    e_y[i] = pick(mine, ey, e_y[i]);
-    e_z[i] = pick(mine, ez, e_z[i]);
+    const Mask mine = mask(light[i] == id);
+    ok[i] = when(mine, int32_t(good), ok[i]);
+    wi_x[i] = when(mine, dx, wi_x[i]);
+    wi_y[i] = when(mine, dy, wi_y[i]);
+    wi_z[i] = when(mine, dz, wi_z[i]);
+    distance[i] = when(mine, dist, distance[i]);
+    pdf[i] = when(mine, density, pdf[i]);
+    p_x[i] = when(mine, px, p_x[i]);
+    p_y[i] = when(mine, py, p_y[i]);
+    p_z[i] = when(mine, pz, p_z[i]);
+    e_x[i] = when(mine, ex, e_x[i]);
+    e_y[i] = when(mine, ey, e_y[i]);
+    e_z[i] = when(mine, ez, e_z[i]);
   }
 }
 
@@ -88,11 +88,11 @@ void uniform_sphere_samples(int32_t id, size_t n, const int32_t* __restrict ligh
     const float s0 = swap ? b : a, c0 = swap ? a : b;
     const float s = (k & 2) != 0 ? -s0 : s0;
     const float c = ((k + 1) & 2) != 0 ? -c0 : c0;
-    const bool mine = light[i] == id;
-    ok[i] = pick(mine, int32_t(1), ok[i]);
-    wi_x[i] = pick(mine, r * c, wi_x[i]);
-    wi_y[i] = pick(mine, r * s, wi_y[i]);
-    wi_z[i] = pick(mine, z, wi_z[i]);
+    const Mask mine = mask(light[i] == id);
+    ok[i] = when(mine, int32_t(1), ok[i]);
+    wi_x[i] = when(mine, r * c, wi_x[i]);
+    wi_y[i] = when(mine, r * s, wi_y[i]);
+    wi_z[i] = when(mine, z, wi_z[i]);
   }
 }
 
@@ -113,9 +113,6 @@ void choose_lights(const float* __restrict cdf, int32_t lights, size_t n,
 StagedLights::StagedLights(const Scene& scene) {
   const size_t lights = size_t(scene.light_count());
   source.assign(lights, kNotStaged);
-  const std::vector<float>& table = scene.light_sampler().cdf();
-  cdf.assign(table.begin(), table.end());
-  for (size_t l = 0; l < lights; ++l) pmf.push_back(scene.light_sampler().pmf(int(l)));
   for (size_t l = 0; l < lights; ++l) {
     const Light& light = scene.light(int(l));
     if (const auto* env = dynamic_cast<const ConstantEnvironment*>(&light)) {

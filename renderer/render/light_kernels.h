@@ -16,10 +16,15 @@
 
 namespace penumbra {
 
-// `mine ? a : b` with both evaluated: no control flow, so loops over arrays if-convert.
+// A lane's condition as an integer mask (all bits or none), for the stages' loops over arrays:
+// conditions combine with integer &, | and ~, and only selects read them, both sides computed,
+// so the loops if-convert. (Combined as bools, GCC 12 turns some of them into selects between
+// bools, which its vectoriser does not support.)
+using Mask = int32_t;
+[[gnu::always_inline]] inline Mask mask(bool b) { return b ? -1 : 0; }
 template <class T>
-[[gnu::always_inline]] inline T pick(bool mine, T a, T b) {
-  return mine ? a : b;
+[[gnu::always_inline]] inline T when(Mask m, T a, T b) {
+  return m != 0 ? a : b;
 }
 
 // The scene's lights as the kernels see them.
@@ -36,9 +41,6 @@ struct StagedLights {
   std::vector<int32_t> source;  // per light: its index in quads, kEnvironment or kNotStaged
   Spectrum environment{0.f};    // a ConstantEnvironment's radiance
   int32_t environment_id = -1;  // its light index
-  std::vector<float> cdf, pmf;  // the LightSampler's, per light
-
-  bool staged(int32_t light) const { return source[size_t(light)] != kNotStaged; }
 };
 
 // LightSampler::choose of u[i] into light[i], i < n (`cdf`: its table of `lights` entries).

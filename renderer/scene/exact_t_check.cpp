@@ -23,11 +23,7 @@ inline void check_candidate(const RTCFilterFunctionNArguments* args, const Exact
 // geometry (Embree 3 manual, rtcInitIntersectContext).
 void exact_t_context_filter(const RTCFilterFunctionNArguments* args) {
   const ExactTCheck& check = *reinterpret_cast<const ExactTContext*>(args->context)->check;
-  if (args->N == 1) {  // single rays: the accessors fold to plain fields
-    check_candidate(args, check, 1, 0);
-    return;
-  }
-  for (unsigned i = 0; i < args->N; ++i) check_candidate(args, check, args->N, i);
+  for_each_filter_lane(args, [&](unsigned n, unsigned i) { check_candidate(args, check, n, i); });
 }
 
 // ---- coincident triangles ----

@@ -42,11 +42,7 @@ inline void filter_triangle_hit(const RTCFilterFunctionNArguments* args, unsigne
 }
 
 void triangle_filter_fn(const RTCFilterFunctionNArguments* args) {
-  if (args->N == 1) {  // rtcIntersect1 / rtcOccluded1: the accessors fold to plain fields
-    filter_triangle_hit(args, 1, 0);
-    return;
-  }
-  for (unsigned i = 0; i < args->N; ++i) filter_triangle_hit(args, args->N, i);
+  for_each_filter_lane(args, [args](unsigned n, unsigned i) { filter_triangle_hit(args, n, i); });
 }
 
 // Vertex buffers at evenly spread shutter instants. Linear interpolation of the quadratic path
