@@ -15,6 +15,7 @@ class ConductorBsdf : public OpaqueBsdf {
   explicit ConductorBsdf(const ConductorParams& params) : ConductorBsdf(params.color, params.roughness) {}
 
   bool smooth() const { return smooth_; }
+  float alpha() const { return distr_.alpha(); }  // GGX alpha, clamped as the lobe uses it
   uint32_t lobes() const { return smooth_ ? kLobeDeltaReflection : kLobeGlossyReflection; }
   // Reflectance at normal incidence, OIDN's albedo for metals (docs/output-layers.md); the
   // model's Fresnel term is constant, so it is `color` at every angle.

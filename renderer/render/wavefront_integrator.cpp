@@ -28,6 +28,23 @@ void PathBatch::clear() {
   firsts_.clear();
 }
 
+// The stages of the models `scene`'s surfaces use, and which object goes to which.
+void make_stages(const Scene& scene, PathBatch& b) {
+  b.stages_.clear();
+  b.stage_of_.assign(scene.object_count(), -1);
+  for (StageModel model : {StageModel::kLambert, StageModel::kRoughConductor}) {
+    auto stage = std::make_unique<SurfaceStage>(scene, model);
+    bool used = false;
+    for (uint32_t o = 0; o < scene.object_count(); ++o) {
+      if (!stage->takes(o)) continue;
+      b.stage_of_[o] = int8_t(b.stages_.size());
+      used = true;
+    }
+    if (used) b.stages_.push_back(std::move(stage));
+  }
+  b.staged_scene_ = &scene;
+}
+
 template <bool kDistributed, uint32_t kFeatures>
 void integrate_batch(const Scene& scene, const IntegratorSettings& settings, PathBatch& b,
                      PathCounters& counters) {
@@ -54,16 +71,15 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
       if (b.found_[k]) samples.add(*b.samplers_[live[k]], b.cursors_[live[k]]);
     samples.compute();
 
-    // Shade: every live path takes its step. Paths on plain Lambertian surfaces (path
-    // integrator) take theirs in the diffuse stage, the others one by one; each path's results
-    // go to its own slot k, and the survivors and shadow queries are then gathered in path
-    // order, as the scalar loop would leave them.
-    constexpr bool kStage = !kDistributed;
-    if (kStage && (!b.diffuse_stage_ || &b.diffuse_stage_->scene() != &scene))
-      b.diffuse_stage_ = std::make_unique<DiffuseStage>(scene);
-    DiffuseStage* stage = kStage ? b.diffuse_stage_.get() : nullptr;
+    // Shade: every live path takes its step. Paths on plain Lambertian surfaces and rough
+    // conductors (path integrator) take theirs in the surface stages, the others one by one;
+    // each path's results go to its own slot k, and the survivors and shadow queries are then
+    // gathered in path order, as the scalar loop would leave them.
+    constexpr bool kStages = !kDistributed;
+    if (kStages && b.staged_scene_ != &scene) make_stages(scene, b);
     const bool next_event = (kFeatures & kFeatureLights) != 0 && !scene.light_sampler().empty();
-    if (stage) stage->start(live.size());
+    if (kStages)
+      for (auto& stage : b.stages_) stage->start(live.size());
     std::vector<uint8_t>& goes_on = b.goes_on_;
     std::vector<uint8_t>& has_shadow = b.has_shadow_;
     goes_on.assign(live.size(), 0);
@@ -82,9 +98,11 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
       const size_t j = hit_index++;
       hit_of[k] = uint32_t(j);
       SurfaceHit& hit = b.hits_[k];
-      if (stage && stage->takes(hit.object)) {
+      const int stage = kStages ? b.stage_of_[hit.object] : -1;
+      if (stage >= 0) {
         if (path_arrive<kFeatures>(scene, settings, s, hit, first))
-          stage->add(uint32_t(k), s, hit, samples.x(j), samples.y(j), next_event);
+          b.stages_[size_t(stage)]->add(uint32_t(k), s, hit, samples.x(j), samples.y(j),
+                                        next_event);
         continue;
       }
       PrefetchedSampler sampler(*b.samplers_[p], b.cursors_[p], samples, j);
@@ -94,7 +112,8 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
       has_shadow[k] = shadow;
       b.cursors_[p] = sampler.cursor();
     }
-    if (stage) {
+    for (auto& stage : b.stages_) {
+      if (!kStages) break;
       stage->compute(settings, next_event);
       for (size_t lane = 0; lane < stage->size(); ++lane) {
         const size_t k = stage->slot(lane);

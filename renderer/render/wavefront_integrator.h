@@ -3,14 +3,14 @@
 // at a time (pbrt-v4's wavefront integrator and Mitsuba 3's LLVM mode are the models). Each
 // bounce traces all live paths' rays in 16-wide Embree packets (camera rays as coherent ones),
 // shades every path with the same steps as the scalar driver (path_step.h), then traces the
-// bounce's shadow rays in packets. Paths on plain Lambertian surfaces take their step together
-// in SIMD lanes (diffuse_stage.h). Per path the steps, sampler dimensions and additions are the
+// bounce's shadow rays in packets. Paths on plain Lambertian surfaces and rough conductors take
+// their step together in SIMD lanes, one stage per model (surface_stage.h). Per path the steps, sampler dimensions and additions are the
 // scalar driver's, so both give the same image; only the order paths are advanced in differs.
 #include <cstdint>
 #include <memory>
 #include <vector>
 
-#include "renderer/render/diffuse_stage.h"
+#include "renderer/render/surface_stage.h"
 #include "renderer/render/path_step.h"
 #include "renderer/sampling/sobol_batch.h"
 
@@ -40,6 +40,7 @@ class PathBatch {
 
   template <bool, uint32_t>
   friend void integrate_batch(const Scene&, const IntegratorSettings&, PathBatch&, PathCounters&);
+  friend void make_stages(const Scene& scene, PathBatch& b);
 
  private:
   size_t capacity_;
@@ -55,7 +56,10 @@ class PathBatch {
   std::vector<ShadowQuery> shadows_;
   std::vector<uint32_t> shadow_paths_;
   BounceSamples samples_;  // the sampler values of the bounce's paths that hit something
-  std::unique_ptr<DiffuseStage> diffuse_stage_;  // made for the scene at hand
+  // Made for the scene at hand: the stages of the models its surfaces use.
+  const Scene* staged_scene_ = nullptr;
+  std::vector<std::unique_ptr<SurfaceStage>> stages_;
+  std::vector<int8_t> stage_of_;  // per object: its stage in stages_, or -1
   std::vector<uint8_t> goes_on_, has_shadow_;  // per live path of the bounce
   std::vector<uint32_t> hit_of_;               // per live path: its index among the hits
 };

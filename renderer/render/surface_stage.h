@@ -1,12 +1,13 @@
 #pragma once
-// The wavefront driver's diffuse stage: the step of every path that hit a plain Lambertian
-// surface (constant colour, no normal map), after its emission, as loops over arrays: the light
-// choice and light sample (light_kernels.h), the BSDF's value, pdf and MIS weight towards the
-// light, the shadow ray and its contribution, then the cosine-weighted sample, the throughput,
-// the spawned ray and Russian roulette. One path at a time these are many short dependent
-// chains; the diffuse surfaces of a bounce are usually most of its paths, so the stage carries
-// a whole step per path against the arrays it fills and reads back (the light stage alone,
-// a third of this, did not pay: docs/performance.md).
+// The wavefront driver's surface stages: the step of every path that hit a plain surface of one
+// BSDF model (constant parameters, no normal map: Lambertian, or a rough conductor), after its
+// emission, as loops over arrays: the light choice and light sample (light_kernels.h), the
+// BSDF's value, pdf and MIS weight towards the light, the shadow ray and its contribution, then
+// the BSDF's sample (lane_bsdfs.h), the throughput, the spawned ray and Russian roulette. One
+// path at a time these are many short dependent chains; the surfaces of one model are often
+// most of a bounce's paths, so a stage carries a whole step per path against the arrays it
+// fills and reads back (the light stage alone, a third of this, did not pay:
+// docs/performance.md).
 //
 // The results are path_scatter's to the bit for the path integrator: the same operations in the
 // same order (glm's dot is (x + y) + z, to_world is (s x + t y) + n z, std::max and std::min
@@ -23,13 +24,21 @@
 
 namespace penumbra {
 
-class DiffuseStage {
- public:
-  explicit DiffuseStage(const Scene& scene);
-  const Scene& scene() const { return scene_; }
+// The surfaces a stage takes (lane_bsdfs.h has their models).
+enum class StageModel : uint8_t {
+  kLambert,         // DiffuseBsdf
+  kRoughConductor,  // ConductorBsdf with a microfacet lobe (not a smooth mirror)
+};
 
-  // Whether the stage can take hits on `object`: its material is a plain Lambertian one.
-  bool takes(uint32_t object) const { return colour_of_[object] >= 0; }
+class SurfaceStage {
+ public:
+  SurfaceStage(const Scene& scene, StageModel model);
+  const Scene& scene() const { return scene_; }
+  StageModel model() const { return model_; }
+
+  // Whether the stage can take hits on `object`: its material is a plain one of the stage's
+  // model (constant finite parameters, no normal map, two-sided).
+  bool takes(uint32_t object) const { return params_of_[object] >= 0; }
 
   // Empty, with room for `paths` lanes.
   void start(size_t paths);
@@ -58,14 +67,16 @@ class DiffuseStage {
 
  private:
   const Scene& scene_;
+  StageModel model_;
   StagedLights lights_;
-  std::vector<int32_t> colour_of_;  // per object: index into colours_, or -1
+  std::vector<int32_t> params_of_;  // per object: index into colours_ and alphas_, or -1
   std::vector<Spectrum> colours_;
+  std::vector<float> alphas_;  // GGX alpha (microfacet models)
   size_t count_ = 0;
   std::vector<uint32_t> slot_;
   // Inputs per lane.
   std::vector<float> p_[3], p_error_[3], ng_[3], ns_[3], dir_[3], beta_[3], colour_[3];
-  std::vector<float> time_, eta_, u_light_, u_point_[2], u_dir_[2], u_rr_;
+  std::vector<float> alpha_, time_, eta_, u_light_, u_point_[2], u_dir_[2], u_rr_;
   std::vector<int32_t> depth_;
   // The light sample per lane.
   std::vector<int32_t> light_, light_ok_;

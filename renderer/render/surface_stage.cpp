@@ -1,10 +1,12 @@
-#include "renderer/render/diffuse_stage.h"
+#include "renderer/render/surface_stage.h"
 
 #include <cmath>
 #include <cstring>
 
 #include "renderer/core/simd_clones.h"
+#include "renderer/materials/conductor.h"
 #include "renderer/materials/diffuse.h"
+#include "renderer/render/lane_bsdfs.h"
 #include "renderer/sampling/sampling.h"
 
 namespace penumbra {
@@ -56,11 +58,9 @@ namespace {
   return mask(geo != 0.f) & ~(mask(geo > 0.f) ^ mask(shade > 0.f));
 }
 
-[[gnu::always_inline]] inline Mask finite(float x) { return mask(std::fabs(x) < kInfinity); }
-
-// The arrays of a stage's lanes, inputs and results (DiffuseStage's members).
+// The arrays of a stage's lanes, inputs and results (SurfaceStage's members).
 struct Lanes {
-  const float *p[3], *e[3], *ng[3], *ns[3], *dir[3], *beta[3], *colour[3];
+  const float *p[3], *e[3], *ng[3], *ns[3], *dir[3], *beta[3], *colour[3], *alpha;
   const float *time, *eta, *u_dir[2], *u_rr;
   const int32_t* depth;
   const int32_t* light_ok;
@@ -70,10 +70,10 @@ struct Lanes {
   float *origin[3], *wo[3], *beta_out[3], *prev_pdf;
 };
 
-// path_scatter of the path integrator on a two-sided DiffuseBsdf without a normal map, lane by
-// lane (see the header). `next_event`: whether the step samples a light.
-template <bool kNextEvent>
-[[gnu::always_inline]] inline void diffuse_step(const Lanes& lanes, size_t n, int32_t rr_depth) {
+// path_scatter of the path integrator on a two-sided `Model` (lane_bsdfs.h) without a normal
+// map, lane by lane (see the header). `next_event`: whether the step samples a light.
+template <class Model, bool kNextEvent>
+[[gnu::always_inline]] inline void surface_step(const Lanes& lanes, size_t n, int32_t rr_depth) {
   // A local copy: stores through the result pointers cannot then change the pointers, which
   // GCC would otherwise reload every iteration (and not vectorise).
   const Lanes L = lanes;
@@ -88,40 +88,36 @@ template <bool kNextEvent>
     const float gx = L.ng[0][i], gy = L.ng[1][i], gz = L.ng[2][i];
     const float nx = L.ns[0][i], ny = L.ns[1][i], nz = L.ns[2][i];
     const float bx = L.beta[0][i], by = L.beta[1][i], bz = L.beta[2][i];
-    const float cx = L.colour[0][i], cy = L.colour[1][i], cz = L.colour[2][i];
+    const lane::Params q{{L.colour[0][i], L.colour[1][i], L.colour[2][i]}, L.alpha[i]};
     // Frame(ns): Duff et al. 2017 (core/frame.h).
     const float sign = std::copysign(1.f, nz);
     const float fa = -1.f / (sign + nz);
     const float fb = nx * ny * fa;
     const float sx = 1.f + sign * nx * nx * fa, sy = sign * fb, sz = -sign * nx;
     const float tx = fb, ty = sign + ny * ny * fa, tz = -ny;
-    // wi = -direction, in world and local coordinates.
+    // wi = -direction, in world and local coordinates (Frame::to_local).
     const float wx = -L.dir[0][i], wy = -L.dir[1][i], wz = -L.dir[2][i];
-    // (Only the local z of wi matters to a Lambertian surface.)
+    const float wi_x = (wx * sx + wy * sy) + wz * sz;
+    const float wi_y = (wx * tx + wy * ty) + wz * tz;
     const float wi_z = (wx * nx + wy * ny) + wz * nz;
+    // SurfaceBsdf: a two-sided model seen from the back is its front, mirrored.
+    const Mask flip = mask(wi_z < 0.f);
+    const float a[3] = {wi_x, wi_y, when(flip, -wi_z, wi_z)};
 
     // Next-event estimation.
     const float lx = L.l_wi[0][i], ly = L.l_wi[1][i], lz = L.l_wi[2][i];
     const float l_pdf = L.l_pdf[i] * L.l_pmf[i];
+    const float lo_x = (lx * sx + ly * sy) + lz * sz;
+    const float lo_y = (lx * tx + ly * ty) + lz * tz;
     const float lo_z = (lx * nx + ly * ny) + lz * nz;
     const Mask l_agrees = agrees(wx, wy, wz, lx, ly, lz, gx, gy, gz, wi_z, lo_z);
-    // SurfaceBsdf::evaluate: the back side mirrored to the front; DiffuseBsdf::evaluate.
-    const Mask flip = mask(wi_z < 0.f);
-    const float a_z = when(flip, -wi_z, wi_z), b_z = when(flip, -lo_z, lo_z);
-    const Mask zero = mask(a_z <= 0.f) | mask(b_z <= 0.f);
-    // Zero where the model answers zero. (SurfaceBsdf also zeroes an answer that is not finite;
-    // with b_z > 0 a cosine and the colour finite, which the stage requires, it always is.)
-    const float cos_term = kInvPi * b_z;
-    float f_x = when(zero, 0.f, cx * cos_term), f_y = when(zero, 0.f, cy * cos_term),
-          f_z = when(zero, 0.f, cz * cos_term);
-    const float e_pdf = when(zero, 0.f, b_z * kInvPi);
-    // power_heuristic(l_pdf, e_pdf).
-    const float h_a = l_pdf * l_pdf, h_b = e_pdf * e_pdf;
+    const float b[3] = {lo_x, lo_y, when(flip, -lo_z, lo_z)};
+    const lane::EvalPdf e = Model::eval_pdf(q, a, b);
+    // power_heuristic(l_pdf, e.pdf).
+    const float h_a = l_pdf * l_pdf, h_b = e.pdf * e.pdf;
     const float h_ratio = h_a / (h_a + h_b);
     const float mis = h_a + h_b > 0.f ? h_ratio : 0.f;
-    f_x = f_x * mis;
-    f_y = f_y * mis;
-    f_z = f_z * mis;
+    const float f_x = e.f[0] * mis, f_y = e.f[1] * mis, f_z = e.f[2] * mis;
     const Mask black = mask(f_x == 0.f) & mask(f_y == 0.f) & mask(f_z == 0.f);
     const Mask nee = mask(kNextEvent) & mask(L.light_ok[i] != 0) & l_agrees & ~black;
     // The shadow ray: from the offset hit point to the light point offset off the light.
@@ -138,7 +134,7 @@ template <bool kNextEvent>
     const float dx = tg_x - so_x, dy = tg_y - so_y, dz = tg_z - so_z;
     const float dist = std::sqrt((dx * dx + dy * dy) + dz * dz);
     const float qx = dx / dist, qy = dy / dist, qz = dz / dist;
-    const Mask far_end = finite(L.l_distance[i]);
+    const Mask far_end = lane::finite(L.l_distance[i]);
     const Mask positive = mask(dist > 0.f);
     const float t_max = when(far_end, when(point, dist, dist * kShadowScale), kInfinity);
     L.s_origin[0][i] = so_x;
@@ -154,76 +150,87 @@ template <bool kNextEvent>
     L.nee_ray[i] = nee;
     L.has_shadow[i] = nee & mask(t_max > 0.f);
 
-    // The BSDF's sample: DiffuseBsdf::sample on the front-mirrored wi, square_to_cosine_hemisphere.
-    const float ox = 2.f * L.u_dir[0][i] - 1.f, oy = 2.f * L.u_dir[1][i] - 1.f;
-    const Mask centre = mask(ox == 0.f) & mask(oy == 0.f);
-    const Mask wide = mask(std::fabs(ox) > std::fabs(oy));
-    const float num = when(wide, oy, ox), den = when(wide, ox, oy), r = when(wide, ox, oy);
-    float sn, cs;
-    sincos_quarter_pi((kPi / 4.f) * (num / den), &sn, &cs);
-    const float d_x = when(centre, 0.f, when(wide, r * cs, r * sn));
-    const float d_y = when(centre, 0.f, when(wide, r * sn, r * cs));
-    const float h = 1.f - d_x * d_x - d_y * d_y;
-    const float o_z = std::sqrt(0.f < h ? h : 0.f);  // safe_sqrt: std::max(0.f, h)
-    const float pdf = o_z > 0.f ? o_z * kInvPi : 0.f;
-    // (SurfaceBsdf::sample's finiteness checks always pass here: the colour is finite, which the
-    // stage requires, and for the sampler's values in [0, 1) so are d, o_z and the pdf.)
-    const Mask sampled = ~mask(a_z <= 0.f) & mask(pdf > 0.f);
-    const float wo_z = when(flip, -o_z, o_z);
-    const float ww_x = (sx * d_x + tx * d_y) + nx * wo_z;
-    const float ww_y = (sy * d_x + ty * d_y) + ny * wo_z;
-    const float ww_z = (sz * d_x + tz * d_y) + nz * wo_z;
+    // The BSDF's sample, its direction mirrored back to the side wi came from.
+    const lane::Sample bs = Model::sample(q, a, L.u_dir[0][i], L.u_dir[1][i]);
+    const float wo_z = when(flip, -bs.wo[2], bs.wo[2]);
+    const float ww_x = (sx * bs.wo[0] + tx * bs.wo[1]) + nx * wo_z;
+    const float ww_y = (sy * bs.wo[0] + ty * bs.wo[1]) + ny * wo_z;
+    const float ww_z = (sz * bs.wo[0] + tz * bs.wo[1]) + nz * wo_z;
     const Mask o_agrees = agrees(wx, wy, wz, ww_x, ww_y, ww_z, gx, gy, gz, wi_z, wo_z);
-    const float nb_x = bx * cx, nb_y = by * cy, nb_z = bz * cz;
-    float o_x, o_y, o_z2;
-    offset_origin(px, py, pz, ex, ey, ez, gx, gy, gz, ww_x, ww_y, ww_z, &o_x, &o_y, &o_z2);
+    const float nb_x = bx * bs.weight[0], nb_y = by * bs.weight[1], nb_z = bz * bs.weight[2];
+    float o_x, o_y, o_z;
+    offset_origin(px, py, pz, ex, ey, ez, gx, gy, gz, ww_x, ww_y, ww_z, &o_x, &o_y, &o_z);
     // max_component (std::max as its comparison), then Russian roulette as path_scatter.
     const float m_yz = nb_y < nb_z ? nb_z : nb_y;
     const float beta_max = nb_x < m_yz ? m_yz : nb_x;
     const Mask roulette = mask(L.depth[i] >= rr_depth);
     const float q_raw = beta_max * L.eta[i] * L.eta[i];
-    const float q = 0.95f < q_raw ? 0.95f : q_raw;
-    const Mask killed = roulette & mask(L.u_rr[i] >= q);
-    L.beta_out[0][i] = when(roulette, nb_x / q, nb_x);
-    L.beta_out[1][i] = when(roulette, nb_y / q, nb_y);
-    L.beta_out[2][i] = when(roulette, nb_z / q, nb_z);
-    L.alive[i] = sampled & o_agrees & mask(beta_max > 0.f) & ~killed;
+    const float q_rr = 0.95f < q_raw ? 0.95f : q_raw;
+    const Mask killed = roulette & mask(L.u_rr[i] >= q_rr);
+    L.beta_out[0][i] = when(roulette, nb_x / q_rr, nb_x);
+    L.beta_out[1][i] = when(roulette, nb_y / q_rr, nb_y);
+    L.beta_out[2][i] = when(roulette, nb_z / q_rr, nb_z);
+    L.alive[i] = bs.ok & o_agrees & mask(beta_max > 0.f) & ~killed;
     L.dims[i] = (kNextEvent ? 4 : 2) + (roulette & 1);
     L.origin[0][i] = o_x;
     L.origin[1][i] = o_y;
-    L.origin[2][i] = o_z2;
+    L.origin[2][i] = o_z;
     L.wo[0][i] = ww_x;
     L.wo[1][i] = ww_y;
     L.wo[2][i] = ww_z;
-    L.prev_pdf[i] = pdf;
+    L.prev_pdf[i] = bs.pdf;
   }
 }
 
-// The loop compiled for each case (a flag inside the loop kept GCC from vectorising it).
-PENUMBRA_SIMD_CLONES
-void diffuse_step_kernel(const Lanes& lanes, size_t n, bool next_event, int32_t rr_depth) {
+// The loop compiled for each model and case (a flag inside the loop kept GCC from vectorising
+// it).
+template <class Model>
+[[gnu::always_inline]] inline void step_cases(const Lanes& lanes, size_t n, bool next_event,
+                                              int32_t rr_depth) {
   if (next_event)
-    diffuse_step<true>(lanes, n, rr_depth);
+    surface_step<Model, true>(lanes, n, rr_depth);
   else
-    diffuse_step<false>(lanes, n, rr_depth);
+    surface_step<Model, false>(lanes, n, rr_depth);
+}
+PENUMBRA_SIMD_CLONES
+void lambert_step_kernel(const Lanes& lanes, size_t n, bool next_event, int32_t rr_depth) {
+  step_cases<lane::Lambert>(lanes, n, next_event, rr_depth);
+}
+PENUMBRA_SIMD_CLONES
+void rough_conductor_step_kernel(const Lanes& lanes, size_t n, bool next_event,
+                                 int32_t rr_depth) {
+  step_cases<lane::RoughConductor>(lanes, n, next_event, rr_depth);
 }
 
 }  // namespace
 
-DiffuseStage::DiffuseStage(const Scene& scene) : scene_(scene), lights_(scene) {
-  colour_of_.assign(scene.object_count(), -1);
+SurfaceStage::SurfaceStage(const Scene& scene, StageModel model)
+    : scene_(scene), model_(model), lights_(scene) {
+  params_of_.assign(scene.object_count(), -1);
   for (size_t o = 0; o < scene.object_count(); ++o) {
     const Material& m = scene.material(scene.object(uint32_t(o)).material);
     if (m.varies() || m.normal_mapped() || m.bsdf().normal_mapped() || !m.bsdf().two_sided())
       continue;
-    const auto* diffuse = std::get_if<DiffuseBsdf>(&m.bsdf().model());
-    if (!diffuse || !is_finite(diffuse->albedo())) continue;
-    colour_of_[o] = int32_t(colours_.size());
-    colours_.push_back(diffuse->albedo());
+    Spectrum colour;
+    float alpha = 0.f;
+    if (model == StageModel::kLambert) {
+      const auto* diffuse = std::get_if<DiffuseBsdf>(&m.bsdf().model());
+      if (!diffuse) continue;
+      colour = diffuse->albedo();
+    } else {
+      const auto* conductor = std::get_if<ConductorBsdf>(&m.bsdf().model());
+      if (!conductor || conductor->smooth()) continue;
+      colour = conductor->albedo();
+      alpha = conductor->alpha();
+    }
+    if (!is_finite(colour)) continue;
+    params_of_[o] = int32_t(colours_.size());
+    colours_.push_back(colour);
+    alphas_.push_back(alpha);
   }
 }
 
-void DiffuseStage::start(size_t paths) {
+void SurfaceStage::start(size_t paths) {
   count_ = 0;
   if (slot_.size() >= paths) return;
   slot_.resize(paths);
@@ -232,18 +239,19 @@ void DiffuseStage::start(size_t paths) {
                     &l_wi_[c], &l_p_[c], &l_error_[c], &l_n_[c], &l_value_[c], &s_origin_[c],
                     &s_dir_[c], &s_contrib_[c], &origin_[c], &wo_[c], &beta_out_[c]})
       a->resize(paths);
-  for (auto* a : {&time_, &eta_, &u_light_, &u_point_[0], &u_point_[1], &u_dir_[0], &u_dir_[1],
+  for (auto* a : {&alpha_, &time_, &eta_, &u_light_, &u_point_[0], &u_point_[1], &u_dir_[0], &u_dir_[1],
                   &u_rr_, &l_distance_, &l_pdf_, &l_pmf_, &s_t_max_, &prev_pdf_})
     a->resize(paths);
   for (auto* a : {&depth_, &light_, &light_ok_, &staged_, &alive_, &has_shadow_, &nee_ray_, &dims_})
     a->resize(paths);
 }
 
-void DiffuseStage::add(uint32_t slot, const PathState& s, const SurfaceHit& hit, const float* x,
+void SurfaceStage::add(uint32_t slot, const PathState& s, const SurfaceHit& hit, const float* x,
                        const float* y, bool next_event) {
   const size_t i = count_++;
   slot_[i] = slot;
-  const Spectrum& colour = colours_[size_t(colour_of_[hit.object])];
+  const size_t params = size_t(params_of_[hit.object]);
+  const Spectrum& colour = colours_[params];
   for (int c = 0; c < 3; ++c) {
     p_[c][i] = hit.p[c];
     p_error_[c][i] = hit.p_error[c];
@@ -253,11 +261,12 @@ void DiffuseStage::add(uint32_t slot, const PathState& s, const SurfaceHit& hit,
     beta_[c][i] = s.beta[c];
     colour_[c][i] = colour[c];
   }
+  alpha_[i] = alphas_[params];
   time_[i] = s.ray.time;
   eta_[i] = s.eta;
   depth_[i] = s.depth;
   // The step's values in the order path_scatter takes them: light choice and point (with next-
-  // event estimation), lobe (unused by a single lobe), direction, roulette.
+  // event estimation), lobe (unused by the stage's single-lobe models), direction, roulette.
   const int d = next_event ? 2 : 0;
   u_light_[i] = x[0];
   u_point_[0][i] = x[1];
@@ -267,7 +276,7 @@ void DiffuseStage::add(uint32_t slot, const PathState& s, const SurfaceHit& hit,
   u_rr_[i] = x[d + 2];
 }
 
-void DiffuseStage::compute(const IntegratorSettings& settings, bool next_event) {
+void SurfaceStage::compute(const IntegratorSettings& settings, bool next_event) {
   const size_t n = count_;
   if (n == 0) return;
   for (size_t i = 0; i < n; ++i) staged_[i] = 1;
@@ -334,6 +343,7 @@ void DiffuseStage::compute(const IntegratorSettings& settings, bool next_event) 
     L.wo[c] = wo_[c].data();
     L.beta_out[c] = beta_out_[c].data();
   }
+  L.alpha = alpha_.data();
   L.time = time_.data();
   L.eta = eta_.data();
   L.u_dir[0] = u_dir_[0].data();
@@ -350,10 +360,13 @@ void DiffuseStage::compute(const IntegratorSettings& settings, bool next_event) 
   L.dims = dims_.data();
   L.s_t_max = s_t_max_.data();
   L.prev_pdf = prev_pdf_.data();
-  diffuse_step_kernel(L, n, next_event, int32_t(settings.rr_depth));
+  if (model_ == StageModel::kLambert)
+    lambert_step_kernel(L, n, next_event, int32_t(settings.rr_depth));
+  else
+    rough_conductor_step_kernel(L, n, next_event, int32_t(settings.rr_depth));
 }
 
-ShadowQuery DiffuseStage::shadow(size_t i) const {
+ShadowQuery SurfaceStage::shadow(size_t i) const {
   ShadowQuery q;
   q.ray = Ray{vec3(s_origin_[0][i], s_origin_[1][i], s_origin_[2][i]),
               vec3(s_dir_[0][i], s_dir_[1][i], s_dir_[2][i]), time_[i], s_t_max_[i]};
@@ -361,7 +374,7 @@ ShadowQuery DiffuseStage::shadow(size_t i) const {
   return q;
 }
 
-void DiffuseStage::apply(size_t i, PathState& s, Sampler::Cursor& cursor) const {
+void SurfaceStage::apply(size_t i, PathState& s, Sampler::Cursor& cursor) const {
   s.beta = Spectrum(beta_out_[0][i], beta_out_[1][i], beta_out_[2][i]);
   s.prev_pdf = prev_pdf_[i];
   s.prev_delta = false;

@@ -1,6 +1,6 @@
-// The wavefront driver's diffuse stage (renderer/render/diffuse_stage.h) against path_scatter,
-// the scalar step it repeats in SIMD lanes: for real hits on a Lambertian floor and ball (front
-// and back side, at every depth around the roulette depth, with the sampler's corner values), every
+// The wavefront driver's surface stages (renderer/render/surface_stage.h) against path_scatter,
+// the scalar step they repeat in SIMD lanes: for real hits on a floor and ball of each stage's
+// model, Lambertian and rough conductors of several roughnesses (front and back side, at every depth around the roulette depth, with the sampler's corner values), every
 // result must be path_scatter's to the bit: whether the path goes on, its new state and how
 // many sampler values it took, its shadow ray and contribution, and the ray count. Lanes whose
 // chosen light has no kernel (the point light here) must say so.
@@ -10,7 +10,7 @@
 #include <random>
 #include <vector>
 
-#include "renderer/render/diffuse_stage.h"
+#include "renderer/render/surface_stage.h"
 #include "renderer/render/path_step.h"
 #include "renderer/sampling/sobol_batch.h"
 #include "renderer/scene/scene.h"
@@ -49,10 +49,16 @@ const vec3 kFloorOrigin(-2.f, -0.3f, 2.f), kFloorU(4.f, 0.5f, 0.3f), kFloorV(0.2
 const vec3 kBallCentre(0.3f, 1.2f, -0.2f);
 constexpr float kBallRadius = 0.6f;
 
-SceneInput floor_scene(bool lights) {
+// The floor and ball's material for a stage's model (`roughness` for a conductor).
+MaterialParams stage_material(StageModel model, float roughness) {
+  if (model == StageModel::kLambert) return DiffuseParams{Spectrum(0.7f, 0.5f, 0.3f)};
+  return ConductorParams{Spectrum(0.9f, 0.6f, 0.3f), roughness};
+}
+
+SceneInput floor_scene(bool lights, const MaterialParams& material) {
   SceneInput in;
   in.camera = camera_looking({0, 2, 4}, {0, 0, 0}, 40.f);
-  in.materials = {DiffuseParams{Spectrum(0.7f, 0.5f, 0.3f)}, DiffuseParams{Spectrum(0.f)}};
+  in.materials = {material, DiffuseParams{Spectrum(0.f)}};
   in.objects = {quad_object(kFloorOrigin, kFloorU, kFloorV, 0),
                 sphere_object(kBallCentre, kBallRadius, 0)};
   if (lights) {
@@ -116,15 +122,16 @@ struct Coverage {
   int staged = 0, fallback = 0, alive = 0, dead = 0, shadows = 0, back = 0, ball = 0;
 };
 
-Coverage expect_stage_matches_scatter(bool lights, uint32_t seed) {
-  const auto scene = Scene::build(floor_scene(lights));
+Coverage expect_stage_matches_scatter(bool lights, uint32_t seed, StageModel model,
+                                      float roughness = 0.f) {
+  const auto scene = Scene::build(floor_scene(lights, stage_material(model, roughness)));
   IntegratorSettings settings;
   settings.max_depth = 16;
   settings.rr_depth = 4;
   const bool next_event = !scene->light_sampler().empty();
   EXPECT_EQ(next_event, lights);
   const std::vector<Lane> lanes = floor_hits(*scene, 2000, seed);
-  DiffuseStage stage(*scene);
+  SurfaceStage stage(*scene, model);
   EXPECT_TRUE(stage.takes(0));
   EXPECT_TRUE(stage.takes(1));
   stage.start(lanes.size());
@@ -189,8 +196,8 @@ Coverage expect_stage_matches_scatter(bool lights, uint32_t seed) {
   return cover;
 }
 
-TEST(DiffuseStage, StepIsPathScatterToTheBitWithQuadLightsEnvironmentAndAPointLight) {
-  const Coverage c = expect_stage_matches_scatter(true, 7);
+TEST(SurfaceStage, LambertStepIsPathScatterToTheBitWithQuadLightsEnvironmentAndAPointLight) {
+  const Coverage c = expect_stage_matches_scatter(true, 7, StageModel::kLambert);
   // Every branch of the step was taken: lanes on both sides, paths that die (roulette, the
   // disk's edge) and go on, shadow rays, and lanes left to path_scatter for the point light.
   EXPECT_GT(c.staged, 1000);
@@ -202,23 +209,56 @@ TEST(DiffuseStage, StepIsPathScatterToTheBitWithQuadLightsEnvironmentAndAPointLi
   EXPECT_GT(c.ball, 500);
 }
 
-TEST(DiffuseStage, StepIsPathScatterToTheBitWithoutLights) {
-  const Coverage c = expect_stage_matches_scatter(false, 11);
+TEST(SurfaceStage, LambertStepIsPathScatterToTheBitWithoutLights) {
+  const Coverage c = expect_stage_matches_scatter(false, 11, StageModel::kLambert);
   EXPECT_EQ(c.fallback, 0);
   EXPECT_EQ(c.shadows, 0);
   EXPECT_GT(c.alive, 500);
   EXPECT_GT(c.dead, 50);
 }
 
-TEST(DiffuseStage, TakesOnlyPlainLambertianSurfaces) {
-  SceneInput in = floor_scene(false);
-  in.materials.push_back(ConductorParams{});
+TEST(SurfaceStage, RoughConductorStepIsPathScatterToTheBitWithLights) {
+  // From nearly a mirror (alpha 1.2e-4, where the NDF's values overflow) to very rough.
+  for (const float roughness : {0.011f, 0.1f, 0.35f, 0.8f, 1.f}) {
+    SCOPED_TRACE("roughness " + std::to_string(roughness));
+    const Coverage c = expect_stage_matches_scatter(true, 13, StageModel::kRoughConductor,
+                                                    roughness);
+    EXPECT_GT(c.staged, 1000);
+    EXPECT_GT(c.fallback, 50);
+    EXPECT_GT(c.alive, 300);
+    EXPECT_GT(c.dead, 50);
+    EXPECT_GT(c.back, 200);
+    EXPECT_GT(c.ball, 500);
+    if (roughness > 0.05f) {
+      EXPECT_GT(c.shadows, 100);
+    }
+  }
+}
+
+TEST(SurfaceStage, RoughConductorStepIsPathScatterToTheBitWithoutLights) {
+  const Coverage c = expect_stage_matches_scatter(false, 17, StageModel::kRoughConductor, 0.5f);
+  EXPECT_EQ(c.fallback, 0);
+  EXPECT_EQ(c.shadows, 0);
+  EXPECT_GT(c.alive, 300);
+  EXPECT_GT(c.dead, 50);
+}
+
+TEST(SurfaceStage, TakesOnlyPlainSurfacesOfItsModel) {
+  SceneInput in = floor_scene(false, DiffuseParams{Spectrum(0.5f)});
+  in.materials.push_back(ConductorParams{Spectrum(0.9f), 0.3f});
+  in.materials.push_back(ConductorParams{Spectrum(0.9f), 0.f});  // a mirror: a delta lobe
   in.objects.push_back(quad_object({-2, 1, 2}, {4, 0, 0}, {0, 0, -4}, 2));
+  in.objects.push_back(quad_object({-2, 1.5f, 2}, {4, 0, 0}, {0, 0, -4}, 3));
   const auto scene = Scene::build(in);
-  DiffuseStage stage(*scene);
-  EXPECT_TRUE(stage.takes(0));
-  EXPECT_TRUE(stage.takes(1));
-  EXPECT_FALSE(stage.takes(2));
+  const SurfaceStage lambert(*scene, StageModel::kLambert);
+  EXPECT_TRUE(lambert.takes(0));
+  EXPECT_TRUE(lambert.takes(1));
+  EXPECT_FALSE(lambert.takes(2));
+  EXPECT_FALSE(lambert.takes(3));
+  const SurfaceStage conductor(*scene, StageModel::kRoughConductor);
+  EXPECT_FALSE(conductor.takes(0));
+  EXPECT_TRUE(conductor.takes(2));
+  EXPECT_FALSE(conductor.takes(3));
 }
 
 }  // namespace
