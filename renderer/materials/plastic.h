@@ -42,6 +42,13 @@ class PlasticBsdf : public OpaqueBsdf {
   std::optional<BsdfSample> sample(const BsdfContext& ctx, const vec3& wi, float u_lobe,
                                    const vec2& u) const;
 
+  // The constants the wavefront driver's surface stage reads (render/lane_bsdfs.h repeats this
+  // model's arithmetic on them).
+  float eta() const { return eta_; }
+  float alpha() const { return distr_.alpha(); }
+  float specular_sampling_weight() const { return specular_sampling_weight_; }
+  float diffuse_scale() const { return diffuse_scale_; }
+  const CoatingTables& tables() const { return *tables_; }
   // Exposed for tests: the coating's internal diffuse reflectance and external transmittance.
   float internal_reflectance() const { return internal_reflectance_; }
   float external_transmittance(float cos_theta) const;

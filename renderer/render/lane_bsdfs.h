@@ -8,8 +8,8 @@
 // is its comparison), its branches selects between values every lane computes, so the stage's
 // results are path_scatter's to the bit.
 //
-// A new model (a plastic, a dielectric) adds a struct of the same shape here, a kind in
-// StageModel and the scene's surfaces it takes in SurfaceStage's constructor.
+// A new model (a dielectric, say) adds a struct of the same shape here, a kind in StageModel
+// and the scene's surfaces it takes in SurfaceStage's constructor.
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -29,26 +29,42 @@ namespace penumbra::lane {
   return ((b & 0x7fffffff) - 0x7f800000) >> 31;
 }
 
-// A lane's surface parameters: a colour and, for microfacet models, GGX alpha (already clamped
-// to kMinMicrofacetAlpha as GgxDistribution holds it).
+// The coating tables of a stage's plastics (CoatingTables' cosines and transmittance arrays,
+// kCoatingTableCapacity entries per table, one table after another).
+struct Tables {
+  const float* cosines;
+  const float* transmittance;
+};
+
+// A lane's surface parameters: a colour; for microfacet models GGX alpha (already clamped to
+// kMinMicrofacetAlpha as GgxDistribution holds it); for plastics the coating's ior, the
+// coating's sampling weight, the diffuse factor and its table (first entry and node count).
 struct Params {
   float c[3];
   float alpha;
+  float eta, spec_weight, diffuse_scale;
+  int32_t table, nodes;
+  Tables tables;
 };
 
 // The BSDF's answer towards a light: f (times the cosine) and the pdf of its own sampling.
+// `exact`: whether the lane could repeat the model exactly (a table lookup that resolves in a
+// bounded number of steps); a lane that could not takes path_scatter.
 struct EvalPdf {
   float f[3];
   float pdf;
+  Mask exact = -1;
 };
 
-// A sampled direction: wo in the front-mirrored local frame, weight = f cos / pdf, and whether
-// the model gave a sample at all.
+// A sampled direction: wo in the front-mirrored local frame, weight = f cos / pdf, whether the
+// model gave a sample at all, whether it is a Dirac lobe's (pdf 0), and `exact` as above.
 struct Sample {
   float wo[3];
   float weight[3];
   float pdf;
   Mask ok;
+  Mask delta = 0;
+  Mask exact = -1;
 };
 
 // square_to_disk_concentric (sampling.h; Shirley and Chiu 1997) of (u0, u1).
@@ -80,8 +96,8 @@ struct Lambert {
     return r;
   }
 
-  [[gnu::always_inline]] static Sample sample(const Params& q, const float* a, float u0,
-                                              float u1) {
+  [[gnu::always_inline]] static Sample sample(const Params& q, const float* a, float /*u_lobe*/,
+                                              float u0, float u1) {
     Sample s;
     disk_concentric(u0, u1, &s.wo[0], &s.wo[1]);
     s.wo[2] = safe_root(1.f - s.wo[0] * s.wo[0] - s.wo[1] * s.wo[1]);
@@ -94,17 +110,17 @@ struct Lambert {
   }
 };
 
-// ConductorBsdf (materials/conductor.h) when rough: GGX with Smith masking, visible-normal
-// sampling (materials/microfacet.h: Walter et al. 2007 eq. 33-34, Heitz 2018 listing 1).
-struct RoughConductor {
-  [[gnu::always_inline]] static float dot3(const float* a, const float* b) {
-    return (a[0] * b[0] + a[1] * b[1]) + a[2] * b[2];
-  }
-  // glm::normalize: v times 1 / sqrt(v.v).
-  [[gnu::always_inline]] static void normalize(float* v) {
-    const float k = 1.f / std::sqrt(dot3(v, v));
-    for (int c = 0; c < 3; ++c) v[c] = v[c] * k;
-  }
+[[gnu::always_inline]] inline float dot3(const float* a, const float* b) {
+  return (a[0] * b[0] + a[1] * b[1]) + a[2] * b[2];
+}
+// glm::normalize: v times 1 / sqrt(v.v).
+[[gnu::always_inline]] inline void normalize(float* v) {
+  const float k = 1.f / std::sqrt(dot3(v, v));
+  for (int c = 0; c < 3; ++c) v[c] = v[c] * k;
+}
+
+// GgxDistribution (materials/microfacet.h: Walter et al. 2007 eq. 33-34, Heitz 2018 listing 1).
+struct Ggx {
   // GgxDistribution::ndf.
   [[gnu::always_inline]] static float ndf(float alpha, const float* m) {
     const float a2 = alpha * alpha;
@@ -122,29 +138,9 @@ struct RoughConductor {
     return when(back, 0.f, when(mask(xy_a2 == 0.f), 1.f, g));
   }
 
-  [[gnu::always_inline]] static EvalPdf eval_pdf(const Params& q, const float* a,
-                                                 const float* b) {
-    float h[3] = {a[0] + b[0], a[1] + b[1], a[2] + b[2]};
-    normalize(h);
-    const float d = ndf(q.alpha, h);
-    const float g1_i = smith_g1(q.alpha, a, h);
-    const float denom = 4.f * a[2];
-    const float value = d * (g1_i * smith_g1(q.alpha, b, h)) / denom;
-    const Mask zero = mask(a[2] <= 0.f) | mask(b[2] <= 0.f);
-    const Mask has_value = ~zero & finite(value);
-    EvalPdf r;
-    for (int c = 0; c < 3; ++c) r.f[c] = when(has_value, q.c[c] * value, 0.f);
-    // SurfaceBsdf zeroes a value with a component that is not finite.
-    const Mask f_finite = finite(r.f[0]) & finite(r.f[1]) & finite(r.f[2]);
-    for (int c = 0; c < 3; ++c) r.f[c] = when(f_finite, r.f[c], 0.f);
-    const float p = d * g1_i / denom;
-    r.pdf = when(~zero & mask(dot3(b, h) > 0.f) & finite(p), p, 0.f);
-    return r;
-  }
-
-  [[gnu::always_inline]] static Sample sample(const Params& q, const float* a, float u0,
-                                              float u1) {
-    const float alpha = q.alpha;
+  // GgxDistribution::sample_visible into m.
+  [[gnu::always_inline]] static void sample_visible(float alpha, const float* a, float u0,
+                                                    float u1, float* m) {
     // stretched_view (microfacet.h): the view at alpha = 1 and two tangents around it.
     float vh[3] = {alpha * a[0], alpha * a[1], a[2]};
     normalize(vh);
@@ -164,17 +160,50 @@ struct RoughConductor {
     const float k = safe_root(1.f - p1 * p1 - p2 * p2);
     float nh[3];
     for (int c = 0; c < 3; ++c) nh[c] = (p1 * t1[c] + p2 * t2[c]) + k * vh[c];
-    float m[3] = {alpha * nh[0], alpha * nh[1], 0.f < nh[2] ? nh[2] : 0.f};
+    m[0] = alpha * nh[0];
+    m[1] = alpha * nh[1];
+    m[2] = 0.f < nh[2] ? nh[2] : 0.f;
     normalize(m);
+  }
+};
+
+// ConductorBsdf (materials/conductor.h) when rough: GGX with Smith masking, visible-normal
+// sampling.
+struct RoughConductor {
+  [[gnu::always_inline]] static EvalPdf eval_pdf(const Params& q, const float* a,
+                                                 const float* b) {
+    float h[3] = {a[0] + b[0], a[1] + b[1], a[2] + b[2]};
+    normalize(h);
+    const float d = Ggx::ndf(q.alpha, h);
+    const float g1_i = Ggx::smith_g1(q.alpha, a, h);
+    const float denom = 4.f * a[2];
+    const float value = d * (g1_i * Ggx::smith_g1(q.alpha, b, h)) / denom;
+    const Mask zero = mask(a[2] <= 0.f) | mask(b[2] <= 0.f);
+    const Mask has_value = ~zero & finite(value);
+    EvalPdf r;
+    for (int c = 0; c < 3; ++c) r.f[c] = when(has_value, q.c[c] * value, 0.f);
+    // SurfaceBsdf zeroes a value with a component that is not finite.
+    const Mask f_finite = finite(r.f[0]) & finite(r.f[1]) & finite(r.f[2]);
+    for (int c = 0; c < 3; ++c) r.f[c] = when(f_finite, r.f[c], 0.f);
+    const float p = d * g1_i / denom;
+    r.pdf = when(~zero & mask(dot3(b, h) > 0.f) & finite(p), p, 0.f);
+    return r;
+  }
+
+  [[gnu::always_inline]] static Sample sample(const Params& q, const float* a, float /*u_lobe*/,
+                                              float u0, float u1) {
+    const float alpha = q.alpha;
+    float m[3];
+    Ggx::sample_visible(alpha, a, u0, u1, m);
     // ConductorBsdf::sample: the mirror direction about m (fresnel.h's reflect), its pdf
     // (pdf_visible / (4 wo.m)) and weight colour G1(wo, m) (Heitz 2014 eq. 19).
     Sample r;
     const float two_dot = 2.f * dot3(a, m);
     for (int c = 0; c < 3; ++c) r.wo[c] = two_dot * m[c] - a[c];
     const float dot_wo_m = dot3(r.wo, m);
-    const float visible = (ndf(alpha, m) * smith_g1(alpha, a, m)) * std::fabs(dot3(a, m)) / a[2];
+    const float visible = (Ggx::ndf(alpha, m) * Ggx::smith_g1(alpha, a, m)) * std::fabs(dot3(a, m)) / a[2];
     r.pdf = when(mask(a[2] <= 0.f), 0.f, visible) / (4.f * dot_wo_m);
-    const float g1 = smith_g1(alpha, r.wo, m);
+    const float g1 = Ggx::smith_g1(alpha, r.wo, m);
     for (int c = 0; c < 3; ++c) r.weight[c] = q.c[c] * g1;
     r.ok = ~mask(a[2] <= 0.f) & ~mask(r.wo[2] <= 0.f) & mask(r.pdf > 0.f) & finite(r.pdf) &
            mask(g1 > 0.f) & finite(r.weight[0]) & finite(r.weight[1]) & finite(r.weight[2]) &
@@ -182,5 +211,178 @@ struct RoughConductor {
     return r;
   }
 };
+
+// fresnel_dielectric(cos_i, eta).reflectance (materials/fresnel.cpp).
+[[gnu::always_inline]] inline float fresnel_reflectance(float cos_i, float eta) {
+  const Mask outside = mask(cos_i >= 0.f);
+  const float inverse = 1.f / eta;
+  const float eta_it = when(outside, eta, inverse), eta_ti = when(outside, inverse, eta);
+  const float sin2 = 1.f - cos_i * cos_i;
+  const float cos_t_sqr = 1.f - eta_ti * eta_ti * (0.f < sin2 ? sin2 : 0.f);
+  const float ci = std::fabs(cos_i);
+  const float ct = std::sqrt(cos_t_sqr);
+  const float r_s = (ci - eta_it * ct) / (ci + eta_it * ct);
+  const float r_p = (ct - eta_it * ci) / (ct + eta_it * ci);
+  const float half = 0.5f * (r_s * r_s + r_p * r_p);
+  const float f = half < 1.f ? half : 1.f;
+  const Mask reflected = mask(cos_t_sqr <= 0.f) | mask(ci == 0.f);  // total, or grazing
+  return when(mask(eta == 1.f), 0.f, when(reflected, 1.f, f));
+}
+
+// PlasticBsdf (materials/plastic.h): a Lambertian base under a dielectric coating, the coating's
+// lobe and the base's sampled by a choice weighted by their reflectances. The parts both
+// coatings share; `Coating` says what differs: the transmittance t(cos) through the coating
+// (smooth: 1 - F; rough: the table) and the rough coating's own lobe.
+template <class Coating>
+struct Plastic {
+  // PlasticBsdf::specular_probability with both lobes enabled; t_i = t(cos_i).
+  [[gnu::always_inline]] static float specular_probability(const Params& q, float t_i) {
+    const float p_spec = (1.f - t_i) * q.spec_weight;
+    const float p_diff = t_i * (1.f - q.spec_weight);
+    const float sum = p_spec + p_diff;
+    return when(mask(sum > 0.f), p_spec / sum, 0.f);
+  }
+
+  // PlasticBsdf::evaluate<true, true> (its own answer, which sample weighs with; eval_pdf
+  // cleans it as SurfaceBsdf does). `exact` collects the table lookups' exactness.
+  [[gnu::always_inline]] static EvalPdf evaluate(const Params& q, const float* a, const float* b,
+                                                 Mask* exact) {
+    const float t_i = Coating::transmittance(q, a[2], exact);
+    const float p_spec = specular_probability(q, t_i);
+    EvalPdf r;
+    float spec, spec_pdf;
+    const Mask has_spec = Coating::lobe(q, a, b, &spec, &spec_pdf);
+    const float t = t_i * Coating::transmittance(q, b[2], exact);
+    const float k = t * q.diffuse_scale * kInvPi * b[2];
+    for (int c = 0; c < 3; ++c) r.f[c] = when(has_spec, 0.f + spec, 0.f) + q.c[c] * k;
+    const float p = (1.f - p_spec) * (b[2] > 0.f ? b[2] * kInvPi : 0.f);
+    r.pdf = when(mask(p_spec > 0.f) & mask(Coating::kRough) & finite(spec_pdf),
+                 p + p_spec * spec_pdf, p);
+    const Mask zero = mask(a[2] <= 0.f) | mask(b[2] <= 0.f);
+    for (int c = 0; c < 3; ++c) r.f[c] = when(zero, 0.f, r.f[c]);
+    r.pdf = when(zero, 0.f, r.pdf);
+    return r;
+  }
+
+  [[gnu::always_inline]] static EvalPdf eval_pdf(const Params& q, const float* a,
+                                                 const float* b) {
+    Mask exact = -1;
+    EvalPdf r = evaluate(q, a, b, &exact);
+    // SurfaceBsdf zeroes a value with a component that is not finite, and such a pdf.
+    const Mask f_finite = finite(r.f[0]) & finite(r.f[1]) & finite(r.f[2]);
+    for (int c = 0; c < 3; ++c) r.f[c] = when(f_finite, r.f[c], 0.f);
+    r.pdf = when(finite(r.pdf), r.pdf, 0.f);
+    r.exact = exact;
+    return r;
+  }
+
+  [[gnu::always_inline]] static Sample sample(const Params& q, const float* a, float u_lobe,
+                                              float u0, float u1) {
+    Mask exact = -1;
+    const float t_i = Coating::transmittance(q, a[2], &exact);
+    const Mask pick_spec = mask(u_lobe < specular_probability(q, t_i));
+    // The base's direction: square_to_cosine_hemisphere; the coating's: Coating::reflect.
+    float wo[3];
+    disk_concentric(u0, u1, &wo[0], &wo[1]);
+    wo[2] = safe_root(1.f - wo[0] * wo[0] - wo[1] * wo[1]);
+    float spec_wo[3];
+    Coating::reflect(q, a, u0, u1, spec_wo);
+    Sample r;
+    for (int c = 0; c < 3; ++c) r.wo[c] = when(pick_spec, spec_wo[c], wo[c]);
+    // One-sample MIS over the lobes: the mixture's pdf, weight f / pdf.
+    const EvalPdf e = evaluate(q, a, r.wo, &exact);
+    r.pdf = e.pdf;
+    for (int c = 0; c < 3; ++c) r.weight[c] = e.f[c] / e.pdf;
+    Mask ok = ~mask(r.wo[2] <= 0.f) & mask(r.pdf > 0.f);
+    // A smooth coating's Dirac reflection: weight F / P(coating), no pdf.
+    const Mask delta = pick_spec & mask(!Coating::kRough);
+    const float w_delta = fresnel_reflectance(a[2], q.eta) / specular_probability(q, t_i);
+    for (int c = 0; c < 3; ++c) r.weight[c] = when(delta, w_delta, r.weight[c]);
+    r.pdf = when(delta, 0.f, r.pdf);
+    ok = when(delta, Mask(-1), ok);
+    // SurfaceBsdf::sample's checks.
+    r.ok = ~mask(a[2] <= 0.f) & ok & finite(r.weight[0]) & finite(r.weight[1]) &
+           finite(r.weight[2]) & finite(r.pdf) & finite(r.wo[0]) & finite(r.wo[1]) &
+           finite(r.wo[2]);
+    r.delta = delta;
+    r.exact = exact;
+    return r;
+  }
+};
+
+// A smooth coating: t = 1 - F(cos), a Dirac reflection (reflect_local) and no lobe of its own
+// towards a light.
+struct SmoothCoating {
+  static constexpr bool kRough = false;
+  [[gnu::always_inline]] static float transmittance(const Params& q, float cos_theta, Mask*) {
+    return 1.f - fresnel_reflectance(cos_theta, q.eta);
+  }
+  [[gnu::always_inline]] static Mask lobe(const Params&, const float*, const float*, float* f,
+                                          float* pdf) {
+    *f = 0.f;
+    *pdf = 0.f;
+    return 0;
+  }
+  [[gnu::always_inline]] static void reflect(const Params&, const float* a, float, float,
+                                             float* wo) {
+    wo[0] = -a[0];
+    wo[1] = -a[1];
+    wo[2] = a[2];
+  }
+};
+
+// A rough GGX coating: t(cos) from the coating's table (PlasticBsdf::external_transmittance),
+// the Torrance-Sparrow lobe with the dielectric Fresnel term, visible-normal sampling.
+struct RoughCoating {
+  static constexpr bool kRough = true;
+  [[gnu::always_inline]] static float transmittance(const Params& q, float cos_theta,
+                                                    Mask* exact) {
+    const float lo = cos_theta < 0.f ? 0.f : cos_theta;  // std::clamp(cos_theta, 0.f, 1.f)
+    const float mu = 1.f < lo ? 1.f : lo;
+    // CoatingTables::interval on square nodes: the guess from sqrt(mu), then its corrections
+    // one step each way (only the step up ever happens on the tables in use: the test checks
+    // every node); a lane whose answer needed more than that is not exact (the scalar step,
+    // whose loops run on, takes it). Entries as offsets from the tables' start, in int32, so
+    // the lookups are gathers from one base.
+    const float* cosines = q.tables.cosines;
+    const int32_t first = q.table, last = q.table + q.nodes - 2;
+    const float root = mu > 0.f ? std::sqrt(mu) : 0.f;  // (mu <= 1 already, and not NaN)
+    const int32_t guess = first + int32_t(root * float(q.nodes - 1));
+    int32_t i = last < guess ? last : guess;
+    i -= mask(i < last) & mask(cosines[i + 1] <= mu);
+    const Mask up_again = mask(i < last) & mask(cosines[i + 1] <= mu);
+    i += mask(i > first) & mask(cosines[i] > mu);
+    const Mask down_again = mask(i > first) & mask(cosines[i] > mu);
+    *exact &= ~up_again & ~down_again;
+    const float c0 = cosines[i], c1 = cosines[i + 1];
+    const float width = c1 - c0;
+    const float w = width > 0.f ? (mu - c0) / width : 1.f;
+    return (1.f - w) * q.tables.transmittance[i] + w * q.tables.transmittance[i + 1];
+  }
+  // The coating's f cos and its sampling density towards b; whether f counts (finite).
+  [[gnu::always_inline]] static Mask lobe(const Params& q, const float* a, const float* b,
+                                          float* f, float* pdf) {
+    float h[3] = {a[0] + b[0], a[1] + b[1], a[2] + b[2]};
+    normalize(h);
+    const float d = Ggx::ndf(q.alpha, h);
+    const float g1_i = Ggx::smith_g1(q.alpha, a, h);
+    const float fresnel = fresnel_reflectance(dot3(a, h), q.eta);
+    // Walter et al. 2007 eq. 20 with the dielectric Fresnel term, G = G1 G1.
+    *f = fresnel * d * (g1_i * Ggx::smith_g1(q.alpha, b, h)) / (4.f * a[2]);
+    // Visible-normal density times the reflection Jacobian 1 / (4 wo.h).
+    *pdf = d * g1_i / (4.f * a[2]);
+    return finite(*f);
+  }
+  [[gnu::always_inline]] static void reflect(const Params& q, const float* a, float u0,
+                                             float u1, float* wo) {
+    float m[3];
+    Ggx::sample_visible(q.alpha, a, u0, u1, m);
+    const float two_dot = 2.f * dot3(a, m);
+    for (int c = 0; c < 3; ++c) wo[c] = two_dot * m[c] - a[c];
+  }
+};
+
+using SmoothPlastic = Plastic<SmoothCoating>;
+using RoughPlastic = Plastic<RoughCoating>;
 
 }  // namespace penumbra::lane

@@ -6,6 +6,7 @@
 #include "renderer/core/simd_clones.h"
 #include "renderer/materials/conductor.h"
 #include "renderer/materials/diffuse.h"
+#include "renderer/materials/plastic.h"
 #include "renderer/render/lane_bsdfs.h"
 #include "renderer/sampling/sampling.h"
 
@@ -60,12 +61,15 @@ namespace {
 
 // The arrays of a stage's lanes, inputs and results (SurfaceStage's members).
 struct Lanes {
-  const float *p[3], *e[3], *ng[3], *ns[3], *dir[3], *beta[3], *colour[3], *alpha;
-  const float *time, *eta, *u_dir[2], *u_rr;
+  const float *p[3], *e[3], *ng[3], *ns[3], *dir[3], *beta[3];
+  const float *colour[3], *alpha, *coat_eta, *spec_weight, *diffuse_scale;
+  const int32_t *table, *nodes;
+  lane::Tables tables;
+  const float *time, *eta, *u_lobe, *u_dir[2], *u_rr;
   const int32_t* depth;
   const int32_t* light_ok;
   const float *l_wi[3], *l_distance, *l_pdf, *l_p[3], *l_error[3], *l_n[3], *l_value[3], *l_pmf;
-  int32_t *alive, *has_shadow, *nee_ray, *dims;
+  int32_t *staged, *alive, *has_shadow, *nee_ray, *dims, *prev_delta;
   float *s_origin[3], *s_dir[3], *s_t_max, *s_contrib[3];
   float *origin[3], *wo[3], *beta_out[3], *prev_pdf;
 };
@@ -88,7 +92,14 @@ template <class Model, bool kNextEvent>
     const float gx = L.ng[0][i], gy = L.ng[1][i], gz = L.ng[2][i];
     const float nx = L.ns[0][i], ny = L.ns[1][i], nz = L.ns[2][i];
     const float bx = L.beta[0][i], by = L.beta[1][i], bz = L.beta[2][i];
-    const lane::Params q{{L.colour[0][i], L.colour[1][i], L.colour[2][i]}, L.alpha[i]};
+    const lane::Params q{{L.colour[0][i], L.colour[1][i], L.colour[2][i]},
+                         L.alpha[i],
+                         L.coat_eta[i],
+                         L.spec_weight[i],
+                         L.diffuse_scale[i],
+                         L.table[i],
+                         L.nodes[i],
+                         L.tables};
     // Frame(ns): Duff et al. 2017 (core/frame.h).
     const float sign = std::copysign(1.f, nz);
     const float fa = -1.f / (sign + nz);
@@ -151,7 +162,7 @@ template <class Model, bool kNextEvent>
     L.has_shadow[i] = nee & mask(t_max > 0.f);
 
     // The BSDF's sample, its direction mirrored back to the side wi came from.
-    const lane::Sample bs = Model::sample(q, a, L.u_dir[0][i], L.u_dir[1][i]);
+    const lane::Sample bs = Model::sample(q, a, L.u_lobe[i], L.u_dir[0][i], L.u_dir[1][i]);
     const float wo_z = when(flip, -bs.wo[2], bs.wo[2]);
     const float ww_x = (sx * bs.wo[0] + tx * bs.wo[1]) + nx * wo_z;
     const float ww_y = (sy * bs.wo[0] + ty * bs.wo[1]) + ny * wo_z;
@@ -179,6 +190,8 @@ template <class Model, bool kNextEvent>
     L.wo[1][i] = ww_y;
     L.wo[2][i] = ww_z;
     L.prev_pdf[i] = bs.pdf;
+    L.prev_delta[i] = bs.delta;
+    L.staged[i] = L.staged[i] & e.exact & bs.exact;
   }
 }
 
@@ -201,32 +214,62 @@ void rough_conductor_step_kernel(const Lanes& lanes, size_t n, bool next_event,
                                  int32_t rr_depth) {
   step_cases<lane::RoughConductor>(lanes, n, next_event, rr_depth);
 }
+PENUMBRA_SIMD_CLONES
+void smooth_plastic_step_kernel(const Lanes& lanes, size_t n, bool next_event, int32_t rr_depth) {
+  step_cases<lane::SmoothPlastic>(lanes, n, next_event, rr_depth);
+}
+PENUMBRA_SIMD_CLONES
+void rough_plastic_step_kernel(const Lanes& lanes, size_t n, bool next_event, int32_t rr_depth) {
+  step_cases<lane::RoughPlastic>(lanes, n, next_event, rr_depth);
+}
 
 }  // namespace
 
 SurfaceStage::SurfaceStage(const Scene& scene, StageModel model)
     : scene_(scene), model_(model), lights_(scene) {
   params_of_.assign(scene.object_count(), -1);
+  std::vector<const CoatingTables*> tables;  // those in table_cosines_, in order
   for (size_t o = 0; o < scene.object_count(); ++o) {
     const Material& m = scene.material(scene.object(uint32_t(o)).material);
     if (m.varies() || m.normal_mapped() || m.bsdf().normal_mapped() || !m.bsdf().two_sided())
       continue;
-    Spectrum colour;
-    float alpha = 0.f;
+    SurfaceParams q;
+    const BsdfModel& bsdf = m.bsdf().model();
     if (model == StageModel::kLambert) {
-      const auto* diffuse = std::get_if<DiffuseBsdf>(&m.bsdf().model());
+      const auto* diffuse = std::get_if<DiffuseBsdf>(&bsdf);
       if (!diffuse) continue;
-      colour = diffuse->albedo();
-    } else {
-      const auto* conductor = std::get_if<ConductorBsdf>(&m.bsdf().model());
+      q.colour = diffuse->albedo();
+    } else if (model == StageModel::kRoughConductor) {
+      const auto* conductor = std::get_if<ConductorBsdf>(&bsdf);
       if (!conductor || conductor->smooth()) continue;
-      colour = conductor->albedo();
-      alpha = conductor->alpha();
+      q.colour = conductor->albedo();
+      q.alpha = conductor->alpha();
+    } else {
+      const auto* plastic = std::get_if<PlasticBsdf>(&bsdf);
+      if (!plastic || plastic->smooth() != (model == StageModel::kSmoothPlastic)) continue;
+      q.colour = plastic->albedo();
+      q.alpha = plastic->alpha();
+      q.eta = plastic->eta();
+      q.spec_weight = plastic->specular_sampling_weight();
+      q.diffuse_scale = plastic->diffuse_scale();
+      if (model == StageModel::kRoughPlastic) {
+        const CoatingTables& t = plastic->tables();
+        if (!t.square_nodes) continue;  // adaptive nodes (ior < 1): bisection, left to the scalar step
+        size_t k = 0;
+        while (k < tables.size() && tables[k] != &t) ++k;
+        if (k == tables.size()) {
+          tables.push_back(&t);
+          table_cosines_.insert(table_cosines_.end(), t.cosines.begin(), t.cosines.end());
+          table_values_.insert(table_values_.end(), t.transmittance.begin(),
+                               t.transmittance.end());
+        }
+        q.table = int32_t(k * kCoatingTableCapacity);
+        q.nodes = t.nodes;
+      }
     }
-    if (!is_finite(colour)) continue;
-    params_of_[o] = int32_t(colours_.size());
-    colours_.push_back(colour);
-    alphas_.push_back(alpha);
+    if (!is_finite(q.colour)) continue;
+    params_of_[o] = int32_t(params_.size());
+    params_.push_back(q);
   }
 }
 
@@ -239,10 +282,12 @@ void SurfaceStage::start(size_t paths) {
                     &l_wi_[c], &l_p_[c], &l_error_[c], &l_n_[c], &l_value_[c], &s_origin_[c],
                     &s_dir_[c], &s_contrib_[c], &origin_[c], &wo_[c], &beta_out_[c]})
       a->resize(paths);
-  for (auto* a : {&alpha_, &time_, &eta_, &u_light_, &u_point_[0], &u_point_[1], &u_dir_[0], &u_dir_[1],
-                  &u_rr_, &l_distance_, &l_pdf_, &l_pmf_, &s_t_max_, &prev_pdf_})
+  for (auto* a : {&alpha_, &coat_eta_, &spec_weight_, &diffuse_scale_, &time_, &eta_, &u_light_,
+                  &u_point_[0], &u_point_[1], &u_lobe_, &u_dir_[0], &u_dir_[1], &u_rr_,
+                  &l_distance_, &l_pdf_, &l_pmf_, &s_t_max_, &prev_pdf_})
     a->resize(paths);
-  for (auto* a : {&depth_, &light_, &light_ok_, &staged_, &alive_, &has_shadow_, &nee_ray_, &dims_})
+  for (auto* a : {&table_, &nodes_, &depth_, &light_, &light_ok_, &staged_, &alive_,
+                  &has_shadow_, &nee_ray_, &dims_, &prev_delta_})
     a->resize(paths);
 }
 
@@ -250,8 +295,7 @@ void SurfaceStage::add(uint32_t slot, const PathState& s, const SurfaceHit& hit,
                        const float* y, bool next_event) {
   const size_t i = count_++;
   slot_[i] = slot;
-  const size_t params = size_t(params_of_[hit.object]);
-  const Spectrum& colour = colours_[params];
+  const SurfaceParams& q = params_[size_t(params_of_[hit.object])];
   for (int c = 0; c < 3; ++c) {
     p_[c][i] = hit.p[c];
     p_error_[c][i] = hit.p_error[c];
@@ -259,18 +303,27 @@ void SurfaceStage::add(uint32_t slot, const PathState& s, const SurfaceHit& hit,
     ns_[c][i] = hit.ns[c];
     dir_[c][i] = s.ray.direction[c];
     beta_[c][i] = s.beta[c];
-    colour_[c][i] = colour[c];
+    colour_[c][i] = q.colour[c];
   }
-  alpha_[i] = alphas_[params];
+  // (Each model reads only its own constants: a Lambertian surface's colour alone.)
+  if (model_ != StageModel::kLambert) {
+    alpha_[i] = q.alpha;
+    coat_eta_[i] = q.eta;
+    spec_weight_[i] = q.spec_weight;
+    diffuse_scale_[i] = q.diffuse_scale;
+    table_[i] = q.table;
+    nodes_[i] = q.nodes;
+  }
   time_[i] = s.ray.time;
   eta_[i] = s.eta;
   depth_[i] = s.depth;
   // The step's values in the order path_scatter takes them: light choice and point (with next-
-  // event estimation), lobe (unused by the stage's single-lobe models), direction, roulette.
+  // event estimation), lobe, direction, roulette.
   const int d = next_event ? 2 : 0;
   u_light_[i] = x[0];
   u_point_[0][i] = x[1];
   u_point_[1][i] = y[1];
+  u_lobe_[i] = x[d];
   u_dir_[0][i] = x[d + 1];
   u_dir_[1][i] = y[d + 1];
   u_rr_[i] = x[d + 2];
@@ -344,6 +397,13 @@ void SurfaceStage::compute(const IntegratorSettings& settings, bool next_event) 
     L.beta_out[c] = beta_out_[c].data();
   }
   L.alpha = alpha_.data();
+  L.coat_eta = coat_eta_.data();
+  L.spec_weight = spec_weight_.data();
+  L.diffuse_scale = diffuse_scale_.data();
+  L.table = table_.data();
+  L.nodes = nodes_.data();
+  L.tables = lane::Tables{table_cosines_.data(), table_values_.data()};
+  L.u_lobe = u_lobe_.data();
   L.time = time_.data();
   L.eta = eta_.data();
   L.u_dir[0] = u_dir_[0].data();
@@ -354,16 +414,29 @@ void SurfaceStage::compute(const IntegratorSettings& settings, bool next_event) 
   L.l_distance = l_distance_.data();
   L.l_pdf = l_pdf_.data();
   L.l_pmf = l_pmf_.data();
+  L.staged = staged_.data();
+  L.prev_delta = prev_delta_.data();
   L.alive = alive_.data();
   L.has_shadow = has_shadow_.data();
   L.nee_ray = nee_ray_.data();
   L.dims = dims_.data();
   L.s_t_max = s_t_max_.data();
   L.prev_pdf = prev_pdf_.data();
-  if (model_ == StageModel::kLambert)
-    lambert_step_kernel(L, n, next_event, int32_t(settings.rr_depth));
-  else
-    rough_conductor_step_kernel(L, n, next_event, int32_t(settings.rr_depth));
+  const int32_t rr_depth = int32_t(settings.rr_depth);
+  switch (model_) {
+    case StageModel::kLambert:
+      lambert_step_kernel(L, n, next_event, rr_depth);
+      break;
+    case StageModel::kRoughConductor:
+      rough_conductor_step_kernel(L, n, next_event, rr_depth);
+      break;
+    case StageModel::kSmoothPlastic:
+      smooth_plastic_step_kernel(L, n, next_event, rr_depth);
+      break;
+    case StageModel::kRoughPlastic:
+      rough_plastic_step_kernel(L, n, next_event, rr_depth);
+      break;
+  }
 }
 
 ShadowQuery SurfaceStage::shadow(size_t i) const {
@@ -377,7 +450,7 @@ ShadowQuery SurfaceStage::shadow(size_t i) const {
 void SurfaceStage::apply(size_t i, PathState& s, Sampler::Cursor& cursor) const {
   s.beta = Spectrum(beta_out_[0][i], beta_out_[1][i], beta_out_[2][i]);
   s.prev_pdf = prev_pdf_[i];
-  s.prev_delta = false;
+  s.prev_delta = prev_delta_[i] != 0;
   s.prev_p = vec3(p_[0][i], p_[1][i], p_[2][i]);
   s.ray = Ray{vec3(origin_[0][i], origin_[1][i], origin_[2][i]),
               vec3(wo_[0][i], wo_[1][i], wo_[2][i]), time_[i]};

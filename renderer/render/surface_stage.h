@@ -28,7 +28,12 @@ namespace penumbra {
 enum class StageModel : uint8_t {
   kLambert,         // DiffuseBsdf
   kRoughConductor,  // ConductorBsdf with a microfacet lobe (not a smooth mirror)
+  kSmoothPlastic,   // PlasticBsdf with a smooth coating
+  kRoughPlastic,    // PlasticBsdf with a rough coating tabulated on square nodes (ior >= 1)
 };
+inline constexpr StageModel kStageModels[] = {StageModel::kLambert, StageModel::kRoughConductor,
+                                              StageModel::kSmoothPlastic,
+                                              StageModel::kRoughPlastic};
 
 class SurfaceStage {
  public:
@@ -53,8 +58,9 @@ class SurfaceStage {
 
   size_t size() const { return count_; }
   uint32_t slot(size_t lane) const { return slot_[lane]; }
-  // False if the lane's chosen light has no kernel: the caller takes the step with
-  // path_scatter instead of the results below.
+  // False if the lane's chosen light has no kernel, or its model could not repeat the scalar
+  // arithmetic exactly (lane_bsdfs.h): the caller takes the step with path_scatter instead of
+  // the results below.
   bool staged(size_t lane) const { return staged_[lane] != 0; }
   // The step's results, as path_scatter leaves them: whether the path goes on (then `apply`
   // updates its state and sampler cursor), whether it has a shadow query, and whether it
@@ -69,20 +75,29 @@ class SurfaceStage {
   const Scene& scene_;
   StageModel model_;
   StagedLights lights_;
-  std::vector<int32_t> params_of_;  // per object: index into colours_ and alphas_, or -1
-  std::vector<Spectrum> colours_;
-  std::vector<float> alphas_;  // GGX alpha (microfacet models)
+  // A surface's constants (lane::Params without the tables).
+  struct SurfaceParams {
+    Spectrum colour;
+    float alpha = 0.f, eta = 1.f, spec_weight = 0.f, diffuse_scale = 0.f;
+    int32_t table = 0, nodes = 0;
+  };
+  std::vector<int32_t> params_of_;  // per object: index into params_, or -1
+  std::vector<SurfaceParams> params_;
+  // The rough plastics' coating tables, one after another (lane::Tables).
+  std::vector<float> table_cosines_, table_values_;
   size_t count_ = 0;
   std::vector<uint32_t> slot_;
   // Inputs per lane.
   std::vector<float> p_[3], p_error_[3], ng_[3], ns_[3], dir_[3], beta_[3], colour_[3];
-  std::vector<float> alpha_, time_, eta_, u_light_, u_point_[2], u_dir_[2], u_rr_;
+  std::vector<float> alpha_, coat_eta_, spec_weight_, diffuse_scale_;
+  std::vector<int32_t> table_, nodes_;
+  std::vector<float> time_, eta_, u_light_, u_point_[2], u_lobe_, u_dir_[2], u_rr_;
   std::vector<int32_t> depth_;
   // The light sample per lane.
   std::vector<int32_t> light_, light_ok_;
   std::vector<float> l_wi_[3], l_distance_, l_pdf_, l_p_[3], l_error_[3], l_n_[3], l_value_[3], l_pmf_;
   // Results per lane.
-  std::vector<int32_t> staged_, alive_, has_shadow_, nee_ray_, dims_;
+  std::vector<int32_t> staged_, alive_, has_shadow_, nee_ray_, dims_, prev_delta_;
   std::vector<float> s_origin_[3], s_dir_[3], s_t_max_, s_contrib_[3];
   std::vector<float> origin_[3], wo_[3], beta_out_[3], prev_pdf_;
 };

@@ -32,7 +32,7 @@ void PathBatch::clear() {
 void make_stages(const Scene& scene, PathBatch& b) {
   b.stages_.clear();
   b.stage_of_.assign(scene.object_count(), -1);
-  for (StageModel model : {StageModel::kLambert, StageModel::kRoughConductor}) {
+  for (StageModel model : kStageModels) {
     auto stage = std::make_unique<SurfaceStage>(scene, model);
     bool used = false;
     for (uint32_t o = 0; o < scene.object_count(); ++o) {
@@ -71,8 +71,8 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
       if (b.found_[k]) samples.add(*b.samplers_[live[k]], b.cursors_[live[k]]);
     samples.compute();
 
-    // Shade: every live path takes its step. Paths on plain Lambertian surfaces and rough
-    // conductors (path integrator) take theirs in the surface stages, the others one by one;
+    // Shade: every live path takes its step. Paths on plain Lambertian surfaces, rough
+    // conductors and plastics (path integrator) take theirs in the surface stages, the others one by one;
     // each path's results go to its own slot k, and the survivors and shadow queries are then
     // gathered in path order, as the scalar loop would leave them.
     constexpr bool kStages = !kDistributed;

@@ -1,15 +1,19 @@
 // The wavefront driver's surface stages (renderer/render/surface_stage.h) against path_scatter,
 // the scalar step they repeat in SIMD lanes: for real hits on a floor and ball of each stage's
-// model, Lambertian and rough conductors of several roughnesses (front and back side, at every depth around the roulette depth, with the sampler's corner values), every
+// model, Lambertian, rough conductors and rough plastics of several roughnesses and smooth
+// plastics of several iors (front and back side, at every depth around the roulette depth, with the sampler's corner values), every
 // result must be path_scatter's to the bit: whether the path goes on, its new state and how
 // many sampler values it took, its shadow ray and contribution, and the ray count. Lanes whose
 // chosen light has no kernel (the point light here) must say so.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
 #include <random>
 #include <vector>
 
+#include "renderer/materials/plastic.h"
+#include "renderer/render/lane_bsdfs.h"
 #include "renderer/render/surface_stage.h"
 #include "renderer/render/path_step.h"
 #include "renderer/sampling/sobol_batch.h"
@@ -49,10 +53,20 @@ const vec3 kFloorOrigin(-2.f, -0.3f, 2.f), kFloorU(4.f, 0.5f, 0.3f), kFloorV(0.2
 const vec3 kBallCentre(0.3f, 1.2f, -0.2f);
 constexpr float kBallRadius = 0.6f;
 
-// The floor and ball's material for a stage's model (`roughness` for a conductor).
-MaterialParams stage_material(StageModel model, float roughness) {
-  if (model == StageModel::kLambert) return DiffuseParams{Spectrum(0.7f, 0.5f, 0.3f)};
-  return ConductorParams{Spectrum(0.9f, 0.6f, 0.3f), roughness};
+// The floor and ball's material for a stage's model (`roughness` of a conductor or a rough
+// plastic, `ior` of a plastic).
+MaterialParams stage_material(StageModel model, float roughness, float ior) {
+  switch (model) {
+    case StageModel::kLambert:
+      return DiffuseParams{Spectrum(0.7f, 0.5f, 0.3f)};
+    case StageModel::kRoughConductor:
+      return ConductorParams{Spectrum(0.9f, 0.6f, 0.3f), roughness};
+    case StageModel::kSmoothPlastic:
+      return PlasticParams{Spectrum(0.2f, 0.4f, 0.8f), ior, 0.f};
+    case StageModel::kRoughPlastic:
+      return PlasticParams{Spectrum(0.7f, 0.15f, 0.1f), ior, roughness};
+  }
+  return DiffuseParams{};
 }
 
 SceneInput floor_scene(bool lights, const MaterialParams& material) {
@@ -119,12 +133,12 @@ std::vector<Lane> floor_hits(const Scene& scene, size_t count, uint32_t seed) {
 }
 
 struct Coverage {
-  int staged = 0, fallback = 0, alive = 0, dead = 0, shadows = 0, back = 0, ball = 0;
+  int staged = 0, fallback = 0, alive = 0, dead = 0, shadows = 0, back = 0, ball = 0, delta = 0;
 };
 
 Coverage expect_stage_matches_scatter(bool lights, uint32_t seed, StageModel model,
-                                      float roughness = 0.f) {
-  const auto scene = Scene::build(floor_scene(lights, stage_material(model, roughness)));
+                                      float roughness = 0.f, float ior = 1.5f) {
+  const auto scene = Scene::build(floor_scene(lights, stage_material(model, roughness, ior)));
   IntegratorSettings settings;
   settings.max_depth = 16;
   settings.rr_depth = 4;
@@ -177,6 +191,7 @@ Coverage expect_stage_matches_scatter(bool lights, uint32_t seed, StageModel mod
       continue;
     }
     ++cover.alive;
+    cover.delta += s.prev_delta;
     PathState staged = lanes[k].state;
     Sampler::Cursor cursor{0, 100};
     stage.apply(lane, staged, cursor);
@@ -243,12 +258,89 @@ TEST(SurfaceStage, RoughConductorStepIsPathScatterToTheBitWithoutLights) {
   EXPECT_GT(c.dead, 50);
 }
 
+TEST(SurfaceStage, RoughPlasticStepIsPathScatterToTheBit) {
+  for (const float roughness : {0.011f, 0.15f, 0.5f, 1.f}) {
+    for (const float ior : {1.f, 1.33f, 1.6f, 3.f}) {
+      SCOPED_TRACE("roughness " + std::to_string(roughness) + " ior " + std::to_string(ior));
+      const Coverage c = expect_stage_matches_scatter(true, 19, StageModel::kRoughPlastic,
+                                                      roughness, ior);
+      EXPECT_GT(c.staged, 1000);
+      EXPECT_GT(c.alive, 300);
+      EXPECT_GT(c.dead, 50);
+      EXPECT_GT(c.shadows, 300);
+      EXPECT_EQ(c.delta, 0);
+    }
+  }
+  const Coverage c = expect_stage_matches_scatter(false, 23, StageModel::kRoughPlastic, 0.3f);
+  EXPECT_EQ(c.fallback, 0);
+  EXPECT_GT(c.alive, 300);
+}
+
+TEST(SurfaceStage, SmoothPlasticStepIsPathScatterToTheBit) {
+  for (const float ior : {1.f, 1.33f, 1.5f, 3.f}) {
+    SCOPED_TRACE("ior " + std::to_string(ior));
+    const Coverage c = expect_stage_matches_scatter(true, 29, StageModel::kSmoothPlastic, 0.f,
+                                                    ior);
+    EXPECT_GT(c.staged, 1000);
+    EXPECT_GT(c.alive, 300);
+    EXPECT_GT(c.dead, 50);
+    EXPECT_GT(c.shadows, 300);
+    // Both lobes chosen: the coating's mirror (a Dirac sample) and the base.
+    if (ior > 1.f) {
+      EXPECT_GT(c.delta, 10);
+      EXPECT_LT(c.delta, c.alive - 100);
+    }
+  }
+  const Coverage c = expect_stage_matches_scatter(false, 31, StageModel::kSmoothPlastic, 0.f);
+  EXPECT_EQ(c.fallback, 0);
+  EXPECT_GT(c.alive, 300);
+}
+
+// The rough coating's table lookup on lanes: the guess from sqrt(mu) and one correction each
+// way give CoatingTables::interval's answer for every cosine (the nodes themselves and their
+// neighbouring floats, where rounding decides, and cosines out of [0, 1]), so no lane of the
+// tables in use falls back to the scalar step; and the interpolated value is the scalar's.
+TEST(SurfaceStage, RoughCoatingTableLookupIsExactEverywhere) {
+  for (const float ior : {1.f, 1.33f, 1.5f, 2.4f}) {
+    for (const float roughness : {0.05f, 0.3f, 0.9f}) {
+      CoatingTableCache cache;
+      const PlasticParams params{Spectrum(0.5f), ior, roughness};
+      const PlasticBsdf plastic(params, PlasticBsdf::tables_for(params, cache));
+      const CoatingTables& tables = plastic.tables();
+      ASSERT_TRUE(tables.square_nodes);
+      const lane::Params q{{0.5f, 0.5f, 0.5f}, plastic.alpha(), ior, 0.f, 0.f, 0, tables.nodes,
+                           lane::Tables{tables.cosines.data(), tables.transmittance.data()}};
+      std::vector<float> cosines = {-0.5f, -0.f, 0.f, 1.f, 1.5f, 1e-30f};
+      for (int i = 0; i < tables.nodes; ++i) {
+        const float c = tables.cosines[size_t(i)];
+        cosines.insert(cosines.end(), {c, std::nextafter(c, -1.f), std::nextafter(c, 2.f),
+                                       std::nextafter(std::nextafter(c, -1.f), -1.f)});
+      }
+      std::mt19937 rng(5);
+      std::uniform_real_distribution<float> u(0.f, 1.f);
+      for (int i = 0; i < 20000; ++i) cosines.push_back(u(rng) * u(rng));
+      for (const float c : cosines) {
+        Mask exact = -1;
+        const float t = lane::RoughCoating::transmittance(q, c, &exact);
+        ASSERT_EQ(exact, -1) << "cosine " << c;
+        const float expected = plastic.external_transmittance(c);
+        ASSERT_TRUE(same_bits(t, expected)) << "cosine " << c << ": " << t << " vs " << expected;
+      }
+    }
+  }
+}
+
 TEST(SurfaceStage, TakesOnlyPlainSurfacesOfItsModel) {
   SceneInput in = floor_scene(false, DiffuseParams{Spectrum(0.5f)});
   in.materials.push_back(ConductorParams{Spectrum(0.9f), 0.3f});
   in.materials.push_back(ConductorParams{Spectrum(0.9f), 0.f});  // a mirror: a delta lobe
   in.objects.push_back(quad_object({-2, 1, 2}, {4, 0, 0}, {0, 0, -4}, 2));
   in.objects.push_back(quad_object({-2, 1.5f, 2}, {4, 0, 0}, {0, 0, -4}, 3));
+  in.materials.push_back(PlasticParams{Spectrum(0.5f), 1.5f, 0.f});
+  in.materials.push_back(PlasticParams{Spectrum(0.5f), 1.5f, 0.4f});
+  in.materials.push_back(PlasticParams{Spectrum(0.5f), 0.8f, 0.4f});  // ior < 1: adaptive nodes
+  for (uint32_t m = 4; m < 7; ++m)
+    in.objects.push_back(quad_object({-2, 1.5f + 0.1f * float(m), 2}, {4, 0, 0}, {0, 0, -4}, m));
   const auto scene = Scene::build(in);
   const SurfaceStage lambert(*scene, StageModel::kLambert);
   EXPECT_TRUE(lambert.takes(0));
@@ -259,6 +351,17 @@ TEST(SurfaceStage, TakesOnlyPlainSurfacesOfItsModel) {
   EXPECT_FALSE(conductor.takes(0));
   EXPECT_TRUE(conductor.takes(2));
   EXPECT_FALSE(conductor.takes(3));
+  EXPECT_FALSE(conductor.takes(4));
+  const SurfaceStage smooth(*scene, StageModel::kSmoothPlastic);
+  const SurfaceStage rough(*scene, StageModel::kRoughPlastic);
+  EXPECT_FALSE(smooth.takes(0));
+  EXPECT_FALSE(rough.takes(2));
+  EXPECT_TRUE(smooth.takes(4));
+  EXPECT_FALSE(rough.takes(4));
+  EXPECT_FALSE(smooth.takes(5));
+  EXPECT_TRUE(rough.takes(5));
+  EXPECT_FALSE(rough.takes(6));
+  EXPECT_FALSE(smooth.takes(6));
 }
 
 }  // namespace
