@@ -19,6 +19,8 @@ class DielectricBsdf {
   // Index-matched (ior == 1): the interface is invisible, a Dirac transmission of weight 1.
   bool index_matched() const { return index_matched_; }
   bool smooth() const { return smooth_; }
+  float ior() const { return eta_; }
+  float alpha() const { return distr_.alpha(); }  // GGX alpha, clamped as the lobes use it
   // Oriented: +z is the outside, so the back is the inside, not a mirrored front.
   static constexpr bool two_sided() { return false; }
   // Beer-Lambert sigma_a of the interior; the integrator applies it along segments inside.

@@ -65,6 +65,7 @@ struct Sample {
   Mask ok;
   Mask delta = 0;
   Mask exact = -1;
+  float eta = 1.f;  // the relative ior crossed (a refraction's), for Russian roulette
 };
 
 // square_to_disk_concentric (sampling.h; Shirley and Chiu 1997) of (u0, u1).
@@ -84,6 +85,7 @@ struct Sample {
 
 // DiffuseBsdf (materials/diffuse.h): f cos = colour cos_o / pi, cosine-weighted sampling.
 struct Lambert {
+  static constexpr bool kTwoSided = true;
   [[gnu::always_inline]] static EvalPdf eval_pdf(const Params& q, const float* a,
                                                  const float* b) {
     EvalPdf r;
@@ -170,6 +172,7 @@ struct Ggx {
 // ConductorBsdf (materials/conductor.h) when rough: GGX with Smith masking, visible-normal
 // sampling.
 struct RoughConductor {
+  static constexpr bool kTwoSided = true;
   [[gnu::always_inline]] static EvalPdf eval_pdf(const Params& q, const float* a,
                                                  const float* b) {
     float h[3] = {a[0] + b[0], a[1] + b[1], a[2] + b[2]};
@@ -212,8 +215,11 @@ struct RoughConductor {
   }
 };
 
-// fresnel_dielectric(cos_i, eta).reflectance (materials/fresnel.cpp).
-[[gnu::always_inline]] inline float fresnel_reflectance(float cos_i, float eta) {
+// fresnel_dielectric (materials/fresnel.cpp).
+struct Fresnel {
+  float reflectance, cos_t, eta_it, eta_ti;
+};
+[[gnu::always_inline]] inline Fresnel fresnel_dielectric(float cos_i, float eta) {
   const Mask outside = mask(cos_i >= 0.f);
   const float inverse = 1.f / eta;
   const float eta_it = when(outside, eta, inverse), eta_ti = when(outside, inverse, eta);
@@ -225,8 +231,18 @@ struct RoughConductor {
   const float r_p = (ct - eta_it * ci) / (ct + eta_it * ci);
   const float half = 0.5f * (r_s * r_s + r_p * r_p);
   const float f = half < 1.f ? half : 1.f;
-  const Mask reflected = mask(cos_t_sqr <= 0.f) | mask(ci == 0.f);  // total, or grazing
-  return when(mask(eta == 1.f), 0.f, when(reflected, 1.f, f));
+  const Mask matched = mask(eta == 1.f);
+  const Mask total = ~matched & mask(cos_t_sqr <= 0.f);  // total internal reflection
+  const Mask grazing = ~matched & ~total & mask(ci == 0.f);
+  Fresnel r;
+  r.reflectance = when(matched, 0.f, when(total | grazing, 1.f, f));
+  r.cos_t = when(matched, -cos_i, when(total, 0.f, when(outside, -ct, ct)));
+  r.eta_it = when(matched, 1.f, eta_it);
+  r.eta_ti = when(matched, 1.f, eta_ti);
+  return r;
+}
+[[gnu::always_inline]] inline float fresnel_reflectance(float cos_i, float eta) {
+  return fresnel_dielectric(cos_i, eta).reflectance;
 }
 
 // PlasticBsdf (materials/plastic.h): a Lambertian base under a dielectric coating, the coating's
@@ -235,6 +251,7 @@ struct RoughConductor {
 // (smooth: 1 - F; rough: the table) and the rough coating's own lobe.
 template <class Coating>
 struct Plastic {
+  static constexpr bool kTwoSided = true;
   // PlasticBsdf::specular_probability with both lobes enabled; t_i = t(cos_i).
   [[gnu::always_inline]] static float specular_probability(const Params& q, float t_i) {
     const float p_spec = (1.f - t_i) * q.spec_weight;
@@ -384,5 +401,100 @@ struct RoughCoating {
 
 using SmoothPlastic = Plastic<SmoothCoating>;
 using RoughPlastic = Plastic<RoughCoating>;
+
+// DielectricBsdf (materials/dielectric.h) when rough and not index-matched: Walter et al. 2007's
+// GGX reflection and refraction, visible normals sampled from the side wi is on, the lobe chosen
+// by Fresnel. One-sided: the back is the interior (`eta` of the lane is the interior's ior).
+struct RoughDielectric {
+  static constexpr bool kTwoSided = false;
+
+  // DielectricBsdf::half_vector: the generalised half vector m towards +z, the relative ior
+  // eta = eta_o / eta_i, whether wi and wo reflect; the mask says whether they form a valid
+  // configuration.
+  [[gnu::always_inline]] static Mask half_vector(const Params& q, const float* a, const float* b,
+                                                 float* m, float* eta, Mask* reflection) {
+    *reflection = mask(a[2] * b[2] > 0.f);
+    *eta = a[2] > 0.f ? q.eta : 1.f / q.eta;
+    float h[3];
+    for (int c = 0; c < 3; ++c) h[c] = when(*reflection, a[c] + b[c], a[c] + *eta * b[c]);
+    const float len = std::sqrt(dot3(h, h));
+    for (int c = 0; c < 3; ++c) h[c] = h[c] / len;
+    const Mask below = mask(h[2] < 0.f);
+    for (int c = 0; c < 3; ++c) m[c] = when(below, -h[c], h[c]);
+    return mask(len > 0.f) & mask(dot3(a, m) * a[2] > 0.f) & mask(dot3(b, m) * b[2] > 0.f);
+  }
+
+  // DielectricBsdf::evaluate<true, true> with both lobes enabled, cleaned as SurfaceBsdf does.
+  [[gnu::always_inline]] static EvalPdf eval_pdf(const Params& q, const float* a,
+                                                 const float* b) {
+    float m[3], eta;
+    Mask reflection;
+    const Mask valid = half_vector(q, a, b, m, &eta, &reflection) & ~mask(a[2] == 0.f) &
+                       ~mask(b[2] == 0.f);
+    const float d = Ggx::ndf(q.alpha, m);
+    const float g1_i = Ggx::smith_g1(q.alpha, a, m);
+    const float dot_i = dot3(a, m), dot_o = dot3(b, m);
+    const float f = fresnel_reflectance(dot_i, q.eta);
+    const float denom = dot_i + eta * dot_o;
+    const float g = g1_i * Ggx::smith_g1(q.alpha, b, m);
+    // Walter et al. 2007 eq. 20 and 21 times |cos_o| (the refraction's 1/eta^2 radiance
+    // scaling cancels its eta^2).
+    const float reflected = f * d * g / (4.f * std::fabs(a[2]));
+    const float refracted = std::fabs((1.f - f) * d * g * dot_i * dot_o / (a[2] * denom * denom));
+    const float value = when(reflection, reflected, refracted);
+    EvalPdf r;
+    for (int c = 0; c < 3; ++c) r.f[c] = when(valid & finite(value), value, 0.f);
+    // Jacobians dm/dwo: eq. 14 and 17; the visible-normal density of wi's side.
+    const float jacobian = when(reflection, 1.f / (4.f * std::fabs(dot_o)),
+                                eta * eta * std::fabs(dot_o) / (denom * denom));
+    const Mask front = mask(a[2] > 0.f);
+    const float wf[3] = {when(front, a[0], -a[0]), when(front, a[1], -a[1]),
+                         when(front, a[2], -a[2])};
+    const float p_m = when(mask(wf[2] <= 0.f), 0.f, d * g1_i * std::fabs(dot3(wf, m)) / wf[2]);
+    const float p = p_m * jacobian * when(reflection, f, 1.f - f);
+    r.pdf = when(valid & finite(p), p, 0.f);
+    return r;
+  }
+
+  // DielectricBsdf::sample_rough with both lobes enabled.
+  [[gnu::always_inline]] static Sample sample(const Params& q, const float* a, float u_lobe,
+                                              float u0, float u1) {
+    const Mask front = mask(a[2] > 0.f);
+    const float wf[3] = {when(front, a[0], -a[0]), when(front, a[1], -a[1]),
+                         when(front, a[2], -a[2])};
+    float m[3];
+    Ggx::sample_visible(q.alpha, wf, u0, u1, m);
+    const float pdf_m = when(mask(wf[2] <= 0.f), 0.f,
+                             Ggx::ndf(q.alpha, m) * Ggx::smith_g1(q.alpha, wf, m) *
+                                 std::fabs(dot3(wf, m)) / wf[2]);
+    const float dot_i = dot3(a, m);
+    const Fresnel fr = fresnel_dielectric(dot_i, q.eta);
+    const Mask pick_r = mask(u_lobe < fr.reflectance);
+    const float pdf = pdf_m * when(pick_r, fr.reflectance, 1.f - fr.reflectance);
+    Sample r;
+    // Reflection (fresnel.h's reflect) or refraction (refract) about m.
+    const float two_dot = 2.f * dot_i;
+    const float k = dot_i * fr.eta_ti + fr.cos_t;
+    for (int c = 0; c < 3; ++c)
+      r.wo[c] = when(pick_r, two_dot * m[c] - a[c], m[c] * k - a[c] * fr.eta_ti);
+    const float side = r.wo[2] * a[2];
+    const float dot_o = dot3(r.wo, m);
+    const float denom = dot_i + fr.eta_it * dot_o;
+    const float jacobian = when(pick_r, 1.f / (4.f * std::fabs(dot_o)),
+                                fr.eta_it * fr.eta_it * std::fabs(dot_o) / (denom * denom));
+    // With visible-normal sampling f |cos_o| / pdf reduces to G1(wo, m) (Heitz 2014 eq. 19),
+    // times 1/eta^2 for the refracted radiance.
+    const float g1 = Ggx::smith_g1(q.alpha, r.wo, m);
+    const float weight = when(pick_r, 1.f, 1.f * (fr.eta_ti * fr.eta_ti)) * g1;
+    r.pdf = pdf * jacobian;
+    for (int c = 0; c < 3; ++c) r.weight[c] = weight;
+    r.eta = when(pick_r, 1.f, fr.eta_it);
+    r.ok = ~mask(a[2] == 0.f) & mask(pdf_m > 0.f) & mask(pdf > 0.f) &
+           when(pick_r, ~mask(side <= 0.f), ~mask(side >= 0.f)) & mask(weight > 0.f) &
+           mask(r.pdf > 0.f) & finite(r.pdf) & finite(weight) & finite(r.wo[0]) &
+           finite(r.wo[1]) & finite(r.wo[2]);
+    return r;
+  }
+};
 
 }  // namespace penumbra::lane

@@ -5,6 +5,7 @@
 
 #include "renderer/core/simd_clones.h"
 #include "renderer/materials/conductor.h"
+#include "renderer/materials/dielectric.h"
 #include "renderer/materials/diffuse.h"
 #include "renderer/materials/plastic.h"
 #include "renderer/render/lane_bsdfs.h"
@@ -71,7 +72,7 @@ struct Lanes {
   const float *l_wi[3], *l_distance, *l_pdf, *l_p[3], *l_error[3], *l_n[3], *l_value[3], *l_pmf;
   int32_t *staged, *alive, *has_shadow, *nee_ray, *dims, *prev_delta;
   float *s_origin[3], *s_dir[3], *s_t_max, *s_contrib[3];
-  float *origin[3], *wo[3], *beta_out[3], *prev_pdf;
+  float *origin[3], *wo[3], *beta_out[3], *prev_pdf, *eta_out;
 };
 
 // path_scatter of the path integrator on a two-sided `Model` (lane_bsdfs.h) without a normal
@@ -112,7 +113,7 @@ template <class Model, bool kNextEvent>
     const float wi_y = (wx * tx + wy * ty) + wz * tz;
     const float wi_z = (wx * nx + wy * ny) + wz * nz;
     // SurfaceBsdf: a two-sided model seen from the back is its front, mirrored.
-    const Mask flip = mask(wi_z < 0.f);
+    const Mask flip = Model::kTwoSided ? mask(wi_z < 0.f) : 0;
     const float a[3] = {wi_x, wi_y, when(flip, -wi_z, wi_z)};
 
     // Next-event estimation.
@@ -175,7 +176,8 @@ template <class Model, bool kNextEvent>
     const float m_yz = nb_y < nb_z ? nb_z : nb_y;
     const float beta_max = nb_x < m_yz ? m_yz : nb_x;
     const Mask roulette = mask(L.depth[i] >= rr_depth);
-    const float q_raw = beta_max * L.eta[i] * L.eta[i];
+    const float eta = L.eta[i] * bs.eta;
+    const float q_raw = beta_max * eta * eta;
     const float q_rr = 0.95f < q_raw ? 0.95f : q_raw;
     const Mask killed = roulette & mask(L.u_rr[i] >= q_rr);
     L.beta_out[0][i] = when(roulette, nb_x / q_rr, nb_x);
@@ -191,6 +193,7 @@ template <class Model, bool kNextEvent>
     L.wo[2][i] = ww_z;
     L.prev_pdf[i] = bs.pdf;
     L.prev_delta[i] = bs.delta;
+    L.eta_out[i] = eta;
     L.staged[i] = L.staged[i] & e.exact & bs.exact;
   }
 }
@@ -222,6 +225,11 @@ PENUMBRA_SIMD_CLONES
 void rough_plastic_step_kernel(const Lanes& lanes, size_t n, bool next_event, int32_t rr_depth) {
   step_cases<lane::RoughPlastic>(lanes, n, next_event, rr_depth);
 }
+PENUMBRA_SIMD_CLONES
+void rough_dielectric_step_kernel(const Lanes& lanes, size_t n, bool next_event,
+                                  int32_t rr_depth) {
+  step_cases<lane::RoughDielectric>(lanes, n, next_event, rr_depth);
+}
 
 }  // namespace
 
@@ -231,11 +239,22 @@ SurfaceStage::SurfaceStage(const Scene& scene, StageModel model)
   std::vector<const CoatingTables*> tables;  // those in table_cosines_, in order
   for (size_t o = 0; o < scene.object_count(); ++o) {
     const Material& m = scene.material(scene.object(uint32_t(o)).material);
-    if (m.varies() || m.normal_mapped() || m.bsdf().normal_mapped() || !m.bsdf().two_sided())
-      continue;
+    if (m.varies() || m.normal_mapped() || m.bsdf().normal_mapped()) continue;
     SurfaceParams q;
     const BsdfModel& bsdf = m.bsdf().model();
-    if (model == StageModel::kLambert) {
+    if (model == StageModel::kRoughDielectric) {
+      // (The scene's transmission feature is what has path_scatter update eta; a dielectric
+      // implies it.)
+      const auto* dielectric = std::get_if<DielectricBsdf>(&bsdf);
+      if (!dielectric || dielectric->smooth() || dielectric->index_matched() ||
+          !scene.features().transmission)
+        continue;
+      q.colour = Spectrum(1.f);
+      q.alpha = dielectric->alpha();
+      q.eta = dielectric->ior();
+    } else if (!m.bsdf().two_sided()) {
+      continue;
+    } else if (model == StageModel::kLambert) {
       const auto* diffuse = std::get_if<DiffuseBsdf>(&bsdf);
       if (!diffuse) continue;
       q.colour = diffuse->albedo();
@@ -284,7 +303,7 @@ void SurfaceStage::start(size_t paths) {
       a->resize(paths);
   for (auto* a : {&alpha_, &coat_eta_, &spec_weight_, &diffuse_scale_, &time_, &eta_, &u_light_,
                   &u_point_[0], &u_point_[1], &u_lobe_, &u_dir_[0], &u_dir_[1], &u_rr_,
-                  &l_distance_, &l_pdf_, &l_pmf_, &s_t_max_, &prev_pdf_})
+                  &l_distance_, &l_pdf_, &l_pmf_, &s_t_max_, &prev_pdf_, &eta_out_})
     a->resize(paths);
   for (auto* a : {&table_, &nodes_, &depth_, &light_, &light_ok_, &staged_, &alive_,
                   &has_shadow_, &nee_ray_, &dims_, &prev_delta_})
@@ -422,6 +441,7 @@ void SurfaceStage::compute(const IntegratorSettings& settings, bool next_event) 
   L.dims = dims_.data();
   L.s_t_max = s_t_max_.data();
   L.prev_pdf = prev_pdf_.data();
+  L.eta_out = eta_out_.data();
   const int32_t rr_depth = int32_t(settings.rr_depth);
   switch (model_) {
     case StageModel::kLambert:
@@ -435,6 +455,9 @@ void SurfaceStage::compute(const IntegratorSettings& settings, bool next_event) 
       break;
     case StageModel::kRoughPlastic:
       rough_plastic_step_kernel(L, n, next_event, rr_depth);
+      break;
+    case StageModel::kRoughDielectric:
+      rough_dielectric_step_kernel(L, n, next_event, rr_depth);
       break;
   }
 }
@@ -454,6 +477,7 @@ void SurfaceStage::apply(size_t i, PathState& s, Sampler::Cursor& cursor) const 
   s.prev_p = vec3(p_[0][i], p_[1][i], p_[2][i]);
   s.ray = Ray{vec3(origin_[0][i], origin_[1][i], origin_[2][i]),
               vec3(wo_[0][i], wo_[1][i], wo_[2][i]), time_[i]};
+  s.eta = eta_out_[i];
   ++s.depth;
   cursor.dimension += uint64_t(dims_[i]);
 }

@@ -1,6 +1,7 @@
 #pragma once
 // The wavefront driver's surface stages: the step of every path that hit a plain surface of one
-// BSDF model (constant parameters, no normal map: Lambertian, or a rough conductor), after its
+// BSDF model (constant parameters, no normal map: Lambertian, rough conductors, plastics and
+// rough dielectrics), after its
 // emission, as loops over arrays: the light choice and light sample (light_kernels.h), the
 // BSDF's value, pdf and MIS weight towards the light, the shadow ray and its contribution, then
 // the BSDF's sample (lane_bsdfs.h), the throughput, the spawned ray and Russian roulette. One
@@ -30,10 +31,11 @@ enum class StageModel : uint8_t {
   kRoughConductor,  // ConductorBsdf with a microfacet lobe (not a smooth mirror)
   kSmoothPlastic,   // PlasticBsdf with a smooth coating
   kRoughPlastic,    // PlasticBsdf with a rough coating tabulated on square nodes (ior >= 1)
+  kRoughDielectric, // DielectricBsdf with microfacet lobes (not smooth, not index-matched)
 };
-inline constexpr StageModel kStageModels[] = {StageModel::kLambert, StageModel::kRoughConductor,
-                                              StageModel::kSmoothPlastic,
-                                              StageModel::kRoughPlastic};
+inline constexpr StageModel kStageModels[] = {
+    StageModel::kLambert, StageModel::kRoughConductor, StageModel::kSmoothPlastic,
+    StageModel::kRoughPlastic, StageModel::kRoughDielectric};
 
 class SurfaceStage {
  public:
@@ -42,7 +44,7 @@ class SurfaceStage {
   StageModel model() const { return model_; }
 
   // Whether the stage can take hits on `object`: its material is a plain one of the stage's
-  // model (constant finite parameters, no normal map, two-sided).
+  // model (constant finite parameters, no normal map).
   bool takes(uint32_t object) const { return params_of_[object] >= 0; }
 
   // Empty, with room for `paths` lanes.
@@ -99,7 +101,7 @@ class SurfaceStage {
   // Results per lane.
   std::vector<int32_t> staged_, alive_, has_shadow_, nee_ray_, dims_, prev_delta_;
   std::vector<float> s_origin_[3], s_dir_[3], s_t_max_, s_contrib_[3];
-  std::vector<float> origin_[3], wo_[3], beta_out_[3], prev_pdf_;
+  std::vector<float> origin_[3], wo_[3], beta_out_[3], prev_pdf_, eta_out_;
 };
 
 }  // namespace penumbra

@@ -1,7 +1,7 @@
 // The wavefront driver's surface stages (renderer/render/surface_stage.h) against path_scatter,
 // the scalar step they repeat in SIMD lanes: for real hits on a floor and ball of each stage's
-// model, Lambertian, rough conductors and rough plastics of several roughnesses and smooth
-// plastics of several iors (front and back side, at every depth around the roulette depth, with the sampler's corner values), every
+// model, Lambertian, rough conductors, rough plastics and rough dielectrics of several
+// roughnesses and iors, and smooth plastics of several iors (front and back side, at every depth around the roulette depth, with the sampler's corner values), every
 // result must be path_scatter's to the bit: whether the path goes on, its new state and how
 // many sampler values it took, its shadow ray and contribution, and the ray count. Lanes whose
 // chosen light has no kernel (the point light here) must say so.
@@ -65,6 +65,8 @@ MaterialParams stage_material(StageModel model, float roughness, float ior) {
       return PlasticParams{Spectrum(0.2f, 0.4f, 0.8f), ior, 0.f};
     case StageModel::kRoughPlastic:
       return PlasticParams{Spectrum(0.7f, 0.15f, 0.1f), ior, roughness};
+    case StageModel::kRoughDielectric:
+      return DielectricParams{ior, roughness, Spectrum(0.2f, 0.f, 0.5f)};
   }
   return DiffuseParams{};
 }
@@ -330,6 +332,28 @@ TEST(SurfaceStage, RoughCoatingTableLookupIsExactEverywhere) {
   }
 }
 
+TEST(SurfaceStage, RoughDielectricStepIsPathScatterToTheBit) {
+  for (const float roughness : {0.011f, 0.2f, 0.6f, 1.f}) {
+    for (const float ior : {0.7f, 1.33f, 1.5f, 2.4f}) {
+      SCOPED_TRACE("roughness " + std::to_string(roughness) + " ior " + std::to_string(ior));
+      const Coverage c = expect_stage_matches_scatter(true, 37, StageModel::kRoughDielectric,
+                                                      roughness, ior);
+      EXPECT_GT(c.staged, 1000);
+      EXPECT_GT(c.alive, 300);
+      EXPECT_GT(c.dead, 50);
+      EXPECT_GT(c.back, 200);
+      EXPECT_GT(c.ball, 500);
+      if (roughness > 0.05f) {
+        EXPECT_GT(c.shadows, 100);
+      }
+      EXPECT_EQ(c.delta, 0);
+    }
+  }
+  const Coverage c = expect_stage_matches_scatter(false, 41, StageModel::kRoughDielectric, 0.4f);
+  EXPECT_EQ(c.fallback, 0);
+  EXPECT_GT(c.alive, 300);
+}
+
 TEST(SurfaceStage, TakesOnlyPlainSurfacesOfItsModel) {
   SceneInput in = floor_scene(false, DiffuseParams{Spectrum(0.5f)});
   in.materials.push_back(ConductorParams{Spectrum(0.9f), 0.3f});
@@ -362,6 +386,21 @@ TEST(SurfaceStage, TakesOnlyPlainSurfacesOfItsModel) {
   EXPECT_TRUE(rough.takes(5));
   EXPECT_FALSE(rough.takes(6));
   EXPECT_FALSE(smooth.takes(6));
+}
+
+TEST(SurfaceStage, TakesOnlyRoughDielectricsThatRefract) {
+  SceneInput in = floor_scene(false, DielectricParams{1.5f, 0.3f});
+  in.materials.push_back(DielectricParams{1.5f, 0.f});     // smooth: Dirac lobes
+  in.materials.push_back(DielectricParams{1.00001f, 0.3f});  // index-matched: invisible
+  in.objects.push_back(quad_object({-2, 1, 2}, {4, 0, 0}, {0, 0, -4}, 2));
+  in.objects.push_back(quad_object({-2, 1.5f, 2}, {4, 0, 0}, {0, 0, -4}, 3));
+  const auto scene = Scene::build(in);
+  const SurfaceStage stage(*scene, StageModel::kRoughDielectric);
+  EXPECT_TRUE(stage.takes(0));
+  EXPECT_TRUE(stage.takes(1));
+  EXPECT_FALSE(stage.takes(2));
+  EXPECT_FALSE(stage.takes(3));
+  EXPECT_FALSE(SurfaceStage(*scene, StageModel::kLambert).takes(0));
 }
 
 }  // namespace
