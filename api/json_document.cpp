@@ -34,8 +34,8 @@ class PathTracker {
                       "duplicate key: an object must not name the same member twice");
         break;
       }
-      case Json::parse_event_t::value:
-        enter_value();
+      case Json::parse_event_t::value:  // a scalar (containers end with *_end, not value)
+        enter_scalar();
         break;
       case Json::parse_event_t::object_end:
       case Json::parse_event_t::array_end:
@@ -54,13 +54,18 @@ class PathTracker {
     std::set<std::string> keys;
   };
 
-  // A value begins inside the current container: remember its token if it is a container.
+  // A scalar is a leaf, never part of a reported path: it only advances its array's index (no
+  // token string per number: a mesh's inline arrays hold millions of them).
+  void enter_scalar() {
+    if (!frames_.empty() && frames_.back().is_array) ++frames_.back().next_index;
+  }
+
+  // A container begins inside the current container: remember its token.
   void enter_value() {
     if (frames_.empty()) return;
     Frame& parent = frames_.back();
     pending_token_ = parent.is_array ? std::to_string(parent.next_index++)
                                      : escape_pointer_token(parent.last_key);
-    // Only containers become part of the path; scalar values are leaves.
     tokens_.resize(frames_.size() - 1);
     tokens_.push_back(pending_token_);
   }

@@ -98,6 +98,14 @@ TEST(JsonSyntax, DuplicateKeysAreErrorsWithPointer) {
   EXPECT_EQ(r.errors.size(), 3u) << describe(r.errors);
 }
 
+TEST(JsonSyntax, DuplicateKeyPointersCountTheScalarsBeforeThem) {
+  // Scalars in an array take no token of their own but advance its index.
+  const LoadResult r = load_scene(
+      R"({"version": 1, "x": [1, 2, [3, {"a": 1, "a": 2}]], "y": {"b": [0, {"c": 1, "c": 2}]}})");
+  EXPECT_ERROR(r, "/x/2/1/a", "duplicate key");
+  EXPECT_ERROR(r, "/y/b/1/c", "duplicate key");
+}
+
 TEST(JsonSyntax, GarbageBytesNeverCrash) {
   std::string text = base_scene().dump();
   // Every truncation of a valid scene is handled.
