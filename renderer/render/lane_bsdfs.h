@@ -8,8 +8,10 @@
 // is its comparison), its branches selects between values every lane computes, so the stage's
 // results are path_scatter's to the bit.
 //
-// A new model (a dielectric, say) adds a struct of the same shape here, a kind in StageModel
-// and the scene's surfaces it takes in SurfaceStage's constructor.
+// Each model says whether it is two-sided (kTwoSided) and whether all its lobes are Dirac
+// deltas (kDeltaOnly: path_scatter then estimates no direct light there, and the model answers
+// no eval_pdf). A new model adds a struct of the same shape here, a kind in StageModel and the
+// scene's surfaces it takes in SurfaceStage's constructor.
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -86,6 +88,7 @@ struct Sample {
 // DiffuseBsdf (materials/diffuse.h): f cos = colour cos_o / pi, cosine-weighted sampling.
 struct Lambert {
   static constexpr bool kTwoSided = true;
+  static constexpr bool kDeltaOnly = false;
   [[gnu::always_inline]] static EvalPdf eval_pdf(const Params& q, const float* a,
                                                  const float* b) {
     EvalPdf r;
@@ -173,6 +176,7 @@ struct Ggx {
 // sampling.
 struct RoughConductor {
   static constexpr bool kTwoSided = true;
+  static constexpr bool kDeltaOnly = false;
   [[gnu::always_inline]] static EvalPdf eval_pdf(const Params& q, const float* a,
                                                  const float* b) {
     float h[3] = {a[0] + b[0], a[1] + b[1], a[2] + b[2]};
@@ -252,6 +256,7 @@ struct Fresnel {
 template <class Coating>
 struct Plastic {
   static constexpr bool kTwoSided = true;
+  static constexpr bool kDeltaOnly = false;
   // PlasticBsdf::specular_probability with both lobes enabled; t_i = t(cos_i).
   [[gnu::always_inline]] static float specular_probability(const Params& q, float t_i) {
     const float p_spec = (1.f - t_i) * q.spec_weight;
@@ -407,6 +412,7 @@ using RoughPlastic = Plastic<RoughCoating>;
 // by Fresnel. One-sided: the back is the interior (`eta` of the lane is the interior's ior).
 struct RoughDielectric {
   static constexpr bool kTwoSided = false;
+  static constexpr bool kDeltaOnly = false;
 
   // DielectricBsdf::half_vector: the generalised half vector m towards +z, the relative ior
   // eta = eta_o / eta_i, whether wi and wo reflect; the mask says whether they form a valid
@@ -493,6 +499,55 @@ struct RoughDielectric {
            when(pick_r, ~mask(side <= 0.f), ~mask(side >= 0.f)) & mask(weight > 0.f) &
            mask(r.pdf > 0.f) & finite(r.pdf) & finite(weight) & finite(r.wo[0]) &
            finite(r.wo[1]) & finite(r.wo[2]);
+    return r;
+  }
+};
+
+// ConductorBsdf when smooth: a mirror of the colour's reflectance.
+struct SmoothConductor {
+  static constexpr bool kTwoSided = true;
+  static constexpr bool kDeltaOnly = true;
+  [[gnu::always_inline]] static EvalPdf eval_pdf(const Params&, const float*, const float*) {
+    return EvalPdf{{0.f, 0.f, 0.f}, 0.f};
+  }
+  [[gnu::always_inline]] static Sample sample(const Params& q, const float* a, float, float,
+                                              float) {
+    Sample r;
+    r.wo[0] = -a[0];  // reflect_local
+    r.wo[1] = -a[1];
+    r.wo[2] = a[2];
+    for (int c = 0; c < 3; ++c) r.weight[c] = q.c[c];
+    r.pdf = 0.f;
+    r.delta = -1;
+    r.ok = ~mask(a[2] <= 0.f) & finite(r.wo[0]) & finite(r.wo[1]) & finite(r.wo[2]);
+    return r;
+  }
+};
+
+// DielectricBsdf when smooth and not index-matched: Dirac reflection or refraction, chosen by
+// Fresnel (weight 1, times 1/eta^2 for the refracted radiance).
+struct SmoothDielectric {
+  static constexpr bool kTwoSided = false;
+  static constexpr bool kDeltaOnly = true;
+  [[gnu::always_inline]] static EvalPdf eval_pdf(const Params&, const float*, const float*) {
+    return EvalPdf{{0.f, 0.f, 0.f}, 0.f};
+  }
+  [[gnu::always_inline]] static Sample sample(const Params& q, const float* a, float u_lobe,
+                                              float, float) {
+    const Fresnel fr = fresnel_dielectric(a[2], q.eta);
+    const Mask pick_r = mask(u_lobe < fr.reflectance);
+    Sample r;
+    // reflect_local or refract_local.
+    r.wo[0] = when(pick_r, -a[0], -fr.eta_ti * a[0]);
+    r.wo[1] = when(pick_r, -a[1], -fr.eta_ti * a[1]);
+    r.wo[2] = when(pick_r, a[2], fr.cos_t);
+    const float weight = when(pick_r, 1.f, 1.f * (fr.eta_ti * fr.eta_ti));
+    for (int c = 0; c < 3; ++c) r.weight[c] = weight;
+    r.pdf = 0.f;
+    r.delta = -1;
+    r.eta = when(pick_r, 1.f, fr.eta_it);
+    r.ok = ~mask(a[2] == 0.f) & finite(weight) & finite(r.wo[0]) & finite(r.wo[1]) &
+           finite(r.wo[2]);
     return r;
   }
 };

@@ -203,7 +203,7 @@ template <class Model, bool kNextEvent>
 template <class Model>
 [[gnu::always_inline]] inline void step_cases(const Lanes& lanes, size_t n, bool next_event,
                                               int32_t rr_depth) {
-  if (next_event)
+  if (next_event && !Model::kDeltaOnly)
     surface_step<Model, true>(lanes, n, rr_depth);
   else
     surface_step<Model, false>(lanes, n, rr_depth);
@@ -226,6 +226,16 @@ void rough_plastic_step_kernel(const Lanes& lanes, size_t n, bool next_event, in
   step_cases<lane::RoughPlastic>(lanes, n, next_event, rr_depth);
 }
 PENUMBRA_SIMD_CLONES
+void smooth_conductor_step_kernel(const Lanes& lanes, size_t n, bool next_event,
+                                  int32_t rr_depth) {
+  step_cases<lane::SmoothConductor>(lanes, n, next_event, rr_depth);
+}
+PENUMBRA_SIMD_CLONES
+void smooth_dielectric_step_kernel(const Lanes& lanes, size_t n, bool next_event,
+                                   int32_t rr_depth) {
+  step_cases<lane::SmoothDielectric>(lanes, n, next_event, rr_depth);
+}
+PENUMBRA_SIMD_CLONES
 void rough_dielectric_step_kernel(const Lanes& lanes, size_t n, bool next_event,
                                   int32_t rr_depth) {
   step_cases<lane::RoughDielectric>(lanes, n, next_event, rr_depth);
@@ -242,12 +252,12 @@ SurfaceStage::SurfaceStage(const Scene& scene, StageModel model)
     if (m.varies() || m.normal_mapped() || m.bsdf().normal_mapped()) continue;
     SurfaceParams q;
     const BsdfModel& bsdf = m.bsdf().model();
-    if (model == StageModel::kRoughDielectric) {
+    if (model == StageModel::kRoughDielectric || model == StageModel::kSmoothDielectric) {
       // (The scene's transmission feature is what has path_scatter update eta; a dielectric
       // implies it.)
       const auto* dielectric = std::get_if<DielectricBsdf>(&bsdf);
-      if (!dielectric || dielectric->smooth() || dielectric->index_matched() ||
-          !scene.features().transmission)
+      if (!dielectric || dielectric->smooth() != (model == StageModel::kSmoothDielectric) ||
+          dielectric->index_matched() || !scene.features().transmission)
         continue;
       q.colour = Spectrum(1.f);
       q.alpha = dielectric->alpha();
@@ -258,9 +268,9 @@ SurfaceStage::SurfaceStage(const Scene& scene, StageModel model)
       const auto* diffuse = std::get_if<DiffuseBsdf>(&bsdf);
       if (!diffuse) continue;
       q.colour = diffuse->albedo();
-    } else if (model == StageModel::kRoughConductor) {
+    } else if (model == StageModel::kRoughConductor || model == StageModel::kSmoothConductor) {
       const auto* conductor = std::get_if<ConductorBsdf>(&bsdf);
-      if (!conductor || conductor->smooth()) continue;
+      if (!conductor || conductor->smooth() != (model == StageModel::kSmoothConductor)) continue;
       q.colour = conductor->albedo();
       q.alpha = conductor->alpha();
     } else {
@@ -338,7 +348,7 @@ void SurfaceStage::add(uint32_t slot, const PathState& s, const SurfaceHit& hit,
   depth_[i] = s.depth;
   // The step's values in the order path_scatter takes them: light choice and point (with next-
   // event estimation), lobe, direction, roulette.
-  const int d = next_event ? 2 : 0;
+  const int d = estimates_light(next_event) ? 2 : 0;
   u_light_[i] = x[0];
   u_point_[0][i] = x[1];
   u_point_[1][i] = y[1];
@@ -348,7 +358,8 @@ void SurfaceStage::add(uint32_t slot, const PathState& s, const SurfaceHit& hit,
   u_rr_[i] = x[d + 2];
 }
 
-void SurfaceStage::compute(const IntegratorSettings& settings, bool next_event) {
+void SurfaceStage::compute(const IntegratorSettings& settings, bool scene_next_event) {
+  const bool next_event = estimates_light(scene_next_event);
   const size_t n = count_;
   if (n == 0) return;
   for (size_t i = 0; i < n; ++i) staged_[i] = 1;
@@ -458,6 +469,12 @@ void SurfaceStage::compute(const IntegratorSettings& settings, bool next_event) 
       break;
     case StageModel::kRoughDielectric:
       rough_dielectric_step_kernel(L, n, next_event, rr_depth);
+      break;
+    case StageModel::kSmoothConductor:
+      smooth_conductor_step_kernel(L, n, next_event, rr_depth);
+      break;
+    case StageModel::kSmoothDielectric:
+      smooth_dielectric_step_kernel(L, n, next_event, rr_depth);
       break;
   }
 }

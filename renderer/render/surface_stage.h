@@ -1,7 +1,7 @@
 #pragma once
 // The wavefront driver's surface stages: the step of every path that hit a plain surface of one
-// BSDF model (constant parameters, no normal map: Lambertian, rough conductors, plastics and
-// rough dielectrics), after its
+// BSDF model (constant parameters, no normal map: Lambertian, conductors, plastics and
+// dielectrics), after its
 // emission, as loops over arrays: the light choice and light sample (light_kernels.h), the
 // BSDF's value, pdf and MIS weight towards the light, the shadow ray and its contribution, then
 // the BSDF's sample (lane_bsdfs.h), the throughput, the spawned ray and Russian roulette. One
@@ -32,10 +32,13 @@ enum class StageModel : uint8_t {
   kSmoothPlastic,   // PlasticBsdf with a smooth coating
   kRoughPlastic,    // PlasticBsdf with a rough coating tabulated on square nodes (ior >= 1)
   kRoughDielectric, // DielectricBsdf with microfacet lobes (not smooth, not index-matched)
+  kSmoothConductor, // ConductorBsdf's mirror
+  kSmoothDielectric,  // DielectricBsdf's Dirac reflection and refraction (not index-matched)
 };
 inline constexpr StageModel kStageModels[] = {
-    StageModel::kLambert, StageModel::kRoughConductor, StageModel::kSmoothPlastic,
-    StageModel::kRoughPlastic, StageModel::kRoughDielectric};
+    StageModel::kLambert,         StageModel::kRoughConductor,  StageModel::kSmoothPlastic,
+    StageModel::kRoughPlastic,    StageModel::kRoughDielectric, StageModel::kSmoothConductor,
+    StageModel::kSmoothDielectric};
 
 class SurfaceStage {
  public:
@@ -57,6 +60,8 @@ class SurfaceStage {
            const float* y, bool next_event);
   // Takes every queued path's step (`next_event` as for add).
   void compute(const IntegratorSettings& settings, bool next_event);
+  // (With next_event, the step estimates direct light unless the model's lobes are all Dirac
+  // deltas, as path_scatter decides; that also decides which sampler values are whose.)
 
   size_t size() const { return count_; }
   uint32_t slot(size_t lane) const { return slot_[lane]; }
@@ -74,6 +79,13 @@ class SurfaceStage {
   void apply(size_t lane, PathState& s, Sampler::Cursor& cursor) const;
 
  private:
+  // Whether path_scatter estimates direct light at this model's surfaces (given lights): not
+  // where every lobe is a Dirac delta.
+  bool estimates_light(bool next_event) const {
+    return next_event && model_ != StageModel::kSmoothConductor &&
+           model_ != StageModel::kSmoothDielectric;
+  }
+
   const Scene& scene_;
   StageModel model_;
   StagedLights lights_;

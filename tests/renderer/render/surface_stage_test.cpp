@@ -1,7 +1,8 @@
 // The wavefront driver's surface stages (renderer/render/surface_stage.h) against path_scatter,
 // the scalar step they repeat in SIMD lanes: for real hits on a floor and ball of each stage's
 // model, Lambertian, rough conductors, rough plastics and rough dielectrics of several
-// roughnesses and iors, and smooth plastics of several iors (front and back side, at every depth around the roulette depth, with the sampler's corner values), every
+// roughnesses and iors, smooth plastics and dielectrics of several iors and a mirror (front and
+// back side, at every depth around the roulette depth, with the sampler's corner values), every
 // result must be path_scatter's to the bit: whether the path goes on, its new state and how
 // many sampler values it took, its shadow ray and contribution, and the ray count. Lanes whose
 // chosen light has no kernel (the point light here) must say so.
@@ -67,6 +68,10 @@ MaterialParams stage_material(StageModel model, float roughness, float ior) {
       return PlasticParams{Spectrum(0.7f, 0.15f, 0.1f), ior, roughness};
     case StageModel::kRoughDielectric:
       return DielectricParams{ior, roughness, Spectrum(0.2f, 0.f, 0.5f)};
+    case StageModel::kSmoothConductor:
+      return ConductorParams{Spectrum(0.9f, 0.6f, 0.3f), 0.f};
+    case StageModel::kSmoothDielectric:
+      return DielectricParams{ior, 0.f, Spectrum(0.2f, 0.f, 0.5f)};
   }
   return DiffuseParams{};
 }
@@ -354,6 +359,32 @@ TEST(SurfaceStage, RoughDielectricStepIsPathScatterToTheBit) {
   EXPECT_GT(c.alive, 300);
 }
 
+TEST(SurfaceStage, MirrorAndSmoothDielectricStepsArePathScatterToTheBit) {
+  // Dirac lobes only: no direct light is estimated there even with lights in the scene, and
+  // the step takes the sampler's values from the first.
+  for (const bool lights : {true, false}) {
+    const Coverage c = expect_stage_matches_scatter(lights, 43, StageModel::kSmoothConductor);
+    EXPECT_GT(c.staged, 1000);
+    EXPECT_EQ(c.fallback, 0);
+    EXPECT_EQ(c.shadows, 0);
+    EXPECT_GT(c.alive, 300);
+    EXPECT_GT(c.dead, 50);
+    EXPECT_EQ(c.delta, c.alive);
+    EXPECT_GT(c.back, 200);
+    for (const float ior : {0.7f, 1.33f, 1.5f, 2.4f}) {
+      SCOPED_TRACE("ior " + std::to_string(ior) + (lights ? " with lights" : ""));
+      const Coverage d =
+          expect_stage_matches_scatter(lights, 47, StageModel::kSmoothDielectric, 0.f, ior);
+      EXPECT_GT(d.staged, 1000);
+      EXPECT_EQ(d.fallback, 0);
+      EXPECT_EQ(d.shadows, 0);
+      EXPECT_GT(d.alive, 300);
+      EXPECT_EQ(d.delta, d.alive);
+      EXPECT_GT(d.back, 200);
+    }
+  }
+}
+
 TEST(SurfaceStage, TakesOnlyPlainSurfacesOfItsModel) {
   SceneInput in = floor_scene(false, DiffuseParams{Spectrum(0.5f)});
   in.materials.push_back(ConductorParams{Spectrum(0.9f), 0.3f});
@@ -376,6 +407,9 @@ TEST(SurfaceStage, TakesOnlyPlainSurfacesOfItsModel) {
   EXPECT_TRUE(conductor.takes(2));
   EXPECT_FALSE(conductor.takes(3));
   EXPECT_FALSE(conductor.takes(4));
+  const SurfaceStage mirror(*scene, StageModel::kSmoothConductor);
+  EXPECT_FALSE(mirror.takes(2));
+  EXPECT_TRUE(mirror.takes(3));
   const SurfaceStage smooth(*scene, StageModel::kSmoothPlastic);
   const SurfaceStage rough(*scene, StageModel::kRoughPlastic);
   EXPECT_FALSE(smooth.takes(0));
@@ -388,7 +422,7 @@ TEST(SurfaceStage, TakesOnlyPlainSurfacesOfItsModel) {
   EXPECT_FALSE(smooth.takes(6));
 }
 
-TEST(SurfaceStage, TakesOnlyRoughDielectricsThatRefract) {
+TEST(SurfaceStage, TakesDielectricsThatRefractByTheirRoughness) {
   SceneInput in = floor_scene(false, DielectricParams{1.5f, 0.3f});
   in.materials.push_back(DielectricParams{1.5f, 0.f});     // smooth: Dirac lobes
   in.materials.push_back(DielectricParams{1.00001f, 0.3f});  // index-matched: invisible
@@ -400,6 +434,10 @@ TEST(SurfaceStage, TakesOnlyRoughDielectricsThatRefract) {
   EXPECT_TRUE(stage.takes(1));
   EXPECT_FALSE(stage.takes(2));
   EXPECT_FALSE(stage.takes(3));
+  const SurfaceStage smooth(*scene, StageModel::kSmoothDielectric);
+  EXPECT_FALSE(smooth.takes(0));
+  EXPECT_TRUE(smooth.takes(2));
+  EXPECT_FALSE(smooth.takes(3));
   EXPECT_FALSE(SurfaceStage(*scene, StageModel::kLambert).takes(0));
 }
 
