@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <iterator>
 
 #include "renderer/core/simd_clones.h"
 #include "renderer/materials/conductor.h"
@@ -453,30 +454,14 @@ void SurfaceStage::compute(const IntegratorSettings& settings, bool scene_next_e
   L.s_t_max = s_t_max_.data();
   L.prev_pdf = prev_pdf_.data();
   L.eta_out = eta_out_.data();
-  const int32_t rr_depth = int32_t(settings.rr_depth);
-  switch (model_) {
-    case StageModel::kLambert:
-      lambert_step_kernel(L, n, next_event, rr_depth);
-      break;
-    case StageModel::kRoughConductor:
-      rough_conductor_step_kernel(L, n, next_event, rr_depth);
-      break;
-    case StageModel::kSmoothPlastic:
-      smooth_plastic_step_kernel(L, n, next_event, rr_depth);
-      break;
-    case StageModel::kRoughPlastic:
-      rough_plastic_step_kernel(L, n, next_event, rr_depth);
-      break;
-    case StageModel::kRoughDielectric:
-      rough_dielectric_step_kernel(L, n, next_event, rr_depth);
-      break;
-    case StageModel::kSmoothConductor:
-      smooth_conductor_step_kernel(L, n, next_event, rr_depth);
-      break;
-    case StageModel::kSmoothDielectric:
-      smooth_dielectric_step_kernel(L, n, next_event, rr_depth);
-      break;
-  }
+  // The kernels in StageModel's order.
+  using Kernel = void (*)(const Lanes&, size_t, bool, int32_t);
+  static constexpr Kernel kKernels[] = {
+      lambert_step_kernel,          rough_conductor_step_kernel,  smooth_plastic_step_kernel,
+      rough_plastic_step_kernel,    rough_dielectric_step_kernel, smooth_conductor_step_kernel,
+      smooth_dielectric_step_kernel};
+  static_assert(std::size(kKernels) == std::size(kStageModels));
+  kKernels[size_t(model_)](L, n, next_event, int32_t(settings.rr_depth));
 }
 
 ShadowQuery SurfaceStage::shadow(size_t i) const {
