@@ -15,6 +15,8 @@ class DirectionalLight final : public Light {
   float power(float scene_radius) const override {
     return luminance(irradiance_) * kPi * (scene_radius * scene_radius);
   }
+  const vec3& direction() const { return direction_; }  // normalised
+  const Spectrum& irradiance() const { return irradiance_; }
 
  private:
   vec3 direction_;

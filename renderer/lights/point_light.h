@@ -11,6 +11,8 @@ class PointLight final : public Light {
 
   bool sample(const vec3& ref, float time, const vec2& u, LightSample* out) const override;
   float power(float) const override { return 4.f * kPi * luminance(intensity_); }
+  const vec3& position() const { return position_; }
+  const Spectrum& intensity() const { return intensity_; }
 
  private:
   vec3 position_;

@@ -5,8 +5,10 @@
 
 #include "renderer/core/simd_clones.h"
 #include "renderer/lights/area_light.h"
+#include "renderer/lights/directional_light.h"
 #include "renderer/lights/environment_light.h"
 #include "renderer/lights/light_sampler.h"
+#include "renderer/lights/point_light.h"
 #include "renderer/sampling/sampling.h"
 #include "renderer/shapes/quad.h"
 
@@ -68,6 +70,40 @@ void quad_light_samples(const float* __restrict q_origin, const float* __restric
   }
 }
 
+// PointLight::sample for the entries whose light is `id`, over arrays (glm's dot and the
+// component-wise divisions as the scalar code does them).
+PENUMBRA_SIMD_CLONES
+void point_light_samples(const float* __restrict position, const float* __restrict intensity,
+                         int32_t id, size_t n, const int32_t* __restrict light,
+                         const float* __restrict ref_x, const float* __restrict ref_y,
+                         const float* __restrict ref_z, int32_t* __restrict ok,
+                         float* __restrict wi_x, float* __restrict wi_y, float* __restrict wi_z,
+                         float* __restrict distance, float* __restrict pdf,
+                         float* __restrict p_x, float* __restrict p_y, float* __restrict p_z,
+                         float* __restrict value_x, float* __restrict value_y,
+                         float* __restrict value_z) {
+  const float sx = position[0], sy = position[1], sz = position[2];
+  const float ix = intensity[0], iy = intensity[1], iz = intensity[2];
+  for (size_t i = 0; i < n; ++i) {
+    const float dx = sx - ref_x[i], dy = sy - ref_y[i], dz = sz - ref_z[i];
+    const float dist2 = (dx * dx + dy * dy) + dz * dz;
+    const float dist = std::sqrt(dist2);
+    const Mask mine = mask(light[i] == id);
+    ok[i] = when(mine, int32_t(dist2 > 0.f), ok[i]);
+    wi_x[i] = when(mine, dx / dist, wi_x[i]);
+    wi_y[i] = when(mine, dy / dist, wi_y[i]);
+    wi_z[i] = when(mine, dz / dist, wi_z[i]);
+    distance[i] = when(mine, dist, distance[i]);
+    pdf[i] = when(mine, 1.f, pdf[i]);
+    p_x[i] = when(mine, sx, p_x[i]);
+    p_y[i] = when(mine, sy, p_y[i]);
+    p_z[i] = when(mine, sz, p_z[i]);
+    value_x[i] = when(mine, ix / dist2, value_x[i]);
+    value_y[i] = when(mine, iy / dist2, value_y[i]);
+    value_z[i] = when(mine, iz / dist2, value_z[i]);
+  }
+}
+
 // ConstantEnvironment::sample for the entries whose light is `id`: square_to_uniform_sphere,
 // with sincos_two_pi's quarter turn as selects and negations instead of its switch (exact:
 // negation does not round), so the values are the scalar ones.
@@ -112,13 +148,38 @@ void choose_lights(const float* __restrict cdf, int32_t lights, size_t n,
 
 StagedLights::StagedLights(const Scene& scene) {
   const size_t lights = size_t(scene.light_count());
-  source.assign(lights, kNotStaged);
+  kind.assign(lights, kNotStaged);
+  index.assign(lights, -1);
   for (size_t l = 0; l < lights; ++l) {
     const Light& light = scene.light(int(l));
     if (const auto* env = dynamic_cast<const ConstantEnvironment*>(&light)) {
-      source[l] = kEnvironment;
+      kind[l] = kEnvironment;
       environment = env->radiance(vec3(0.f, 0.f, 1.f));
       environment_id = int32_t(l);
+      continue;
+    }
+    if (const auto* point = dynamic_cast<const PointLight*>(&light)) {
+      PointSource p;
+      p.light = int32_t(l);
+      for (int c = 0; c < 3; ++c) {
+        p.position[c] = point->position()[c];
+        p.intensity[c] = point->intensity()[c];
+      }
+      kind[l] = kPoint;
+      index[l] = int32_t(points.size());
+      points.push_back(p);
+      continue;
+    }
+    if (const auto* sun = dynamic_cast<const DirectionalLight*>(&light)) {
+      DistantSource d;
+      const vec3 wi = -sun->direction();  // DirectionalLight::sample's wi
+      for (int c = 0; c < 3; ++c) {
+        d.wi[c] = wi[c];
+        d.irradiance[c] = sun->irradiance()[c];
+      }
+      kind[l] = kDirectional;
+      index[l] = int32_t(distant.size());
+      distant.push_back(d);
       continue;
     }
     const auto* area = dynamic_cast<const AreaLight*>(&light);
@@ -138,7 +199,8 @@ StagedLights::StagedLights(const Scene& scene) {
       q.radiance[c] = r[c];
     }
     q.area = quad->area();
-    source[l] = int32_t(quads.size());
+    kind[l] = kQuad;
+    index[l] = int32_t(quads.size());
     quads.push_back(q);
   }
 }

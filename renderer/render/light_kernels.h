@@ -31,14 +31,26 @@ template <class T>
 struct StagedLights {
   explicit StagedLights(const Scene& scene);
 
-  static constexpr int32_t kNotStaged = -1, kEnvironment = -2;
+  enum Kind : int32_t { kNotStaged, kQuad, kEnvironment, kPoint, kDirectional };
   // A static, untextured quad light: what Quad::sample and AreaLight::sample read.
   struct QuadLight {
     int32_t light;
     float origin[3], u[3], v[3], n[3], area, radiance[3];
   };
+  // A point light (PointLight::sample) and a directional one (DirectionalLight::sample: its
+  // sample is the same everywhere).
+  struct PointSource {
+    int32_t light;
+    float position[3], intensity[3];
+  };
+  struct DistantSource {
+    float wi[3], irradiance[3];
+  };
   std::vector<QuadLight> quads;
-  std::vector<int32_t> source;  // per light: its index in quads, kEnvironment or kNotStaged
+  std::vector<PointSource> points;
+  std::vector<DistantSource> distant;
+  // Per light: its kind and its index in quads, points or distant.
+  std::vector<int32_t> kind, index;
   Spectrum environment{0.f};    // a ConstantEnvironment's radiance
   int32_t environment_id = -1;  // its light index
 };
@@ -54,6 +66,14 @@ void quad_light_samples(const float* q_origin, const float* q_u, const float* q_
                         const float* u_x, const float* u_y, int32_t* ok, float* wi_x, float* wi_y,
                         float* wi_z, float* distance, float* pdf, float* p_x, float* p_y,
                         float* p_z, float* e_x, float* e_y, float* e_z);
+
+// PointLight::sample from ref for the entries whose light is `id` (pdf 1, a delta light);
+// other entries keep what they hold.
+void point_light_samples(const float* position, const float* intensity, int32_t id, size_t n,
+                         const int32_t* light, const float* ref_x, const float* ref_y,
+                         const float* ref_z, int32_t* ok, float* wi_x, float* wi_y, float* wi_z,
+                         float* distance, float* pdf, float* p_x, float* p_y, float* p_z,
+                         float* value_x, float* value_y, float* value_z);
 
 // ConstantEnvironment::sample's direction (square_to_uniform_sphere) for the entries whose
 // light is `id`; its distance, value and pdf are the light's constants.

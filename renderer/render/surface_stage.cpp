@@ -69,7 +69,7 @@ struct Lanes {
   lane::Tables tables;
   const float *time, *eta, *u_lobe, *u_dir[2], *u_rr;
   const int32_t* depth;
-  const int32_t* light_ok;
+  const int32_t *light_ok, *l_delta;
   const float *l_wi[3], *l_distance, *l_pdf, *l_p[3], *l_error[3], *l_n[3], *l_value[3], *l_pmf;
   int32_t *staged, *alive, *has_shadow, *nee_ray, *dims, *prev_delta;
   float *s_origin[3], *s_dir[3], *s_t_max, *s_contrib[3];
@@ -126,10 +126,11 @@ template <class Model, bool kNextEvent>
     const Mask l_agrees = agrees(wx, wy, wz, lx, ly, lz, gx, gy, gz, wi_z, lo_z);
     const float b[3] = {lo_x, lo_y, when(flip, -lo_z, lo_z)};
     const lane::EvalPdf e = Model::eval_pdf(q, a, b);
-    // power_heuristic(l_pdf, e.pdf).
+    // power_heuristic(l_pdf, e.pdf), or 1 for a delta light (path_scatter takes eval alone,
+    // whose value is eval_pdf's).
     const float h_a = l_pdf * l_pdf, h_b = e.pdf * e.pdf;
     const float h_ratio = h_a / (h_a + h_b);
-    const float mis = h_a + h_b > 0.f ? h_ratio : 0.f;
+    const float mis = L.l_delta[i] != 0 ? 1.f : (h_a + h_b > 0.f ? h_ratio : 0.f);
     const float f_x = e.f[0] * mis, f_y = e.f[1] * mis, f_z = e.f[2] * mis;
     const Mask black = mask(f_x == 0.f) & mask(f_y == 0.f) & mask(f_z == 0.f);
     const Mask nee = mask(kNextEvent) & mask(L.light_ok[i] != 0) & l_agrees & ~black;
@@ -316,7 +317,7 @@ void SurfaceStage::start(size_t paths) {
                   &u_point_[0], &u_point_[1], &u_lobe_, &u_dir_[0], &u_dir_[1], &u_rr_,
                   &l_distance_, &l_pdf_, &l_pmf_, &s_t_max_, &prev_pdf_, &eta_out_})
     a->resize(paths);
-  for (auto* a : {&table_, &nodes_, &depth_, &light_, &light_ok_, &staged_, &alive_,
+  for (auto* a : {&table_, &nodes_, &depth_, &light_, &light_ok_, &l_delta_, &staged_, &alive_,
                   &has_shadow_, &nee_ray_, &dims_, &prev_delta_})
     a->resize(paths);
 }
@@ -379,30 +380,65 @@ void SurfaceStage::compute(const IntegratorSettings& settings, bool scene_next_e
       uniform_sphere_samples(lights_.environment_id, n, light_.data(), u_point_[0].data(),
                              u_point_[1].data(), light_ok_.data(), l_wi_[0].data(),
                              l_wi_[1].data(), l_wi_[2].data());
-    // Each lane's light constants: a quad's normal and radiance, or the environment's (no far
-    // end: infinite distance, zero point and normal, as ConstantEnvironment::sample leaves them).
+    for (const StagedLights::PointSource& q : lights_.points)
+      point_light_samples(q.position, q.intensity, q.light, n, light_.data(), p_[0].data(),
+                          p_[1].data(), p_[2].data(), light_ok_.data(), l_wi_[0].data(),
+                          l_wi_[1].data(), l_wi_[2].data(), l_distance_.data(), l_pdf_.data(),
+                          l_p_[0].data(), l_p_[1].data(), l_p_[2].data(), l_value_[0].data(),
+                          l_value_[1].data(), l_value_[2].data());
+    // Each lane's light constants: a quad's normal and radiance; the environment's (no far
+    // end: infinite distance, zero point and normal, as ConstantEnvironment::sample leaves
+    // them); a point light's zero normal and error; a directional light's whole sample. Point
+    // and directional lights are deltas: no MIS weight.
     for (size_t i = 0; i < n; ++i) {
       const int32_t light = light_[i];
-      const int32_t source = lights_.source[size_t(light)];
+      const size_t index = size_t(lights_.index[size_t(light)]);
       l_pmf_[i] = sampler.pmf(light);
-      if (source >= 0) {
-        const StagedLights::QuadLight& q = lights_.quads[size_t(source)];
-        for (int c = 0; c < 3; ++c) {
-          l_n_[c][i] = q.n[c];
-          l_value_[c][i] = q.radiance[c];
+      l_delta_[i] = 0;
+      switch (lights_.kind[size_t(light)]) {
+        case StagedLights::kQuad: {
+          const StagedLights::QuadLight& q = lights_.quads[index];
+          for (int c = 0; c < 3; ++c) {
+            l_n_[c][i] = q.n[c];
+            l_value_[c][i] = q.radiance[c];
+          }
+          break;
         }
-      } else if (source == StagedLights::kEnvironment) {
-        l_distance_[i] = kInfinity;
-        l_pdf_[i] = uniform_sphere_pdf();
-        for (int c = 0; c < 3; ++c) {
-          l_n_[c][i] = 0.f;
-          l_p_[c][i] = 0.f;
-          l_error_[c][i] = 0.f;
-          l_value_[c][i] = lights_.environment[c];
+        case StagedLights::kEnvironment:
+          l_distance_[i] = kInfinity;
+          l_pdf_[i] = uniform_sphere_pdf();
+          for (int c = 0; c < 3; ++c) {
+            l_n_[c][i] = 0.f;
+            l_p_[c][i] = 0.f;
+            l_error_[c][i] = 0.f;
+            l_value_[c][i] = lights_.environment[c];
+          }
+          break;
+        case StagedLights::kPoint:
+          l_delta_[i] = 1;
+          for (int c = 0; c < 3; ++c) {
+            l_n_[c][i] = 0.f;
+            l_error_[c][i] = 0.f;
+          }
+          break;
+        case StagedLights::kDirectional: {
+          const StagedLights::DistantSource& d = lights_.distant[index];
+          l_delta_[i] = 1;
+          light_ok_[i] = 1;
+          l_distance_[i] = kInfinity;
+          l_pdf_[i] = 1.f;
+          for (int c = 0; c < 3; ++c) {
+            l_wi_[c][i] = d.wi[c];
+            l_n_[c][i] = 0.f;
+            l_p_[c][i] = 0.f;
+            l_error_[c][i] = 0.f;
+            l_value_[c][i] = d.irradiance[c];
+          }
+          break;
         }
-      } else {
-        staged_[i] = 0;  // path_scatter samples this light itself
-        light_ok_[i] = 0;
+        default:
+          staged_[i] = 0;  // path_scatter samples this light itself
+          light_ok_[i] = 0;
       }
     }
   }
@@ -442,6 +478,7 @@ void SurfaceStage::compute(const IntegratorSettings& settings, bool scene_next_e
   L.u_rr = u_rr_.data();
   L.depth = depth_.data();
   L.light_ok = light_ok_.data();
+  L.l_delta = l_delta_.data();
   L.l_distance = l_distance_.data();
   L.l_pdf = l_pdf_.data();
   L.l_pmf = l_pmf_.data();

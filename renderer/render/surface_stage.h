@@ -14,7 +14,7 @@
 // same order (glm's dot is (x + y) + z, to_world is (s x + t y) + n z, std::max and std::min
 // as their comparisons), the branches as selects between values all lanes compute, the file
 // compiled without contraction into fused multiply-adds (renderer/CMakeLists.txt). A path whose
-// chosen light has no kernel (point, spot, sphere, mesh and image lights) takes path_scatter
+// chosen light has no kernel (sphere, mesh and image lights) takes path_scatter
 // itself (`staged(lane)` false).
 #include <cstddef>
 #include <cstdint>
@@ -108,7 +108,7 @@ class SurfaceStage {
   std::vector<float> time_, eta_, u_light_, u_point_[2], u_lobe_, u_dir_[2], u_rr_;
   std::vector<int32_t> depth_;
   // The light sample per lane.
-  std::vector<int32_t> light_, light_ok_;
+  std::vector<int32_t> light_, light_ok_, l_delta_;
   std::vector<float> l_wi_[3], l_distance_, l_pdf_, l_p_[3], l_error_[3], l_n_[3], l_value_[3], l_pmf_;
   // Results per lane.
   std::vector<int32_t> staged_, alive_, has_shadow_, nee_ray_, dims_, prev_delta_;

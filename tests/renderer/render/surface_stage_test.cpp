@@ -4,8 +4,9 @@
 // roughnesses and iors, smooth plastics and dielectrics of several iors and a mirror (front and
 // back side, at every depth around the roulette depth, with the sampler's corner values), every
 // result must be path_scatter's to the bit: whether the path goes on, its new state and how
-// many sampler values it took, its shadow ray and contribution, and the ray count. Lanes whose
-// chosen light has no kernel (the point light here) must say so.
+// many sampler values it took, its shadow ray and contribution, and the ray count. The lights:
+// two quads and an environment (area lights with MIS), a point and a directional light (deltas),
+// and an emitting sphere, which has no kernel: lanes that choose it must say so.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -90,7 +91,9 @@ SceneInput floor_scene(bool lights, const MaterialParams& material) {
     in.objects.push_back(quad_object({-0.5f, 2, -0.5f}, {1, 0, 0}, {0, 0, 1}, 1, Spectrum(5.f)));
     in.objects.push_back(
         quad_object({1.5f, -1, 1}, {0, 0, -2}, {0, 1.5f, 0}, 1, Spectrum(1.f, 2.f, 3.f)));
-    in.lights = {PointLightDesc{{-1, 1, 1}, Spectrum(2.f)}};
+    in.objects.push_back(sphere_object({2.f, 2.5f, -1.5f}, 0.3f, 1, Spectrum(3.f, 3.f, 2.f)));
+    in.lights = {PointLightDesc{{-1, 1, 1}, Spectrum(2.f)},
+                 DirectionalLightDesc{{-0.3f, -1.f, -0.2f}, Spectrum(0.8f, 0.6f, 0.4f)}};
   }
   return in;
 }
@@ -143,6 +146,7 @@ std::vector<Lane> floor_hits(const Scene& scene, size_t count, uint32_t seed) {
 
 struct Coverage {
   int staged = 0, fallback = 0, alive = 0, dead = 0, shadows = 0, back = 0, ball = 0, delta = 0;
+  int delta_lights = 0;  // staged lanes whose chosen light is a point or directional light
 };
 
 Coverage expect_stage_matches_scatter(bool lights, uint32_t seed, StageModel model,
@@ -179,6 +183,11 @@ Coverage expect_stage_matches_scatter(bool lights, uint32_t seed, StageModel mod
       continue;
     }
     ++cover.staged;
+    if (next_event) {
+      LightSample ls;
+      const Light& light = scene->light(scene->light_sampler().choose(lanes[k].x[0]));
+      cover.delta_lights += light.sample(hit.p, 0.f, vec2(0.5f), &ls) && ls.is_delta;
+    }
     cover.back += glm::dot(lanes[k].state.ray.direction, hit.ng) > 0.f;
     cover.ball += hit.object == 1;
     SCOPED_TRACE("lane " + std::to_string(lane));
@@ -220,12 +229,14 @@ Coverage expect_stage_matches_scatter(bool lights, uint32_t seed, StageModel mod
   return cover;
 }
 
-TEST(SurfaceStage, LambertStepIsPathScatterToTheBitWithQuadLightsEnvironmentAndAPointLight) {
+TEST(SurfaceStage, LambertStepIsPathScatterToTheBitWithAreaDeltaAndUnstagedLights) {
   const Coverage c = expect_stage_matches_scatter(true, 7, StageModel::kLambert);
   // Every branch of the step was taken: lanes on both sides, paths that die (roulette, the
-  // disk's edge) and go on, shadow rays, and lanes left to path_scatter for the point light.
+  // disk's edge) and go on, shadow rays, lanes lit by delta lights, and lanes left to
+  // path_scatter for the sphere light.
   EXPECT_GT(c.staged, 1000);
   EXPECT_GT(c.fallback, 50);
+  EXPECT_GT(c.delta_lights, 200);
   EXPECT_GT(c.alive, 500);
   EXPECT_GT(c.dead, 50);
   EXPECT_GT(c.shadows, 500);
@@ -251,7 +262,8 @@ void expect_model_cases(StageModel model, std::initializer_list<float> roughness
       SCOPED_TRACE("roughness " + std::to_string(roughness) + " ior " + std::to_string(ior));
       const Coverage c = expect_stage_matches_scatter(true, seed, model, roughness, ior);
       EXPECT_GT(c.staged, 1000);
-      EXPECT_GT(c.fallback, 50);  // the point light
+      EXPECT_GT(c.fallback, 50);  // the sphere light
+      EXPECT_GT(c.delta_lights, 200);
       EXPECT_GT(c.alive, 300);
       EXPECT_GT(c.dead, 50);
       EXPECT_GT(c.back, 200);
