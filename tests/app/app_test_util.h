@@ -46,13 +46,10 @@ struct CommandResult {
   std::string output;  // stdout and stderr, interleaved
 };
 
-// Runs `penumbra ARGS` inside `folder` through the shell: tests pass plain words and paths
-// without spaces or quotes.
-inline CommandResult run_penumbra(const SceneFolder& folder, const std::string& args) {
-  const std::string command = "cd " + folder.path().string() + " && " +
-                              std::string(PENUMBRA_BINARY) + " " + args + " 2>&1";
+// Runs `command` through the shell, its stderr into its stdout.
+inline CommandResult run_command(const std::string& command) {
   CommandResult result;
-  FILE* pipe = ::popen(command.c_str(), "r");
+  FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
   if (!pipe) return result;
   char buffer[4096];
   std::size_t n;
@@ -60,6 +57,13 @@ inline CommandResult run_penumbra(const SceneFolder& folder, const std::string& 
   const int status = ::pclose(pipe);
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return result;
+}
+
+// Runs `penumbra ARGS` inside `folder` through the shell: tests pass plain words and paths
+// without spaces or quotes.
+inline CommandResult run_penumbra(const SceneFolder& folder, const std::string& args) {
+  return run_command("cd " + folder.path().string() + " && " + std::string(PENUMBRA_BINARY) +
+                     " " + args);
 }
 
 }  // namespace penumbra::test
