@@ -25,6 +25,11 @@ class ConstantEnvironment final : public EnvironmentLight {
   }
   Spectrum radiance(const vec3&) const override { return radiance_; }
   float pdf(const vec3& dir) const override;
+  // The radiance is the same from everywhere, so the integrand at a surface is the BSDF's
+  // value times the cosine times visibility: the BSDF's importance sampling follows it (a
+  // Lambertian surface's cosine sample has zero variance where the sky is unoccluded), while
+  // uniform sphere samples waste half their shadow rays below the surface.
+  bool left_to_bsdf_sampling() const override { return true; }
 
  private:
   Spectrum radiance_;

@@ -25,6 +25,12 @@ class Light {
   virtual bool sample(const vec3& ref, float time, const vec2& u, LightSample* out) const = 0;
   // An estimate of the emitted power (luminance), from which the light sampler chooses.
   virtual float power(float scene_radius) const = 0;
+  // Whether an integrator that weighs light sampling against BSDF sampling by MIS on every
+  // lobe (the path integrator) should leave this light to BSDF sampling alone: true where no
+  // light sample can beat the BSDF's own. Such a light then gets no next-event estimate and no
+  // shadow ray, and a BSDF-sampled ray that reaches it counts with MIS weight 1 (pbrt-v4's
+  // "allowIncompletePDF"; Karlik et al. 2019, "MIS compensation").
+  virtual bool left_to_bsdf_sampling() const { return false; }
 };
 
 }  // namespace penumbra

@@ -8,6 +8,10 @@
 // Cauchy-Schwarz). Taking n_i = s_i * mean(s) / t^2 makes that relMSE equal to t^2, so the
 // threshold t is the relative RMS error the image aims for.
 //
+// A pixel's count is decided by its neighbours' deviations (and the image-wide scale without its
+// own term), never by its own samples: a count that depends on the values it averages biases the
+// mean (adaptive_sampling.cpp, docs/stability-and-features.md).
+//
 // Not the per-pixel rule "stop a pixel once its own relative error is below t" (Cycles): that
 // gives every pixel n_i = s_i^2 / t^2, i.e. relMSE * mean(n) = mean(s^2), exactly what uniform
 // sampling gets, and measured no better than uniform on our reference scenes

@@ -15,7 +15,7 @@ Spectrum integrate(const Scene& scene, const IntegratorSettings& settings, Ray r
     SurfaceHit hit;
     ++counters.rays;
     if (!scene.intersect(s.ray, &hit)) {
-      path_escaped<kFeatures>(scene, s, first);
+      path_escaped<kDistributed, kFeatures>(scene, s, first);
       break;
     }
     ShadowQuery shadow;
@@ -37,18 +37,19 @@ using ScalarInstantiations = FeatureInstantiations<IntegrateFn, ScalarKernel>;
 
 }  // namespace
 
-uint32_t integrator_feature_mask(const SceneFeatures& f) {
+uint32_t integrator_feature_mask(const SceneFeatures& f, IntegratorKind kind) {
   uint32_t mask = 0;
   if (f.absorption) mask |= kFeatureAbsorption;
   // An absorbing material is a dielectric, so absorption implies transmission.
   if (f.transmission) mask |= kFeatureTransmission;
   if (f.environment) mask |= kFeatureEnvironment;
-  if (f.lights) mask |= kFeatureLights;
+  // The path integrator leaves some lights to BSDF sampling (next_event_lights).
+  if (kind == IntegratorKind::kDistributed ? f.lights : f.mis_lights) mask |= kFeatureLights;
   return mask;
 }
 
 IntegrateFn select_integrator(IntegratorKind kind, const SceneFeatures& features) {
-  return ScalarInstantiations::select(kind, integrator_feature_mask(features));
+  return ScalarInstantiations::select(kind, integrator_feature_mask(features, kind));
 }
 
 IntegrateFn select_generic_integrator(IntegratorKind kind) {

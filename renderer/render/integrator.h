@@ -27,6 +27,6 @@ IntegrateFn select_integrator(IntegratorKind kind, const SceneFeatures& features
 // The instantiation with every feature compiled in (tests check the specialised ones against it).
 IntegrateFn select_generic_integrator(IntegratorKind kind);
 // The feature bits select_integrator compiles in for a scene (for tests and benchmarks).
-uint32_t integrator_feature_mask(const SceneFeatures& features);
+uint32_t integrator_feature_mask(const SceneFeatures& features, IntegratorKind kind);
 
 }  // namespace penumbra

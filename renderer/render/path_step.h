@@ -147,15 +147,25 @@ inline void record_miss(const EnvironmentLight* environment, const Ray& ray, Fir
 
 }  // namespace path_step_detail
 
+// The lights an integrator's next-event estimation chooses from: every light for the
+// distributed integrator (its diffuse lobes see direct light through light sampling alone), for
+// the path integrator all but those BSDF sampling covers better (Scene::mis_light_sampler).
+template <bool kDistributed>
+[[gnu::always_inline]] inline const LightSampler& next_event_lights(const Scene& scene) {
+  if constexpr (kDistributed) return scene.light_sampler();
+  else return scene.mis_light_sampler();
+}
+
 // The path's ray escaped the scene: the environment's radiance, weighted by MIS against light
-// sampling. The path ends.
-template <uint32_t kFeatures>
+// sampling (weight 1 where the integrator leaves the environment to BSDF sampling: its pmf is
+// 0). The path ends.
+template <bool kDistributed, uint32_t kFeatures>
 inline void path_escaped(const Scene& scene, PathState& s, FirstHit* first) {
   const EnvironmentLight* environment = scene.environment();
   if (first && s.depth == 1) path_step_detail::record_miss(environment, s.ray, first);
   if constexpr ((kFeatures & kFeatureEnvironment) != 0) {
     if (!environment) return;
-    const LightSampler& lights = scene.light_sampler();
+    const LightSampler& lights = next_event_lights<kDistributed>(scene);
     const float w =
         s.prev_delta ? 1.f
                      : power_heuristic(s.prev_pdf, lights.pmf(scene.environment_light()) *
@@ -167,13 +177,13 @@ inline void path_escaped(const Scene& scene, PathState& s, FirstHit* first) {
 // The path's ray hit `hit`, first part: the first-hit record, Beer-Lambert absorption and the
 // emission it sees. False if the path ends here (it reached max_depth); else path_scatter goes
 // on from the same hit.
-template <uint32_t kFeatures>
+template <bool kDistributed, uint32_t kFeatures>
 [[gnu::always_inline]] inline bool path_arrive(const Scene& scene, const IntegratorSettings& settings,
                                                PathState& s, const SurfaceHit& hit,
                                                FirstHit* first) {
   using namespace path_step_detail;
   const int max_depth = settings.max_depth < 0 ? INT_MAX : settings.max_depth;
-  const LightSampler& lights = scene.light_sampler();
+  const LightSampler& lights = next_event_lights<kDistributed>(scene);
   const Ray& ray = s.ray;
   const SceneObject& obj = scene.object(hit.object);
   const Material& material = scene.material(obj.material);
@@ -208,7 +218,7 @@ inline bool path_scatter(const Scene& scene, const IntegratorSettings& settings,
                          ShadowQuery* shadow, bool* has_shadow) {
   using namespace path_step_detail;
   *has_shadow = false;
-  const LightSampler& lights = scene.light_sampler();
+  const LightSampler& lights = next_event_lights<kDistributed>(scene);
   constexpr uint32_t kContinueLobes = kDistributed ? uint32_t(kLobeNonDiffuse) : uint32_t(kLobeAll);
   const Ray& ray = s.ray;
   const Material& material = scene.material(scene.object(hit.object).material);
@@ -312,7 +322,7 @@ inline bool path_hit(const Scene& scene, const IntegratorSettings& settings, Pat
                      SurfaceHit& hit, PathSampler& sampler, PathCounters& counters,
                      FirstHit* first, ShadowQuery* shadow, bool* has_shadow) {
   *has_shadow = false;
-  if (!path_arrive<kFeatures>(scene, settings, s, hit, first)) return false;
+  if (!path_arrive<kDistributed, kFeatures>(scene, settings, s, hit, first)) return false;
   return path_scatter<kDistributed, kFeatures>(scene, settings, s, hit, sampler, counters,
                                                shadow, has_shadow);
 }

@@ -365,7 +365,7 @@ void SurfaceStage::compute(const IntegratorSettings& settings, bool scene_next_e
   const size_t n = count_;
   if (n == 0) return;
   for (size_t i = 0; i < n; ++i) staged_[i] = 1;
-  const LightSampler& sampler = scene_.light_sampler();
+  const LightSampler& sampler = scene_.mis_light_sampler();  // stages: path integrator
   if (next_event) {
     choose_lights(sampler.cdf().data(), int32_t(sampler.cdf().size()), n, u_light_.data(),
                   light_.data());

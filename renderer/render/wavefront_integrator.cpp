@@ -77,7 +77,7 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
     // gathered in path order, as the scalar loop would leave them.
     constexpr bool kStages = !kDistributed;
     if (kStages && b.staged_scene_ != &scene) make_stages(scene, b);
-    const bool next_event = (kFeatures & kFeatureLights) != 0 && !scene.light_sampler().empty();
+    const bool next_event = (kFeatures & kFeatureLights) != 0 && !next_event_lights<kDistributed>(scene).empty();
     if (kStages)
       for (auto& stage : b.stages_) stage->start(live.size());
     std::vector<uint8_t>& goes_on = b.goes_on_;
@@ -92,7 +92,7 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
       PathState& s = b.states_[p];
       FirstHit* first = b.record_first_hits_ ? &b.firsts_[p] : nullptr;
       if (!b.found_[k]) {
-        path_escaped<kFeatures>(scene, s, first);
+        path_escaped<kDistributed, kFeatures>(scene, s, first);
         continue;
       }
       const size_t j = hit_index++;
@@ -100,7 +100,7 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
       SurfaceHit& hit = b.hits_[k];
       const int stage = kStages ? b.stage_of_[hit.object] : -1;
       if (stage >= 0) {
-        if (path_arrive<kFeatures>(scene, settings, s, hit, first))
+        if (path_arrive<kDistributed, kFeatures>(scene, settings, s, hit, first))
           b.stages_[size_t(stage)]->add(uint32_t(k), s, hit, samples.x(j), samples.y(j),
                                         next_event);
         continue;
@@ -175,7 +175,7 @@ using BatchInstantiations = FeatureInstantiations<IntegrateBatchFn, BatchKernel>
 }  // namespace
 
 IntegrateBatchFn select_batch_integrator(IntegratorKind kind, const SceneFeatures& features) {
-  return BatchInstantiations::select(kind, integrator_feature_mask(features));
+  return BatchInstantiations::select(kind, integrator_feature_mask(features, kind));
 }
 
 IntegrateBatchFn select_generic_batch_integrator(IntegratorKind kind) {

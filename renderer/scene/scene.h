@@ -64,7 +64,13 @@ class Scene {
   const SceneObject& object(uint32_t id) const { return objects_[id]; }
   const Material& material(uint32_t index) const { return materials_[index]; }
 
+  // The choice of a light for next-event estimation over every light: for integrators that see
+  // some lobes' direct light only through light sampling (the distributed integrator).
   const LightSampler& light_sampler() const { return light_sampler_; }
+  // The same over the lights the path integrator samples, which weighs light against BSDF
+  // sampling by MIS everywhere: all but those left to BSDF sampling
+  // (Light::left_to_bsdf_sampling; same indices, the others with pmf 0).
+  const LightSampler& mis_light_sampler() const { return mis_light_sampler_; }
   const Light& light(int index) const { return *lights_[size_t(index)]; }
   int light_count() const { return int(lights_.size()); }
   // The environment (nullptr if rays that escape see black) and its index among the lights.
@@ -102,7 +108,7 @@ class Scene {
   std::vector<Instance> instances_;
   std::vector<EmbreeScene> instanced_scenes_;
   std::vector<std::unique_ptr<Light>> lights_;
-  LightSampler light_sampler_;
+  LightSampler light_sampler_, mis_light_sampler_;
   const EnvironmentLight* environment_ = nullptr;
   int environment_light_ = -1;
   ExactTCheck exact_t_;

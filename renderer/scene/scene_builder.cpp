@@ -146,9 +146,14 @@ class SceneBuilder {
     s_.features_.lights = !s_.lights_.empty();
     const float radius = std::max(0.5f * glm::length(s_.bounds_.hi - s_.bounds_.lo), 1e-6f);
     std::vector<float> powers;
-    powers.reserve(s_.lights_.size());
-    for (const auto& light : s_.lights_) powers.push_back(light->power(radius));
+    std::vector<bool> mis_sampled;
+    for (const auto& light : s_.lights_) {
+      powers.push_back(light->power(radius));
+      mis_sampled.push_back(!light->left_to_bsdf_sampling());
+    }
     s_.light_sampler_ = LightSampler(powers);
+    s_.mis_light_sampler_ = LightSampler(powers, mis_sampled);
+    s_.features_.mis_lights = !s_.mis_light_sampler_.empty();
   }
 
   void add_environment(std::unique_ptr<EnvironmentLight> env) {

@@ -10,6 +10,7 @@ struct SceneFeatures {
   bool transmission = false;  // any material that transmits
   bool absorption = false;    // any material that absorbs inside (Beer-Lambert)
   bool lights = false;        // any light to sample (area, point, directional or environment)
+  bool mis_lights = false;    // any light the path integrator samples (Light::left_to_bsdf_sampling)
   bool environment = false;   // rays that escape see radiance
   bool textures = false;      // some material reads textures: hits need their uv
 };

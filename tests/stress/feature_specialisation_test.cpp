@@ -106,9 +106,11 @@ TEST(FeatureSpecialisation, BitIdenticalToGenericIntegrator) {
       ASSERT_EQ(specialised.image.rgb.size(), generic.rgb.size());
       EXPECT_EQ(std::memcmp(specialised.image.rgb.data(), generic.rgb.data(), generic.rgb.size() * sizeof(float)), 0)
           << fs.name << (kind == IntegratorKind::kPath ? " path" : " distributed");
-      masks.push_back(integrator_feature_mask(scene->features()));
-      const uint32_t all = integrator_feature_mask(
-          SceneFeatures{true, true, true, true, true, true});
+      masks.push_back(integrator_feature_mask(scene->features(), kind));
+      SceneFeatures every;
+      every.motion = every.lens = every.transmission = every.absorption = every.lights =
+          every.mis_lights = every.environment = every.textures = true;
+      const uint32_t all = integrator_feature_mask(every, kind);
       EXPECT_EQ(select_integrator(kind, scene->features()) == select_generic_integrator(kind),
                 masks.back() == all)
           << fs.name;
@@ -139,7 +141,8 @@ TEST(FeatureSpecialisation, ZeroVelocityAndApertureCountAsAbsent) {
   const auto sa = Scene::build(a.request->scene), sb = Scene::build(b.request->scene);
   EXPECT_FALSE(sb->features().motion);
   EXPECT_FALSE(sb->features().lens);
-  EXPECT_EQ(integrator_feature_mask(sa->features()), integrator_feature_mask(sb->features()));
+  for (IntegratorKind kind : {IntegratorKind::kPath, IntegratorKind::kDistributed})
+    EXPECT_EQ(integrator_feature_mask(sa->features(), kind), integrator_feature_mask(sb->features(), kind));
   EXPECT_EQ(render(*sa, a.request->settings).image.rgb, render(*sb, b.request->settings).image.rgb);
 }
 

@@ -8,6 +8,7 @@
 #include "renderer/lights/environment_light.h"
 #include "renderer/lights/light_sampler.h"
 #include "renderer/lights/point_light.h"
+#include "renderer/render/light_kernels.h"
 #include "renderer/sampling/sampling.h"
 #include "renderer/shapes/quad.h"
 
@@ -33,6 +34,38 @@ TEST(LightSampler, NonFiniteOrNegativePowerCountsAsZero) {
   for (int i = 0; i < 3; ++i) EXPECT_FLOAT_EQ(sampler.pmf(i), 0.125f);
   EXPECT_EQ(sampler.choose(0.99999994f), 3);
   EXPECT_TRUE(LightSampler().empty());
+}
+
+// Lights left out of a sampler (the path integrator's, Scene::mis_light_sampler) keep their
+// index with pmf 0 and are never chosen, wherever they sit: first, between, or last (where the
+// cdf's rounding to 1 must not hand them the top of [0, 1)); the choice in SIMD
+// (choose_lights: a count of cdf <= u) agrees.
+TEST(LightSampler, LeftOutLightsAreNeverChosen) {
+  const std::vector<float> powers = {2.f, 1.f, 5.f, 3.f, 7.f};
+  const std::vector<bool> sampled = {false, true, false, true, false};
+  const LightSampler sampler(powers, sampled);
+  ASSERT_FALSE(sampler.empty());
+  EXPECT_FLOAT_EQ(sampler.pmf(1), 0.5f * 1.f / 4.f + 0.25f);
+  EXPECT_FLOAT_EQ(sampler.pmf(3), 0.5f * 3.f / 4.f + 0.25f);
+  for (int i : {0, 2, 4}) EXPECT_EQ(sampler.pmf(i), 0.f) << i;
+  const int n = 100000;
+  int counts[5] = {0, 0, 0, 0, 0};
+  std::vector<float> us;
+  for (int i = 0; i < n; ++i) us.push_back(float(i) / float(n));
+  us.push_back(0.99999994f);
+  for (float u : us) {
+    const int light = sampler.choose(u);
+    ++counts[light];
+    int32_t simd;
+    choose_lights(sampler.cdf().data(), int32_t(sampler.cdf().size()), 1, &u, &simd);
+    EXPECT_EQ(simd, light) << u;
+  }
+  EXPECT_EQ(counts[0] + counts[2] + counts[4], 0);
+  EXPECT_NEAR(double(counts[1]) / n, sampler.pmf(1), 1e-4);
+
+  const LightSampler none(powers, std::vector<bool>(powers.size(), false));
+  EXPECT_TRUE(none.empty());
+  for (int i = 0; i < 5; ++i) EXPECT_EQ(none.pmf(i), 0.f);
 }
 
 TEST(Lights, PointLightFallsOffWithTheSquareOfTheDistance) {

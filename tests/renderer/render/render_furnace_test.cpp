@@ -22,6 +22,23 @@ TEST(RenderFurnace, DiffuseAlbedoOneSphereRendersOne) {
   EXPECT_LT(st.max, 1.15);
 }
 
+// The path integrator leaves a constant environment to BSDF sampling (Light::
+// left_to_bsdf_sampling): a white Lambertian sphere's cosine sample carries weight 1 and escapes
+// into radiance 1 with MIS weight 1, so every sample is 1 -- no noise at all. Light samples of
+// the environment weighed by MIS (or a weight below 1 on the escape) would scatter the pixels.
+// The distributed integrator still estimates the environment by light sampling at the diffuse
+// surface, and must still give 1 on average.
+TEST(RenderFurnace, PathIntegratorLeavesConstantEnvironmentToBsdfSampling) {
+  const auto r = render_input(furnace_with_sphere(DiffuseParams{Spectrum(1.f)}), small_settings(24, 24, 16));
+  const ImageStats st = image_stats(r.image);
+  EXPECT_EQ(st.nonfinite, 0);
+  EXPECT_NEAR(st.min, 1.0, 1e-5);
+  EXPECT_NEAR(st.max, 1.0, 1e-5);
+  RenderSettings s = small_settings(24, 24, 64);
+  s.integrator = IntegratorKind::kDistributed;
+  expect_image_mean_near(render_input(furnace_with_sphere(DiffuseParams{Spectrum(1.f)}), s), 1.0, 0.01);
+}
+
 TEST(RenderFurnace, SmoothGlassSphereRendersOne) {
   const auto r = render_input(furnace_with_sphere(DielectricParams{1.5f, 0.f, Spectrum(0.f)}),
                               small_settings(24, 24, 64));

@@ -1,6 +1,7 @@
 // The feature mask the scene build computes: `textures` (spheres then compute the uv of their
 // hits, ShapeContext::need_uv) is set exactly when some material reads a texture or a normal map,
-// or some emission is textured.
+// or some emission is textured. `lights` and `mis_lights`: whether the distributed and the path
+// integrator sample lights, the path integrator leaving a constant environment to BSDF sampling.
 #include <gtest/gtest.h>
 
 #include "renderer/scene/scene.h"
@@ -42,6 +43,41 @@ TEST(SceneFeatures, TexturesOnlyWhenSomethingReadsTheUv) {
   emitter.objects[0].emission = Spectrum(1.f);
   emitter.objects[0].emission_texture = texture;
   EXPECT_TRUE(Scene::build(emitter)->features().textures);
+}
+
+TEST(SceneFeatures, PathIntegratorLeavesOnlyTheConstantEnvironmentOut) {
+  // A constant environment alone: every light for the distributed integrator, none for the path.
+  const auto env_only = Scene::build(sphere_scene(DiffuseParams{Spectrum(0.5f)}));
+  EXPECT_TRUE(env_only->features().lights);
+  EXPECT_FALSE(env_only->features().mis_lights);
+  EXPECT_FALSE(env_only->light_sampler().empty());
+  EXPECT_TRUE(env_only->mis_light_sampler().empty());
+  EXPECT_EQ(env_only->mis_light_sampler().pmf(env_only->environment_light()), 0.f);
+
+  // Beside an emitter: the path integrator samples the emitter alone.
+  SceneInput both = sphere_scene(DiffuseParams{Spectrum(0.5f)});
+  ObjectDesc emitter;
+  emitter.shape = SphereDesc{vec3(0.f, 3.f, 0.f), 0.5f};
+  emitter.emission = Spectrum(4.f);
+  both.objects.push_back(emitter);
+  const auto scene = Scene::build(both);
+  EXPECT_TRUE(scene->features().mis_lights);
+  const int env = scene->environment_light(), light = scene->object(1).light;
+  EXPECT_GT(scene->light_sampler().pmf(env), 0.f);
+  EXPECT_EQ(scene->mis_light_sampler().pmf(env), 0.f);
+  EXPECT_EQ(scene->mis_light_sampler().pmf(light), 1.f);
+
+  // An environment map is sampled by its luminance, which BSDF sampling does not follow: it stays.
+  SceneInput mapped = sphere_scene(DiffuseParams{Spectrum(0.5f)});
+  mapped.environment = Spectrum(0.f);
+  EnvironmentMapDesc map;
+  map.width = 4;
+  map.height = 2;
+  map.rgb = {1, 1, 1, 9, 9, 9, 1, 1, 1, 1, 1, 1, 2, 2, 2, 1, 1, 1, 1, 1, 1, 1, 1, 1};
+  mapped.environment_map = map;
+  const auto with_map = Scene::build(mapped);
+  EXPECT_TRUE(with_map->features().mis_lights);
+  EXPECT_EQ(with_map->mis_light_sampler().pmf(with_map->environment_light()), 1.f);
 }
 
 }  // namespace
