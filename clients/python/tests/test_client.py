@@ -127,6 +127,9 @@ class JobsTest(ServerTest):
         scene = sky_scene(40, 37, 8)  # 37 lines: a last, partial 16-line block
         scene["materials"] = {"m": {"type": "diffuse", "color": [0.8, 0.3, 0.1]}}
         scene["objects"] = [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m"}]
+        # Under the sky alone the sphere is flat (the path integrator's cosine samples of a
+        # constant environment carry no noise); a point light shades it.
+        scene["lights"] = [{"type": "point", "position": [2, 3, 3], "intensity": [6, 6, 6]}]
         job = self.client.submit(scene)
         self.client.wait(job, progress=False)
         linear = self.client.result(job)
