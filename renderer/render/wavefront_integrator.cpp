@@ -64,9 +64,12 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
     }
     counters.rays += live.size();
 
-    // The sampler values the paths that hit something will take, for all of them at once.
+    // The sampler values the paths that hit something will take, for all of them at once (no
+    // light choice and light point where the integrator samples no light).
+    const bool next_event =
+        (kFeatures & kFeatureLights) != 0 && !next_event_lights<kDistributed>(scene).empty();
     BounceSamples& samples = b.samples_;
-    samples.start(live.size());
+    samples.start(live.size(), next_event ? BounceSamples::kBounce : BounceSamples::kBounceWithoutLight);
     for (size_t k = 0; k < live.size(); ++k)
       if (b.found_[k]) samples.add(*b.samplers_[live[k]], b.cursors_[live[k]]);
     samples.compute();
@@ -77,7 +80,6 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
     // gathered in path order, as the scalar loop would leave them.
     constexpr bool kStages = !kDistributed;
     if (kStages && b.staged_scene_ != &scene) make_stages(scene, b);
-    const bool next_event = (kFeatures & kFeatureLights) != 0 && !next_event_lights<kDistributed>(scene).empty();
     if (kStages)
       for (auto& stage : b.stages_) stage->start(live.size());
     std::vector<uint8_t>& goes_on = b.goes_on_;

@@ -26,6 +26,9 @@ void scrambled_sobol_batch(size_t n, const uint32_t* index, const uint32_t* seed
 class BounceSamples {
  public:
   static constexpr int kBounce = 5;
+  // A bounce without a next-event estimate (no light the integrator samples): lobe,
+  // direction, Russian roulette.
+  static constexpr int kBounceWithoutLight = 3;
 
   // Room for `paths` paths' values, per_path each, from path 0.
   void start(size_t paths, int per_path = kBounce) {
@@ -47,6 +50,8 @@ class BounceSamples {
     for (int j = 0; j < per_path_; ++j) index_[e + j] = cursor.index;
     if (per_path_ == kBounce)
       sampler.scrambles<kBounce>(cursor.dimension, &seed_index_[e], &seed_x_[e], &seed_y_[e]);
+    else if (per_path_ == kBounceWithoutLight)
+      sampler.scrambles<kBounceWithoutLight>(cursor.dimension, &seed_index_[e], &seed_x_[e], &seed_y_[e]);
     else
       sampler.scrambles(cursor.dimension, per_path_, &seed_index_[e], &seed_x_[e], &seed_y_[e]);
   }
