@@ -75,7 +75,7 @@ class SurfaceStage {
   bool alive(size_t lane) const { return alive_[lane] != 0; }
   bool has_shadow(size_t lane) const { return has_shadow_[lane] != 0; }
   bool counted_ray(size_t lane) const { return nee_ray_[lane] != 0; }
-  ShadowQuery shadow(size_t lane) const;
+  void shadow(size_t lane, ShadowQuery* out) const;
   void apply(size_t lane, PathState& s, Sampler::Cursor& cursor) const;
 
  private:

@@ -19,6 +19,7 @@ PathBatch::PathBatch(size_t capacity, bool record_first_hits)
   found_.resize(capacity_);
   shadows_.resize(capacity_);
   shadow_paths_.resize(capacity_);
+  shadow_slots_.resize(capacity_);
 }
 
 void PathBatch::clear() {
@@ -134,7 +135,7 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
         if (stage->counted_ray(lane)) ++counters.rays;
         if (stage->has_shadow(lane)) {
           has_shadow[k] = 1;
-          b.shadows_[k] = stage->shadow(lane);
+          stage->shadow(lane, &b.shadows_[k]);
         }
         if (stage->alive(lane)) {
           goes_on[k] = 1;
@@ -142,14 +143,16 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
         }
       }
     }
+    // The shadow queries stay in their slots (copying 44-byte queries into a compact array
+    // stalled on store forwarding); their slots and paths are listed in path order.
     size_t survivors = 0, shadows = 0;
     for (size_t k = 0; k < live.size(); ++k) {
       const uint32_t p = live[k];
-      if (has_shadow[k]) {  // shadows <= k: reads stay ahead of writes
-        b.shadows_[shadows] = b.shadows_[k];
+      if (has_shadow[k]) {
+        b.shadow_slots_[shadows] = uint32_t(k);
         b.shadow_paths_[shadows++] = p;
       }
-      if (goes_on[k]) live[survivors++] = p;  // survivors <= k likewise
+      if (goes_on[k]) live[survivors++] = p;  // survivors <= k: reads stay ahead of writes
     }
     live.resize(survivors);
 
@@ -158,10 +161,11 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
     std::array<bool, kPacket> blocked;
     for (size_t k = 0; k < shadows; k += kPacket) {
       const int count = int(std::min<size_t>(kPacket, shadows - k));
-      for (int i = 0; i < count; ++i) rays[i] = b.shadows_[k + i].ray;
+      for (int i = 0; i < count; ++i) rays[i] = b.shadows_[b.shadow_slots_[k + i]].ray;
       scene.occluded_packet(rays.data(), count, blocked.data());
       for (int i = 0; i < count; ++i)
-        if (!blocked[i]) b.states_[b.shadow_paths_[k + i]].radiance += b.shadows_[k + i].contribution;
+        if (!blocked[i])
+          b.states_[b.shadow_paths_[k + i]].radiance += b.shadows_[b.shadow_slots_[k + i]].contribution;
     }
   }
 }

@@ -54,7 +54,7 @@ class PathBatch {
   std::vector<SurfaceHit> hits_;
   std::vector<uint8_t> found_;
   std::vector<ShadowQuery> shadows_;
-  std::vector<uint32_t> shadow_paths_;
+  std::vector<uint32_t> shadow_paths_, shadow_slots_;
   BounceSamples samples_;  // the sampler values of the bounce's paths that hit something
   // Made for the scene at hand: the stages of the models its surfaces use.
   const Scene* staged_scene_ = nullptr;

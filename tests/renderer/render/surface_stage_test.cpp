@@ -197,7 +197,8 @@ Coverage expect_stage_matches_scatter(bool lights, uint32_t seed, StageModel mod
     if (stage.has_shadow(lane) != has_shadow || stage.alive(lane) != goes_on) continue;
     if (has_shadow) {
       ++cover.shadows;
-      const ShadowQuery q = stage.shadow(lane);
+      ShadowQuery q;
+      stage.shadow(lane, &q);
       EXPECT_TRUE(same_bits(q.ray.origin, shadow.ray.origin));
       EXPECT_TRUE(same_bits(q.ray.direction, shadow.ray.direction));
       EXPECT_TRUE(same_bits(q.ray.t_max, shadow.ray.t_max));
