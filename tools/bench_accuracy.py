@@ -156,7 +156,8 @@ def cycles_reference(blender: str, scene_path: str, spp: int, mi, sphere_mesh: i
     return read_exr(mi, path)
 
 
-def run_mitsuba(variant: str, scene: dict, spp: int, seed: int, instants: int) -> tuple[np.ndarray, float]:
+def run_mitsuba(variant: str, scene: dict, spp: int, seed: int, instants: int,
+                assets: str = ".") -> tuple[np.ndarray, float]:
     """Render with Mitsuba in this process; returns the image and load + render seconds."""
     mi = p2m.import_mitsuba(variant)
     times = p2m.shutter_instants(scene, instants)
@@ -164,7 +165,7 @@ def run_mitsuba(variant: str, scene: dict, spp: int, seed: int, instants: int) -
     total, seconds = None, 0.0
     for k, t in enumerate(times):
         start = time.perf_counter()
-        mscene = mi.load_dict(p2m.to_mitsuba(mi, scene, time=t, spp=per_instant))
+        mscene = mi.load_dict(p2m.to_mitsuba(mi, scene, time=t, spp=per_instant, assets=assets))
         img = np.asarray(mi.render(mscene, spp=per_instant, seed=seed * len(times) + k), dtype=np.float64)
         seconds += time.perf_counter() - start
         total = img if total is None else total + img
@@ -336,6 +337,9 @@ def main(argv: list[str]) -> int:
     for scene_name in scenes:
         scene_path = os.path.join(ACCURACY, "scenes", f"{scene_name}.json")
         scene = p2m.load_json(scene_path)
+        # Files the scene names (environment maps, textures) are relative to its folder, as for penumbra.
+        p2m.use_scene_folder(mi, scene_path)
+        assets = os.path.dirname(os.path.abspath(scene_path))
         reference = read_exr(mi, os.path.join(ACCURACY, "references", f"{scene_name}.exr"))
         instants = len(p2m.shutter_instants(scene, args.instants))
         with open(scene_path, encoding="utf-8") as f:
@@ -374,7 +378,7 @@ def main(argv: list[str]) -> int:
             if renderer.startswith("penumbra"):
                 run_penumbra(args.penumbra, scene_path, ladder[0], 0, mi)
             else:
-                run_mitsuba(renderer.split()[1], scene, max(ladder[0], instants), 0, instants)
+                run_mitsuba(renderer.split()[1], scene, max(ladder[0], instants), 0, instants, assets)
             def measure(spp: int, threshold: float) -> float:
                 """One point of the curve over all seeds; returns its mean relMSE."""
                 errs = []
@@ -384,7 +388,7 @@ def main(argv: list[str]) -> int:
                         image, seconds = run_penumbra(args.penumbra, scene_path, spp, seed, mi, threshold)
                         used_instants = 1
                     else:
-                        image, seconds = run_mitsuba(renderer.split()[1], scene, max(spp, instants), seed, instants)
+                        image, seconds = run_mitsuba(renderer.split()[1], scene, max(spp, instants), seed, instants, assets)
                         used_instants = instants
                     process = time.perf_counter() - start
                     used_spp = spp if renderer.startswith("penumbra") else max(spp, instants)

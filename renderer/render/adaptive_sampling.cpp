@@ -67,7 +67,7 @@ std::vector<uint32_t> adaptive_sample_limits(const std::vector<double>& deviatio
     if (predicted(above) > target) {
       c = above;  // even the cap everywhere does not reach t
     } else {
-      for (int k = 0; k < 40 && above > below * (1.0 + 1e-9); ++k) {
+      for (int k = 0; k < 40 && above > below * (1.0 + 1e-5); ++k) {  // ~20 halvings
         const double mid = std::sqrt(below * above);
         (predicted(mid) <= target ? above : below) = mid;
       }
