@@ -6,7 +6,6 @@
 #include "renderer/core/simd_clones.h"
 #include "renderer/lights/area_light.h"
 #include "renderer/lights/directional_light.h"
-#include "renderer/lights/environment_light.h"
 #include "renderer/lights/light_sampler.h"
 #include "renderer/lights/point_light.h"
 #include "renderer/sampling/sampling.h"
@@ -104,34 +103,6 @@ void point_light_samples(const float* __restrict position, const float* __restri
   }
 }
 
-// ConstantEnvironment::sample for the entries whose light is `id`: square_to_uniform_sphere,
-// with sincos_two_pi's quarter turn as selects and negations instead of its switch (exact:
-// negation does not round), so the values are the scalar ones.
-PENUMBRA_SIMD_CLONES
-void uniform_sphere_samples(int32_t id, size_t n, const int32_t* __restrict light,
-                            const float* __restrict u_x, const float* __restrict u_y,
-                            int32_t* __restrict ok, float* __restrict wi_x,
-                            float* __restrict wi_y, float* __restrict wi_z) {
-  for (size_t i = 0; i < n; ++i) {
-    const float z = 1.f - 2.f * u_x[i];
-    const float r = std::sqrt(std::max(0.f, 1.f - z * z));  // safe_sqrt
-    const float t = 4.f * u_y[i];
-    const int k = int(t + std::copysign(0.5f, t));
-    float a, b;
-    sincos_quarter_pi((t - float(k)) * (kPi / 2.f), &a, &b);
-    // Quarter turn k: (s, c) = (a, b), (b, -a), (-a, -b), (-b, a) for k mod 4 = 0, 1, 2, 3.
-    const bool swap = (k & 1) != 0;
-    const float s0 = swap ? b : a, c0 = swap ? a : b;
-    const float s = (k & 2) != 0 ? -s0 : s0;
-    const float c = ((k + 1) & 2) != 0 ? -c0 : c0;
-    const Mask mine = mask(light[i] == id);
-    ok[i] = when(mine, int32_t(1), ok[i]);
-    wi_x[i] = when(mine, r * c, wi_x[i]);
-    wi_y[i] = when(mine, r * s, wi_y[i]);
-    wi_z[i] = when(mine, z, wi_z[i]);
-  }
-}
-
 // LightSampler::choose for every entry: the first light whose cumulative probability exceeds
 // u is the number of lights whose cumulative probability does not (the table is sorted), and
 // the last light if rounding left u past them all.
@@ -152,12 +123,6 @@ StagedLights::StagedLights(const Scene& scene) {
   index.assign(lights, -1);
   for (size_t l = 0; l < lights; ++l) {
     const Light& light = scene.light(int(l));
-    if (const auto* env = dynamic_cast<const ConstantEnvironment*>(&light)) {
-      kind[l] = kEnvironment;
-      environment = env->radiance(vec3(0.f, 0.f, 1.f));
-      environment_id = int32_t(l);
-      continue;
-    }
     if (const auto* point = dynamic_cast<const PointLight*>(&light)) {
       PointSource p;
       p.light = int32_t(l);

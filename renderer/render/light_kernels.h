@@ -2,10 +2,11 @@
 // Next-event light choices and light samples over arrays, for the wavefront driver's SIMD
 // stages: one path at a time a quad light's sample is a dependent chain of multiplies, a square
 // root and two divisions; over arrays eight or sixteen paths go at once. Static, untextured quad
-// lights (the emitters of most scenes) and a constant environment have kernels; a path that
-// chose any other light samples it with its scalar code. The values are the scalar code's to
-// the bit: the kernels are LightSampler::choose, Quad::sample with AreaLight::sample, and
-// ConstantEnvironment::sample operation for operation, compiled without contraction into fused
+// lights (the emitters of most scenes), point and directional lights have kernels; a path that
+// chose any other light samples it with its scalar code (the stages' path integrator never
+// chooses a constant environment: Light::left_to_bsdf_sampling). The values are the scalar
+// code's to the bit: the kernels are LightSampler::choose, Quad::sample with AreaLight::sample,
+// and PointLight::sample operation for operation, compiled without contraction into fused
 // multiply-adds (renderer/CMakeLists.txt).
 #include <cstddef>
 #include <cstdint>
@@ -31,7 +32,7 @@ template <class T>
 struct StagedLights {
   explicit StagedLights(const Scene& scene);
 
-  enum Kind : int32_t { kNotStaged, kQuad, kEnvironment, kPoint, kDirectional };
+  enum Kind : int32_t { kNotStaged, kQuad, kPoint, kDirectional };
   // A static, untextured quad light: what Quad::sample and AreaLight::sample read.
   struct QuadLight {
     int32_t light;
@@ -51,8 +52,6 @@ struct StagedLights {
   std::vector<DistantSource> distant;
   // Per light: its kind and its index in quads, points or distant.
   std::vector<int32_t> kind, index;
-  Spectrum environment{0.f};    // a ConstantEnvironment's radiance
-  int32_t environment_id = -1;  // its light index
 };
 
 // LightSampler::choose of u[i] into light[i], i < n (`cdf`: its table of `lights` entries).
@@ -75,10 +74,5 @@ void point_light_samples(const float* position, const float* intensity, int32_t 
                          float* distance, float* pdf, float* p_x, float* p_y, float* p_z,
                          float* value_x, float* value_y, float* value_z);
 
-// ConstantEnvironment::sample's direction (square_to_uniform_sphere) for the entries whose
-// light is `id`; its distance, value and pdf are the light's constants.
-void uniform_sphere_samples(int32_t id, size_t n, const int32_t* light, const float* u_x,
-                            const float* u_y, int32_t* ok, float* wi_x, float* wi_y,
-                            float* wi_z);
 
 }  // namespace penumbra

@@ -376,20 +376,16 @@ void SurfaceStage::compute(const IntegratorSettings& settings, bool scene_next_e
                          l_distance_.data(), l_pdf_.data(), l_p_[0].data(), l_p_[1].data(),
                          l_p_[2].data(), l_error_[0].data(), l_error_[1].data(),
                          l_error_[2].data());
-    if (lights_.environment_id >= 0)
-      uniform_sphere_samples(lights_.environment_id, n, light_.data(), u_point_[0].data(),
-                             u_point_[1].data(), light_ok_.data(), l_wi_[0].data(),
-                             l_wi_[1].data(), l_wi_[2].data());
     for (const StagedLights::PointSource& q : lights_.points)
       point_light_samples(q.position, q.intensity, q.light, n, light_.data(), p_[0].data(),
                           p_[1].data(), p_[2].data(), light_ok_.data(), l_wi_[0].data(),
                           l_wi_[1].data(), l_wi_[2].data(), l_distance_.data(), l_pdf_.data(),
                           l_p_[0].data(), l_p_[1].data(), l_p_[2].data(), l_value_[0].data(),
                           l_value_[1].data(), l_value_[2].data());
-    // Each lane's light constants: a quad's normal and radiance; the environment's (no far
-    // end: infinite distance, zero point and normal, as ConstantEnvironment::sample leaves
-    // them); a point light's zero normal and error; a directional light's whole sample. Point
-    // and directional lights are deltas: no MIS weight.
+    // Each lane's light constants: a quad's normal and radiance; a point light's zero normal
+    // and error; a directional light's whole sample. Point and directional lights are deltas:
+    // no MIS weight. (No constant environment: the path integrator, the stages' only user,
+    // leaves it to BSDF sampling and never chooses it.)
     for (size_t i = 0; i < n; ++i) {
       const int32_t light = light_[i];
       const size_t index = size_t(lights_.index[size_t(light)]);
@@ -404,16 +400,6 @@ void SurfaceStage::compute(const IntegratorSettings& settings, bool scene_next_e
           }
           break;
         }
-        case StagedLights::kEnvironment:
-          l_distance_[i] = kInfinity;
-          l_pdf_[i] = uniform_sphere_pdf();
-          for (int c = 0; c < 3; ++c) {
-            l_n_[c][i] = 0.f;
-            l_p_[c][i] = 0.f;
-            l_error_[c][i] = 0.f;
-            l_value_[c][i] = lights_.environment[c];
-          }
-          break;
         case StagedLights::kPoint:
           l_delta_[i] = 1;
           for (int c = 0; c < 3; ++c) {
