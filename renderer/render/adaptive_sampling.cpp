@@ -43,20 +43,24 @@ std::vector<uint32_t> adaptive_sample_limits(const std::vector<double>& deviatio
   const auto count_at = [&](double c, size_t i) {
     return std::isfinite(judged[i]) ? std::clamp(std::ceil(judged[i] * c), lo, hi) : hi;
   };
+  // The pixels that enter the image's error: both deviations known.
+  const auto counted = [&](size_t i) { return std::isfinite(deviation[i]) && std::isfinite(judged[i]); };
+  // Pixel i's term s_i^2 / n_i of the image's error at scale c.
+  const auto term = [&](double c, size_t i) { return deviation[i] * deviation[i] / count_at(c, i); };
+  const auto sum_terms = [&](double c) {
+    double sum = 0.0;
+    for (size_t i = 0; i < judged.size(); ++i)
+      if (counted(i)) sum += term(c, i);
+    return sum;
+  };
   double own_over_judged = 0.0;
   size_t finite = 0;
   for (size_t i = 0; i < judged.size(); ++i)
-    if (std::isfinite(deviation[i]) && std::isfinite(judged[i])) {
+    if (counted(i)) {
       if (judged[i] > 0.0) own_over_judged += deviation[i] * deviation[i] / judged[i];
       ++finite;
     }
-  const auto predicted = [&](double c) {
-    double sum = 0.0;
-    for (size_t i = 0; i < judged.size(); ++i)
-      if (std::isfinite(deviation[i]) && std::isfinite(judged[i]))
-        sum += deviation[i] * deviation[i] / count_at(c, i);
-    return sum / double(std::max<size_t>(finite, 1));
-  };
+  const auto predicted = [&](double c) { return sum_terms(c) / double(std::max<size_t>(finite, 1)); };
   // The unclamped solution, sum(s^2 / j) / (N t^2), brackets the answer within the clamping's
   // reach: bisect on log c between it / (hi / lo) and it * (hi / lo) (clamping at lo only lowers
   // the error, at hi only raises it).
@@ -78,17 +82,12 @@ std::vector<uint32_t> adaptive_sample_limits(const std::vector<double>& deviatio
   // i's s_i^2 / n_i among the others, which would let a pixel that met a bright outlier raise its
   // own count. Where the error falls as 1/c (no clamping) c is proportional to the sum of the
   // terms, so without pixel i it is c (T - t_i) / T * N / (N - 1), exactly.
-  double total = 0.0;
-  for (size_t i = 0; i < judged.size(); ++i)
-    if (std::isfinite(deviation[i]) && std::isfinite(judged[i]))
-      total += deviation[i] * deviation[i] / count_at(c, i);
+  const double total = sum_terms(c);
   std::vector<uint32_t> out(judged.size());
   for (size_t i = 0; i < judged.size(); ++i) {
     double ci = c;
-    if (finite > 1 && total > 0.0 && std::isfinite(deviation[i]) && std::isfinite(judged[i])) {
-      const double own = deviation[i] * deviation[i] / count_at(c, i);
-      ci = c * std::max(0.0, total - own) / total * double(finite) / double(finite - 1);
-    }
+    if (finite > 1 && total > 0.0 && counted(i))
+      ci = c * std::max(0.0, total - term(c, i)) / total * double(finite) / double(finite - 1);
     out[i] = uint32_t(count_at(ci, i));
   }
   return out;
