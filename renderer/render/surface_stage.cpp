@@ -1,6 +1,7 @@
 #include "renderer/render/surface_stage.h"
 
 #include <cmath>
+#include <algorithm>
 #include <cstring>
 #include <iterator>
 
@@ -245,61 +246,83 @@ void rough_dielectric_step_kernel(const Lanes& lanes, size_t n, bool next_event,
 
 }  // namespace
 
+bool SurfaceStage::fill_params(const SurfaceBsdf& b, SurfaceParams* q) const {
+  const BsdfModel& bsdf = b.model();
+  if (model_ == StageModel::kRoughDielectric || model_ == StageModel::kSmoothDielectric) {
+    // (The scene's transmission feature is what has path_scatter update eta; a dielectric
+    // implies it.)
+    const auto* dielectric = std::get_if<DielectricBsdf>(&bsdf);
+    if (!dielectric || dielectric->smooth() != (model_ == StageModel::kSmoothDielectric) ||
+        dielectric->index_matched() || !scene_.features().transmission)
+      return false;
+    q->colour = Spectrum(1.f);
+    q->alpha = dielectric->alpha();
+    q->eta = dielectric->ior();
+  } else if (!b.two_sided()) {
+    return false;
+  } else if (model_ == StageModel::kLambert) {
+    const auto* diffuse = std::get_if<DiffuseBsdf>(&bsdf);
+    if (!diffuse) return false;
+    q->colour = diffuse->albedo();
+  } else if (model_ == StageModel::kRoughConductor || model_ == StageModel::kSmoothConductor) {
+    const auto* conductor = std::get_if<ConductorBsdf>(&bsdf);
+    if (!conductor || conductor->smooth() != (model_ == StageModel::kSmoothConductor)) return false;
+    q->colour = conductor->albedo();
+    q->alpha = conductor->alpha();
+  } else {
+    const auto* plastic = std::get_if<PlasticBsdf>(&bsdf);
+    if (!plastic || plastic->smooth() != (model_ == StageModel::kSmoothPlastic)) return false;
+    q->colour = plastic->albedo();
+    q->alpha = plastic->alpha();
+    q->eta = plastic->eta();
+    q->spec_weight = plastic->specular_sampling_weight();
+    q->diffuse_scale = plastic->diffuse_scale();
+    if (model_ == StageModel::kRoughPlastic) {
+      const CoatingTables& t = plastic->tables();
+      if (!t.square_nodes) return false;  // adaptive nodes (ior < 1): bisection, left to the scalar step
+      size_t k = 0;
+      while (k < tables_.size() && tables_[k] != &t) ++k;
+      // A textured plastic keeps its coating's tables (only the colour varies), so a lookup
+      // at a hit finds them among those its material's own BSDF added here.
+      if (k == tables_.size()) return false;
+      q->table = int32_t(k * kCoatingTableCapacity);
+      q->nodes = t.nodes;
+    }
+  }
+  return is_finite(q->colour);
+}
+
 SurfaceStage::SurfaceStage(const Scene& scene, StageModel model)
     : scene_(scene), model_(model), lights_(scene) {
   params_of_.assign(scene.object_count(), -1);
-  std::vector<const CoatingTables*> tables;  // those in table_cosines_, in order
+  textured_of_.assign(scene.object_count(), 0);
+  // Where every light a path can choose lacks a kernel, each lane of a model that estimates
+  // direct light would go back to path_scatter after the stage's work: take nothing.
+  const LightSampler& sampler = scene.mis_light_sampler();
+  bool kernel_light = false;
+  for (int l = 0; l < int(lights_.kind.size()); ++l)
+    kernel_light |= lights_.kind[size_t(l)] != StagedLights::kNotStaged && sampler.pmf(l) > 0.f;
+  if (estimates_light(!sampler.empty()) && !kernel_light) return;
   for (size_t o = 0; o < scene.object_count(); ++o) {
     const Material& m = scene.material(scene.object(uint32_t(o)).material);
-    if (m.varies() || m.normal_mapped() || m.bsdf().normal_mapped()) continue;
-    SurfaceParams q;
-    const BsdfModel& bsdf = m.bsdf().model();
-    if (model == StageModel::kRoughDielectric || model == StageModel::kSmoothDielectric) {
-      // (The scene's transmission feature is what has path_scatter update eta; a dielectric
-      // implies it.)
-      const auto* dielectric = std::get_if<DielectricBsdf>(&bsdf);
-      if (!dielectric || dielectric->smooth() != (model == StageModel::kSmoothDielectric) ||
-          dielectric->index_matched() || !scene.features().transmission)
-        continue;
-      q.colour = Spectrum(1.f);
-      q.alpha = dielectric->alpha();
-      q.eta = dielectric->ior();
-    } else if (!m.bsdf().two_sided()) {
-      continue;
-    } else if (model == StageModel::kLambert) {
-      const auto* diffuse = std::get_if<DiffuseBsdf>(&bsdf);
-      if (!diffuse) continue;
-      q.colour = diffuse->albedo();
-    } else if (model == StageModel::kRoughConductor || model == StageModel::kSmoothConductor) {
-      const auto* conductor = std::get_if<ConductorBsdf>(&bsdf);
-      if (!conductor || conductor->smooth() != (model == StageModel::kSmoothConductor)) continue;
-      q.colour = conductor->albedo();
-      q.alpha = conductor->alpha();
-    } else {
-      const auto* plastic = std::get_if<PlasticBsdf>(&bsdf);
-      if (!plastic || plastic->smooth() != (model == StageModel::kSmoothPlastic)) continue;
-      q.colour = plastic->albedo();
-      q.alpha = plastic->alpha();
-      q.eta = plastic->eta();
-      q.spec_weight = plastic->specular_sampling_weight();
-      q.diffuse_scale = plastic->diffuse_scale();
-      if (model == StageModel::kRoughPlastic) {
+    if (m.normal_mapped() || m.bsdf().normal_mapped()) continue;
+    // A rough plastic's coating tables join the stage's list the first time a surface uses them.
+    if (model == StageModel::kRoughPlastic)
+      if (const auto* plastic = std::get_if<PlasticBsdf>(&m.bsdf().model());
+          plastic && plastic->tables().square_nodes &&
+          std::find(tables_.begin(), tables_.end(), &plastic->tables()) == tables_.end()) {
         const CoatingTables& t = plastic->tables();
-        if (!t.square_nodes) continue;  // adaptive nodes (ior < 1): bisection, left to the scalar step
-        size_t k = 0;
-        while (k < tables.size() && tables[k] != &t) ++k;
-        if (k == tables.size()) {
-          tables.push_back(&t);
-          table_cosines_.insert(table_cosines_.end(), t.cosines.begin(), t.cosines.end());
-          table_values_.insert(table_values_.end(), t.transmittance.begin(),
-                               t.transmittance.end());
-        }
-        q.table = int32_t(k * kCoatingTableCapacity);
-        q.nodes = t.nodes;
+        tables_.push_back(&t);
+        table_cosines_.insert(table_cosines_.end(), t.cosines.begin(), t.cosines.end());
+        table_values_.insert(table_values_.end(), t.transmittance.begin(), t.transmittance.end());
       }
-    }
-    if (!is_finite(q.colour)) continue;
+    // A textured material's parameters are looked up at each hit (add); its own BSDF, built
+    // from the textures' factors, has the model its hits have (a textured roughness that
+    // reaches zero makes a hit's lobe smooth: add leaves that hit to path_scatter).
+    SurfaceParams q;
+    if (!fill_params(m.bsdf(), &q)) continue;
     params_of_[o] = int32_t(params_.size());
+    textured_of_[o] = m.varies();
     params_.push_back(q);
   }
 }
@@ -318,7 +341,7 @@ void SurfaceStage::start(size_t paths) {
                   &l_distance_, &l_pdf_, &l_pmf_, &s_t_max_, &prev_pdf_, &eta_out_})
     a->resize(paths);
   for (auto* a : {&table_, &nodes_, &depth_, &light_, &light_ok_, &l_delta_, &staged_, &alive_,
-                  &has_shadow_, &nee_ray_, &dims_, &prev_delta_})
+                  &has_shadow_, &nee_ray_, &dims_, &prev_delta_, &fits_})
     a->resize(paths);
 }
 
@@ -326,7 +349,17 @@ void SurfaceStage::add(uint32_t slot, const PathState& s, const SurfaceHit& hit,
                        const float* y, bool next_event) {
   const size_t i = count_++;
   slot_[i] = slot;
-  const SurfaceParams& q = params_[size_t(params_of_[hit.object])];
+  SurfaceParams textured;
+  const SurfaceParams* params = &params_[size_t(params_of_[hit.object])];
+  fits_[i] = 1;
+  if (textured_of_[hit.object]) {
+    // path_scatter's lookup, at the same point: the same parameters to the bit.
+    const Material& m = scene_.material(scene_.object(hit.object).material);
+    textured = *params;
+    fits_[i] = fill_params(m.bsdf_at(TextureQuery{hit.p, hit.uv, s.ray.time}), &textured);
+    params = &textured;
+  }
+  const SurfaceParams& q = *params;
   for (int c = 0; c < 3; ++c) {
     p_[c][i] = hit.p[c];
     p_error_[c][i] = hit.p_error[c];
@@ -364,7 +397,7 @@ void SurfaceStage::compute(const IntegratorSettings& settings, bool scene_next_e
   const bool next_event = estimates_light(scene_next_event);
   const size_t n = count_;
   if (n == 0) return;
-  for (size_t i = 0; i < n; ++i) staged_[i] = 1;
+  for (size_t i = 0; i < n; ++i) staged_[i] = fits_[i];
   const LightSampler& sampler = scene_.mis_light_sampler();  // stages: path integrator
   if (next_event) {
     choose_lights(sampler.cdf().data(), int32_t(sampler.cdf().size()), n, u_light_.data(),

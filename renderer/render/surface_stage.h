@@ -1,7 +1,7 @@
 #pragma once
-// The wavefront driver's surface stages: the step of every path that hit a plain surface of one
-// BSDF model (constant parameters, no normal map: Lambertian, conductors, plastics and
-// dielectrics), after its
+// The wavefront driver's surface stages: the step of every path that hit a surface of one
+// BSDF model (Lambertian, conductors, plastics and dielectrics, constant or textured parameters,
+// no normal map), after its
 // emission, as loops over arrays: the light choice and light sample (light_kernels.h), the
 // BSDF's value, pdf and MIS weight towards the light, the shadow ray and its contribution, then
 // the BSDF's sample (lane_bsdfs.h), the throughput, the spawned ray and Russian roulette. One
@@ -46,8 +46,9 @@ class SurfaceStage {
   const Scene& scene() const { return scene_; }
   StageModel model() const { return model_; }
 
-  // Whether the stage can take hits on `object`: its material is a plain one of the stage's
-  // model (constant finite parameters, no normal map).
+  // Whether the stage can take hits on `object`: its material is one of the stage's model, no
+  // normal map (textured parameters are looked up per hit in add; a hit whose looked-up
+  // parameters leave the model, such as a roughness texture at zero, is not `staged`).
   bool takes(uint32_t object) const { return params_of_[object] >= 0; }
 
   // Empty, with room for `paths` lanes.
@@ -86,19 +87,26 @@ class SurfaceStage {
            model_ != StageModel::kSmoothDielectric;
   }
 
-  const Scene& scene_;
-  StageModel model_;
-  StagedLights lights_;
   // A surface's constants (lane::Params without the tables).
   struct SurfaceParams {
     Spectrum colour;
     float alpha = 0.f, eta = 1.f, spec_weight = 0.f, diffuse_scale = 0.f;
     int32_t table = 0, nodes = 0;
   };
+  // q's fields for this stage's model from BSDF b; false if b is not of the model (or has a
+  // non-finite colour, or coating tables the stage does not hold).
+  bool fill_params(const SurfaceBsdf& b, SurfaceParams* q) const;
+
+  const Scene& scene_;
+  StageModel model_;
+  StagedLights lights_;
   std::vector<int32_t> params_of_;  // per object: index into params_, or -1
+  // Per object: whether its material is textured (parameters looked up at each hit).
+  std::vector<uint8_t> textured_of_;
   std::vector<SurfaceParams> params_;
-  // The rough plastics' coating tables, one after another (lane::Tables).
+  // The rough plastics' coating tables, one after another (lane::Tables), and whose they are.
   std::vector<float> table_cosines_, table_values_;
+  std::vector<const CoatingTables*> tables_;
   size_t count_ = 0;
   std::vector<uint32_t> slot_;
   // Inputs per lane.
@@ -111,6 +119,8 @@ class SurfaceStage {
   std::vector<int32_t> light_, light_ok_, l_delta_;
   std::vector<float> l_wi_[3], l_distance_, l_pdf_, l_p_[3], l_error_[3], l_n_[3], l_value_[3], l_pmf_;
   // Results per lane.
+  // Whether a lane's parameters fit the model (a textured hit's may not).
+  std::vector<int32_t> fits_;
   std::vector<int32_t> staged_, alive_, has_shadow_, nee_ray_, dims_, prev_delta_;
   std::vector<float> s_origin_[3], s_dir_[3], s_t_max_, s_contrib_[3];
   std::vector<float> origin_[3], wo_[3], beta_out_[3], prev_pdf_, eta_out_;

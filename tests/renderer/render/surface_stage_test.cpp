@@ -23,6 +23,7 @@
 #include "renderer/sampling/sobol_batch.h"
 #include "renderer/scene/scene.h"
 #include "tests/renderer/render/render_test_util.h"
+#include "tests/renderer/textures/texture_test_util.h"
 
 namespace penumbra::test {
 namespace {
@@ -149,9 +150,9 @@ struct Coverage {
   int delta_lights = 0;  // staged lanes whose chosen light is a point or directional light
 };
 
-Coverage expect_stage_matches_scatter(bool lights, uint32_t seed, StageModel model,
-                                      float roughness = 0.f, float ior = 1.5f) {
-  const auto scene = Scene::build(floor_scene(lights, stage_material(model, roughness, ior)));
+Coverage expect_stage_matches_material(bool lights, uint32_t seed, StageModel model,
+                                       const MaterialParams& material) {
+  const auto scene = Scene::build(floor_scene(lights, material));
   IntegratorSettings settings;
   settings.max_depth = 16;
   settings.rr_depth = 4;
@@ -228,6 +229,12 @@ Coverage expect_stage_matches_scatter(bool lights, uint32_t seed, StageModel mod
     EXPECT_TRUE(same_bits(staged.radiance, s.radiance));
   }
   return cover;
+}
+
+Coverage expect_stage_matches_scatter(bool lights, uint32_t seed, StageModel model,
+                                      float roughness = 0.f, float ior = 1.5f) {
+  return expect_stage_matches_material(lights, seed, model,
+                                       stage_material(model, roughness, ior));
 }
 
 TEST(SurfaceStage, LambertStepIsPathScatterToTheBitWithAreaDeltaAndUnstagedLights) {
@@ -378,6 +385,58 @@ TEST(SurfaceStage, MirrorAndSmoothDielectricStepsArePathScatterToTheBit) {
   }
 }
 
+// Textured parameters, looked up per hit by the stage (add) as path_scatter looks them up: a
+// colour texture and a roughness texture whose texels reach 0 (where a conductor's or a
+// dielectric's lobe turns into the smooth model's Dirac delta, which the rough stage leaves to
+// path_scatter: fallback lanes besides the sphere light's).
+TEST(SurfaceStage, TexturedSurfacesArePathScatterToTheBit) {
+  TempFolder dir("surface_stage_textures");
+  std::mt19937 rng(41);
+  std::uniform_real_distribution<float> u(0.f, 1.f);
+  std::vector<float> colour(8 * 8 * 3), rough(8 * 8);
+  for (float& c : colour) c = u(rng);
+  for (size_t k = 0; k < rough.size(); ++k) rough[k] = k % 8 < 3 ? 0.f : u(rng);
+  write_test_image(dir.file("colour.exr"), 8, 8, 3, colour);
+  write_test_image(dir.file("rough.exr"), 8, 8, 1, rough);
+  auto texture = [&](const std::string& name, TextureFilter filter) {
+    ImageTextureDesc d;
+    d.path = dir.file(name);
+    d.colorspace = TextureColorspace::kLinear;
+    d.filter = filter;
+    return d;
+  };
+  const ImageTextureDesc c = texture("colour.exr", TextureFilter::kBilinear);
+  const ImageTextureDesc r = texture("rough.exr", TextureFilter::kNearest);
+  struct Case {
+    const char* name;
+    StageModel model;
+    MaterialParams material;
+    bool smooth_texels;  // whether some hits leave the stage's model
+  };
+  const Case cases[] = {
+      {"diffuse", StageModel::kLambert, DiffuseParams{Spectrum(0.9f), c}, false},
+      {"conductor", StageModel::kRoughConductor,
+       ConductorParams{Spectrum(0.9f, 0.8f, 0.7f), 0.7f, c, r}, true},
+      {"smooth plastic", StageModel::kSmoothPlastic, PlasticParams{Spectrum(1.f), 1.5f, 0.f, c},
+       false},
+      {"rough plastic", StageModel::kRoughPlastic, PlasticParams{Spectrum(0.8f), 1.5f, 0.3f, c},
+       false},
+      {"dielectric", StageModel::kRoughDielectric, DielectricParams{1.5f, 0.6f, Spectrum(0.f), r},
+       true},
+  };
+  for (const Case& k : cases) {
+    SCOPED_TRACE(k.name);
+    const Coverage cv = expect_stage_matches_material(true, 43, k.model, k.material);
+    // (Three columns of eight texels are smooth: about two fifths of the hits fall back.)
+    EXPECT_GT(cv.staged, k.smooth_texels ? 700 : 1000);
+    EXPECT_GT(cv.shadows, 100);
+    EXPECT_GT(cv.alive, 300);
+    EXPECT_GT(cv.ball, k.smooth_texels ? 250 : 500);
+    // Otherwise only the sphere light's lanes fall back (a few percent).
+    if (k.smooth_texels) EXPECT_GT(cv.fallback, 400);
+  }
+}
+
 // Which of the scene's objects a stage of `model` takes, one digit per object.
 std::string taken(const Scene& scene, StageModel model) {
   const SurfaceStage stage(scene, model);
@@ -406,6 +465,24 @@ TEST(SurfaceStage, TakesOnlyPlainSurfacesOfItsModel) {
   EXPECT_EQ(taken(*scene, StageModel::kSmoothPlastic), "0000100");
   EXPECT_EQ(taken(*scene, StageModel::kRoughPlastic), "0000010");
   EXPECT_EQ(taken(*scene, StageModel::kRoughDielectric), "0000000");
+}
+
+// With lights of which none has a kernel (here an emitting sphere), every lane of a model that
+// estimates direct light would go back to path_scatter: such stages take nothing; a mirror's
+// step samples no light and stays.
+TEST(SurfaceStage, TakesNothingThatEstimatesLightWhenNoLightHasAKernel) {
+  SceneInput in = floor_scene(false, DiffuseParams{Spectrum(0.5f)});
+  in.materials.push_back(ConductorParams{Spectrum(0.9f), 0.f});
+  in.objects.push_back(quad_object({-2, 1, 2}, {4, 0, 0}, {0, 0, -4}, 2));
+  in.objects.push_back(sphere_object({2.f, 2.5f, -1.5f}, 0.3f, 1, Spectrum(3.f)));
+  const auto scene = Scene::build(in);
+  ASSERT_FALSE(scene->mis_light_sampler().empty());
+  EXPECT_EQ(taken(*scene, StageModel::kLambert), "0000");
+  EXPECT_EQ(taken(*scene, StageModel::kSmoothConductor), "0010");
+  // A quad light beside it gives the Lambertian stage work again (the lights' own black
+  // Lambertian surfaces too).
+  in.objects.push_back(quad_object({-0.5f, 2, -0.5f}, {1, 0, 0}, {0, 0, 1}, 1, Spectrum(5.f)));
+  EXPECT_EQ(taken(*Scene::build(in), StageModel::kLambert), "11011");
 }
 
 TEST(SurfaceStage, TakesDielectricsThatRefractByTheirRoughness) {
