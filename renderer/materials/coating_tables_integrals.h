@@ -9,7 +9,9 @@
 // disk under the concentric map (a sincos per node) -- and what depends on it only through the
 // stretched view vector (Heitz 2018's frame t1, t2, vh and the squeeze s) is one setup per
 // cosine. Both are hoisted here: per node there remain the squeeze, the unstretch, the
-// normalisation and the Fresnel and Smith factors.
+// normalisation and the Fresnel and Smith factors, which one loop computes for all nodes in SIMD
+// lanes (materials/lane_microfacet.h, the scalar functions' operations in their order, no FMA
+// contraction) before the terms are summed in double in the generic order.
 #include <vector>
 
 #include "renderer/materials/microfacet.h"
@@ -29,18 +31,17 @@ class VisibleNormalQuadrature {
   int res() const { return res_; }
 
  private:
-  struct Node {
-    float p1;        // disk point along t1
-    float p1_slack;  // 1 - p1^2, the disk's half-height at p1 squared
-    float p1_root;   // safe_sqrt(1 - p1^2)
-    float py;        // disk point along t2 before the squeeze
-    double weight;   // w_a w_b / 4: the product rule on [0, 1]^2
-  };
-  template <typename Fn>
-  float integrate(const GgxDistribution& distr, float cos_i, Fn fn) const;
+  enum class Integrand { kReflectance, kTransmittance };
+  float integrate(const GgxDistribution& distr, float cos_i, float eta, Integrand what) const;
 
   int res_;
-  std::vector<Node> nodes_;  // row-major in (a, b), the generic integral's order of summation
+  // The nodes, row-major in (a, b) (the generic integral's order of summation), one array per
+  // quantity so the per-node terms are computed in SIMD lanes:
+  std::vector<float> p1_;        // disk point along t1
+  std::vector<float> p1_slack_;  // 1 - p1^2, the disk's half-height at p1 squared
+  std::vector<float> p1_root_;   // safe_sqrt(1 - p1^2)
+  std::vector<float> py_;        // disk point along t2 before the squeeze
+  std::vector<double> weight_;   // w_a w_b / 4: the product rule on [0, 1]^2
 };
 
 // The rule at the res microfacet.cpp uses for a coating of relative ior eta (32 above 1, 64 at

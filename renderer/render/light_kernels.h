@@ -12,21 +12,11 @@
 #include <cstdint>
 #include <vector>
 
+#include "renderer/core/lane.h"
 #include "renderer/core/math.h"
 #include "renderer/scene/scene.h"
 
 namespace penumbra {
-
-// A lane's condition as an integer mask (all bits or none), for the stages' loops over arrays:
-// conditions combine with integer &, | and ~, and only selects read them, both sides computed,
-// so the loops if-convert. (Combined as bools, GCC 12 turns some of them into selects between
-// bools, which its vectoriser does not support.)
-using Mask = int32_t;
-[[gnu::always_inline]] inline Mask mask(bool b) { return b ? -1 : 0; }
-template <class T>
-[[gnu::always_inline]] inline T when(Mask m, T a, T b) {
-  return m != 0 ? a : b;
-}
 
 // The scene's lights as the kernels see them.
 struct StagedLights {
