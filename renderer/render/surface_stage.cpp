@@ -1,7 +1,7 @@
 #include "renderer/render/surface_stage.h"
 
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <iterator>
 

@@ -118,9 +118,9 @@ class SurfaceStage {
   // The light sample per lane.
   std::vector<int32_t> light_, light_ok_, l_delta_;
   std::vector<float> l_wi_[3], l_distance_, l_pdf_, l_p_[3], l_error_[3], l_n_[3], l_value_[3], l_pmf_;
-  // Results per lane.
   // Whether a lane's parameters fit the model (a textured hit's may not).
   std::vector<int32_t> fits_;
+  // Results per lane.
   std::vector<int32_t> staged_, alive_, has_shadow_, nee_ray_, dims_, prev_delta_;
   std::vector<float> s_origin_[3], s_dir_[3], s_t_max_, s_contrib_[3];
   std::vector<float> origin_[3], wo_[3], beta_out_[3], prev_pdf_, eta_out_;
