@@ -32,6 +32,8 @@ class SurfaceBsdf {
   // the terminator.
   void set_mapped_normal(const vec3& n);
   bool normal_mapped() const { return normal_mapped_; }
+  // The normal set_mapped_normal set (2 rgb - 1 as the map gives it, not normalised).
+  const vec3& mapped_normal() const { return mapped_normal_; }
   // The normal the model is evaluated with for incident direction wi, in the shading frame:
   // +z, or the mapped normal as perturbed_frame adjusts it (for the "normal" output layer).
   vec3 shading_normal(const vec3& wi) const {

@@ -68,6 +68,10 @@ struct Lanes {
   const float *colour[3], *alpha, *coat_eta, *spec_weight, *diffuse_scale;
   const int32_t *table, *nodes;
   lane::Tables tables;
+  // Normal-mapped lanes: whether, the tangent frame's s and t (path_step.h tangent_frame; its
+  // n is ns) and the mapped normal (SurfaceBsdf::mapped_normal).
+  const int32_t* mapped;
+  const float *frame_s[3], *frame_t[3], *mapped_n[3];
   const float *time, *eta, *u_lobe, *u_dir[2], *u_rr;
   const int32_t* depth;
   const int32_t *light_ok, *l_delta;
@@ -77,9 +81,66 @@ struct Lanes {
   float *origin[3], *wo[3], *beta_out[3], *prev_pdf, *eta_out;
 };
 
-// path_scatter of the path integrator on a two-sided `Model` (lane_bsdfs.h) without a normal
-// map, lane by lane (see the header). `next_event`: whether the step samples a light.
-template <class Model, bool kNextEvent>
+// SurfaceBsdf's normal map (materials/surface_bsdf.cpp) on one lane: the perturbed frame of
+// mapped normal m for the (front-mirrored) direction a, and the shadow terminator.
+struct PerturbedFrame {
+  float s[3], t[3], n[3];
+};
+[[gnu::always_inline]] inline PerturbedFrame perturbed_frame(const float* m, const float* a) {
+  // Mirrored about the unperturbed normal where it faces away from a.
+  const Mask away = mask(a[2] * lane::dot3(a, m) <= 0.f);
+  float n[3] = {when(away, -m[0], m[0]), when(away, -m[1], m[1]), m[2]};
+  const float len = std::sqrt(lane::dot3(n, n));
+  const Mask some = mask(len > 1e-6f);
+  for (int c = 0; c < 3; ++c) n[c] = when(some, n[c] / len, c == 2 ? 1.f : 0.f);
+  // Mitsuba's tangent: +x made orthogonal to n; Frame(n) (Duff et al. 2017) where it degenerates.
+  const float r[3] = {1.f - n[0] * n[0], 0.f - n[1] * n[0], 0.f - n[2] * n[0]};
+  const float ls = std::sqrt(lane::dot3(r, r));
+  const Mask tangent = mask(ls > 1e-6f);
+  const float sign = std::copysign(1.f, n[2]);
+  const float fa = -1.f / (sign + n[2]);
+  const float fb = n[0] * n[1] * fa;
+  const float ds[3] = {1.f + sign * n[0] * n[0] * fa, sign * fb, -sign * n[0]};
+  const float dt[3] = {fb, sign + n[1] * n[1] * fa, -n[1]};
+  const float ts[3] = {r[0] / ls, r[1] / ls, r[2] / ls};
+  // glm::cross(n, ts).
+  const float tt[3] = {n[1] * ts[2] - ts[1] * n[2], n[2] * ts[0] - ts[2] * n[0],
+                       n[0] * ts[1] - ts[0] * n[1]};
+  PerturbedFrame f;
+  for (int c = 0; c < 3; ++c) {
+    f.n[c] = n[c];
+    f.s[c] = when(tangent, ts[c], ds[c]);
+    f.t[c] = when(tangent, tt[c], dt[c]);
+  }
+  return f;
+}
+// tan^2 of v's angle to +z: max(0, 1 - c^2) / c^2.
+[[gnu::always_inline]] inline float tan2_theta(const float* v) {
+  const float c2 = v[2] * v[2];
+  const float s2 = 1.f - c2;
+  return (0.f < s2 ? s2 : 0.f) / c2;
+}
+// shadow_terminator (Estevez et al. 2019, eq. 3-4) of perturbed normal n towards v.
+[[gnu::always_inline]] inline float shadow_terminator(const float* n, const float* v) {
+  const float x = 0.125f * tan2_theta(n);
+  const float alpha2 = 1.f < x ? 1.f : x;
+  const float g = 2.f / (1.f + std::sqrt(1.f + alpha2 * tan2_theta(v)));
+  return when(mask(alpha2 > 0.f), g, 1.f);
+}
+// Frame::to_local and to_world.
+[[gnu::always_inline]] inline void to_local(const PerturbedFrame& f, const float* v, float* out) {
+  out[0] = lane::dot3(v, f.s);
+  out[1] = lane::dot3(v, f.t);
+  out[2] = lane::dot3(v, f.n);
+}
+[[gnu::always_inline]] inline void to_world(const PerturbedFrame& f, const float* v, float* out) {
+  for (int c = 0; c < 3; ++c) out[c] = (f.s[c] * v[0] + f.t[c] * v[1]) + f.n[c] * v[2];
+}
+
+// path_scatter of the path integrator on a `Model` (lane_bsdfs.h), lane by lane (see the
+// header). `next_event`: whether the step samples a light; `kMapped`: whether some lanes are
+// normal-mapped (SurfaceBsdf's evaluate_mapped and sample_mapped in the perturbed frame).
+template <class Model, bool kNextEvent, bool kMapped>
 [[gnu::always_inline]] inline void surface_step(const Lanes& lanes, size_t n, int32_t rr_depth) {
   // A local copy: stores through the result pointers cannot then change the pointers, which
   // GCC would otherwise reload every iteration (and not vectorise).
@@ -107,8 +168,18 @@ template <class Model, bool kNextEvent>
     const float sign = std::copysign(1.f, nz);
     const float fa = -1.f / (sign + nz);
     const float fb = nx * ny * fa;
-    const float sx = 1.f + sign * nx * nx * fa, sy = sign * fb, sz = -sign * nx;
-    const float tx = fb, ty = sign + ny * ny * fa, tz = -ny;
+    float sx = 1.f + sign * nx * nx * fa, sy = sign * fb, sz = -sign * nx;
+    float tx = fb, ty = sign + ny * ny * fa, tz = -ny;
+    // A normal-mapped surface's frame follows dp/du (tangent_frame, computed in add).
+    const Mask mapped = kMapped ? L.mapped[i] : 0;
+    if constexpr (kMapped) {
+      sx = when(mapped, L.frame_s[0][i], sx);
+      sy = when(mapped, L.frame_s[1][i], sy);
+      sz = when(mapped, L.frame_s[2][i], sz);
+      tx = when(mapped, L.frame_t[0][i], tx);
+      ty = when(mapped, L.frame_t[1][i], ty);
+      tz = when(mapped, L.frame_t[2][i], tz);
+    }
     // wi = -direction, in world and local coordinates (Frame::to_local).
     const float wx = -L.dir[0][i], wy = -L.dir[1][i], wz = -L.dir[2][i];
     const float wi_x = (wx * sx + wy * sy) + wz * sz;
@@ -126,7 +197,28 @@ template <class Model, bool kNextEvent>
     const float lo_z = (lx * nx + ly * ny) + lz * nz;
     const Mask l_agrees = agrees(wx, wy, wz, lx, ly, lz, gx, gy, gz, wi_z, lo_z);
     const float b[3] = {lo_x, lo_y, when(flip, -lo_z, lo_z)};
-    const lane::EvalPdf e = Model::eval_pdf(q, a, b);
+    // A normal-mapped lane's model answers in the perturbed frame P of a (evaluate_mapped: zero
+    // unless b lies on the same side of P as of the surface; the value times the terminator).
+    PerturbedFrame pf;
+    float a_in[3] = {a[0], a[1], a[2]}, b_in[3] = {b[0], b[1], b[2]};
+    if constexpr (kMapped) {
+      const float mn[3] = {L.mapped_n[0][i], L.mapped_n[1][i], L.mapped_n[2][i]};
+      pf = perturbed_frame(mn, a);
+      float ap[3], bp[3];
+      to_local(pf, a, ap);
+      to_local(pf, b, bp);
+      for (int c = 0; c < 3; ++c) {
+        a_in[c] = when(mapped, ap[c], a[c]);
+        b_in[c] = when(mapped, bp[c], b[c]);
+      }
+    }
+    lane::EvalPdf e = Model::eval_pdf(q, a_in, b_in);
+    if constexpr (kMapped) {
+      const Mask side = mask(b[2] * b_in[2] > 0.f);
+      const float term = shadow_terminator(pf.n, b);
+      for (int c = 0; c < 3; ++c) e.f[c] = when(mapped, when(side, e.f[c] * term, 0.f), e.f[c]);
+      e.pdf = when(mapped & ~side, 0.f, e.pdf);
+    }
     // power_heuristic(l_pdf, e.pdf), or 1 for a delta light (path_scatter takes eval alone,
     // whose value is eval_pdf's).
     const float h_a = l_pdf * l_pdf, h_b = e.pdf * e.pdf;
@@ -166,7 +258,23 @@ template <class Model, bool kNextEvent>
     L.has_shadow[i] = nee & mask(t_max > 0.f);
 
     // The BSDF's sample, its direction mirrored back to the side wi came from.
-    const lane::Sample bs = Model::sample(q, a, L.u_lobe[i], L.u_dir[0][i], L.u_dir[1][i]);
+    lane::Sample bs = Model::sample(q, a_in, L.u_lobe[i], L.u_dir[0][i], L.u_dir[1][i]);
+    if constexpr (kMapped) {
+      // sample_mapped: the direction back out of P, on the same side of both; the weight times
+      // the terminator; then SurfaceBsdf::sample's finiteness checks.
+      float w[3];
+      to_world(pf, bs.wo, w);
+      const float term = shadow_terminator(pf.n, w);
+      const float weight[3] = {bs.weight[0] * term, bs.weight[1] * term, bs.weight[2] * term};
+      const Mask ok = bs.ok & mask(w[2] * bs.wo[2] > 0.f) & lane::finite(weight[0]) &
+                      lane::finite(weight[1]) & lane::finite(weight[2]) & lane::finite(bs.pdf) &
+                      lane::finite(w[0]) & lane::finite(w[1]) & lane::finite(w[2]);
+      for (int c = 0; c < 3; ++c) {
+        bs.wo[c] = when(mapped, w[c], bs.wo[c]);
+        bs.weight[c] = when(mapped, weight[c], bs.weight[c]);
+      }
+      bs.ok = when(mapped, ok, bs.ok);
+    }
     const float wo_z = when(flip, -bs.wo[2], bs.wo[2]);
     const float ww_x = (sx * bs.wo[0] + tx * bs.wo[1]) + nx * wo_z;
     const float ww_y = (sy * bs.wo[0] + ty * bs.wo[1]) + ny * wo_z;
@@ -205,43 +313,53 @@ template <class Model, bool kNextEvent>
 // it).
 template <class Model>
 [[gnu::always_inline]] inline void step_cases(const Lanes& lanes, size_t n, bool next_event,
-                                              int32_t rr_depth) {
-  if (next_event && !Model::kDeltaOnly)
-    surface_step<Model, true>(lanes, n, rr_depth);
-  else
-    surface_step<Model, false>(lanes, n, rr_depth);
+                                              bool mapped, int32_t rr_depth) {
+  if (next_event && !Model::kDeltaOnly) {
+    if (mapped)
+      surface_step<Model, true, true>(lanes, n, rr_depth);
+    else
+      surface_step<Model, true, false>(lanes, n, rr_depth);
+  } else {
+    if (mapped)
+      surface_step<Model, false, true>(lanes, n, rr_depth);
+    else
+      surface_step<Model, false, false>(lanes, n, rr_depth);
+  }
 }
 PENUMBRA_SIMD_CLONES
-void lambert_step_kernel(const Lanes& lanes, size_t n, bool next_event, int32_t rr_depth) {
-  step_cases<lane::Lambert>(lanes, n, next_event, rr_depth);
+void lambert_step_kernel(const Lanes& lanes, size_t n, bool next_event, bool mapped,
+                         int32_t rr_depth) {
+  step_cases<lane::Lambert>(lanes, n, next_event, mapped, rr_depth);
 }
 PENUMBRA_SIMD_CLONES
-void rough_conductor_step_kernel(const Lanes& lanes, size_t n, bool next_event,
+void rough_conductor_step_kernel(const Lanes& lanes, size_t n, bool next_event, bool mapped,
                                  int32_t rr_depth) {
-  step_cases<lane::RoughConductor>(lanes, n, next_event, rr_depth);
+  step_cases<lane::RoughConductor>(lanes, n, next_event, mapped, rr_depth);
 }
 PENUMBRA_SIMD_CLONES
-void smooth_plastic_step_kernel(const Lanes& lanes, size_t n, bool next_event, int32_t rr_depth) {
-  step_cases<lane::SmoothPlastic>(lanes, n, next_event, rr_depth);
+void smooth_plastic_step_kernel(const Lanes& lanes, size_t n, bool next_event, bool mapped,
+                                int32_t rr_depth) {
+  step_cases<lane::SmoothPlastic>(lanes, n, next_event, mapped, rr_depth);
 }
 PENUMBRA_SIMD_CLONES
-void rough_plastic_step_kernel(const Lanes& lanes, size_t n, bool next_event, int32_t rr_depth) {
-  step_cases<lane::RoughPlastic>(lanes, n, next_event, rr_depth);
+void rough_plastic_step_kernel(const Lanes& lanes, size_t n, bool next_event, bool mapped,
+                               int32_t rr_depth) {
+  step_cases<lane::RoughPlastic>(lanes, n, next_event, mapped, rr_depth);
 }
 PENUMBRA_SIMD_CLONES
-void smooth_conductor_step_kernel(const Lanes& lanes, size_t n, bool next_event,
+void smooth_conductor_step_kernel(const Lanes& lanes, size_t n, bool next_event, bool mapped,
                                   int32_t rr_depth) {
-  step_cases<lane::SmoothConductor>(lanes, n, next_event, rr_depth);
+  step_cases<lane::SmoothConductor>(lanes, n, next_event, mapped, rr_depth);
 }
 PENUMBRA_SIMD_CLONES
-void smooth_dielectric_step_kernel(const Lanes& lanes, size_t n, bool next_event,
+void smooth_dielectric_step_kernel(const Lanes& lanes, size_t n, bool next_event, bool mapped,
                                    int32_t rr_depth) {
-  step_cases<lane::SmoothDielectric>(lanes, n, next_event, rr_depth);
+  step_cases<lane::SmoothDielectric>(lanes, n, next_event, mapped, rr_depth);
 }
 PENUMBRA_SIMD_CLONES
-void rough_dielectric_step_kernel(const Lanes& lanes, size_t n, bool next_event,
+void rough_dielectric_step_kernel(const Lanes& lanes, size_t n, bool next_event, bool mapped,
                                   int32_t rr_depth) {
-  step_cases<lane::RoughDielectric>(lanes, n, next_event, rr_depth);
+  step_cases<lane::RoughDielectric>(lanes, n, next_event, mapped, rr_depth);
 }
 
 }  // namespace
@@ -305,7 +423,6 @@ SurfaceStage::SurfaceStage(const Scene& scene, StageModel model)
   if (estimates_light(!sampler.empty()) && !kernel_light) return;
   for (size_t o = 0; o < scene.object_count(); ++o) {
     const Material& m = scene.material(scene.object(uint32_t(o)).material);
-    if (m.normal_mapped() || m.bsdf().normal_mapped()) continue;
     // A rough plastic's coating tables join the stage's list the first time a surface uses them.
     if (model == StageModel::kRoughPlastic)
       if (const auto* plastic = std::get_if<PlasticBsdf>(&m.bsdf().model());
@@ -322,26 +439,28 @@ SurfaceStage::SurfaceStage(const Scene& scene, StageModel model)
     SurfaceParams q;
     if (!fill_params(m.bsdf(), &q)) continue;
     params_of_[o] = int32_t(params_.size());
-    textured_of_[o] = m.varies();
+    textured_of_[o] = m.varies() || m.normal_mapped();
     params_.push_back(q);
   }
 }
 
 void SurfaceStage::start(size_t paths) {
   count_ = 0;
+  any_mapped_ = false;
   if (slot_.size() >= paths) return;
   slot_.resize(paths);
   for (int c = 0; c < 3; ++c)
     for (auto* a : {&p_[c], &p_error_[c], &ng_[c], &ns_[c], &dir_[c], &beta_[c], &colour_[c],
                     &l_wi_[c], &l_p_[c], &l_error_[c], &l_n_[c], &l_value_[c], &s_origin_[c],
-                    &s_dir_[c], &s_contrib_[c], &origin_[c], &wo_[c], &beta_out_[c]})
+                    &s_dir_[c], &s_contrib_[c], &origin_[c], &wo_[c], &beta_out_[c],
+                    &frame_s_[c], &frame_t_[c], &mapped_n_[c]})
       a->resize(paths);
   for (auto* a : {&alpha_, &coat_eta_, &spec_weight_, &diffuse_scale_, &time_, &eta_, &u_light_,
                   &u_point_[0], &u_point_[1], &u_lobe_, &u_dir_[0], &u_dir_[1], &u_rr_,
                   &l_distance_, &l_pdf_, &l_pmf_, &s_t_max_, &prev_pdf_, &eta_out_})
     a->resize(paths);
   for (auto* a : {&table_, &nodes_, &depth_, &light_, &light_ok_, &l_delta_, &staged_, &alive_,
-                  &has_shadow_, &nee_ray_, &dims_, &prev_delta_, &fits_})
+                  &has_shadow_, &nee_ray_, &dims_, &prev_delta_, &fits_, &mapped_})
     a->resize(paths);
 }
 
@@ -352,12 +471,26 @@ void SurfaceStage::add(uint32_t slot, const PathState& s, const SurfaceHit& hit,
   SurfaceParams textured;
   const SurfaceParams* params = &params_[size_t(params_of_[hit.object])];
   fits_[i] = 1;
+  mapped_[i] = 0;
   if (textured_of_[hit.object]) {
     // path_scatter's lookup, at the same point: the same parameters to the bit.
     const Material& m = scene_.material(scene_.object(hit.object).material);
     textured = *params;
-    fits_[i] = fill_params(m.bsdf_at(TextureQuery{hit.p, hit.uv, s.ray.time}), &textured);
+    const SurfaceBsdf b = m.bsdf_at(TextureQuery{hit.p, hit.uv, s.ray.time});
+    fits_[i] = fill_params(b, &textured);
     params = &textured;
+    if (b.normal_mapped()) {
+      // path_scatter's frame for a normal map, along dp/du (its n is the hit's ns).
+      SurfaceHit h = hit;
+      const Frame f = path_step_detail::tangent_frame(scene_, s.ray.time, &h);
+      mapped_[i] = -1;
+      any_mapped_ = true;
+      for (int c = 0; c < 3; ++c) {
+        frame_s_[c][i] = f.s[c];
+        frame_t_[c][i] = f.t[c];
+        mapped_n_[c][i] = b.mapped_normal()[c];
+      }
+    }
   }
   const SurfaceParams& q = *params;
   for (int c = 0; c < 3; ++c) {
@@ -491,6 +624,12 @@ void SurfaceStage::compute(const IntegratorSettings& settings, bool scene_next_e
   L.tables = lane::Tables{table_cosines_.data(), table_values_.data()};
   L.u_lobe = u_lobe_.data();
   L.time = time_.data();
+  L.mapped = mapped_.data();
+  for (int c = 0; c < 3; ++c) {
+    L.frame_s[c] = frame_s_[c].data();
+    L.frame_t[c] = frame_t_[c].data();
+    L.mapped_n[c] = mapped_n_[c].data();
+  }
   L.eta = eta_.data();
   L.u_dir[0] = u_dir_[0].data();
   L.u_dir[1] = u_dir_[1].data();
@@ -511,13 +650,13 @@ void SurfaceStage::compute(const IntegratorSettings& settings, bool scene_next_e
   L.prev_pdf = prev_pdf_.data();
   L.eta_out = eta_out_.data();
   // The kernels in StageModel's order.
-  using Kernel = void (*)(const Lanes&, size_t, bool, int32_t);
+  using Kernel = void (*)(const Lanes&, size_t, bool, bool, int32_t);
   static constexpr Kernel kKernels[] = {
       lambert_step_kernel,          rough_conductor_step_kernel,  smooth_plastic_step_kernel,
       rough_plastic_step_kernel,    rough_dielectric_step_kernel, smooth_conductor_step_kernel,
       smooth_dielectric_step_kernel};
   static_assert(std::size(kKernels) == std::size(kStageModels));
-  kKernels[size_t(model_)](L, n, next_event, int32_t(settings.rr_depth));
+  kKernels[size_t(model_)](L, n, next_event, any_mapped_, int32_t(settings.rr_depth));
 }
 
 void SurfaceStage::shadow(size_t i, ShadowQuery* q) const {

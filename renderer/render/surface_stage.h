@@ -120,6 +120,11 @@ class SurfaceStage {
   std::vector<float> l_wi_[3], l_distance_, l_pdf_, l_p_[3], l_error_[3], l_n_[3], l_value_[3], l_pmf_;
   // Whether a lane's parameters fit the model (a textured hit's may not).
   std::vector<int32_t> fits_;
+  // Normal-mapped lanes (mask), their tangent frames' s and t and mapped normals; whether any
+  // lane is (the kernels' mapped case costs the others nothing then).
+  std::vector<int32_t> mapped_;
+  std::vector<float> frame_s_[3], frame_t_[3], mapped_n_[3];
+  bool any_mapped_ = false;
   // Results per lane.
   std::vector<int32_t> staged_, alive_, has_shadow_, nee_ray_, dims_, prev_delta_;
   std::vector<float> s_origin_[3], s_dir_[3], s_t_max_, s_contrib_[3];

@@ -437,6 +437,64 @@ TEST(SurfaceStage, TexturedSurfacesArePathScatterToTheBit) {
   }
 }
 
+// Normal-mapped surfaces (SurfaceBsdf's normal map: the model in the perturbed frame of the
+// mapped normal for wi, the side conditions, the shadow terminator), every model with a stage,
+// against path_scatter bit for bit. The map's texels are random, one of them (0.5, 0.5, 0.5)
+// (no direction: the unperturbed normal), others steep (mirrored where they face away from wi).
+TEST(SurfaceStage, NormalMappedSurfacesArePathScatterToTheBit) {
+  TempFolder dir("surface_stage_normal_map");
+  std::mt19937 rng(47);
+  std::uniform_real_distribution<float> u(0.f, 1.f);
+  std::vector<float> texels(8 * 8 * 3);
+  for (float& t : texels) t = u(rng);
+  for (int c = 0; c < 3; ++c) texels[size_t(3 * 9 + c)] = 0.5f;  // texel (1, 1)
+  texels[3 * 20 + 2] = 0.5f;  // texel (4, 2): a normal in the tangent plane
+  write_test_image(dir.file("normal.exr"), 8, 8, 3, texels);
+  ImageTextureDesc map;
+  map.path = dir.file("normal.exr");
+  map.colorspace = TextureColorspace::kLinear;
+  map.filter = TextureFilter::kNearest;
+  struct Case {
+    const char* name;
+    StageModel model;
+    MaterialParams material;
+  };
+  DiffuseParams diffuse{Spectrum(0.8f, 0.6f, 0.4f)};
+  diffuse.normal_map = map;
+  ConductorParams rough{Spectrum(0.9f, 0.8f, 0.7f), 0.5f};
+  rough.normal_map = map;
+  ConductorParams mirror{Spectrum(0.9f), 0.f};
+  mirror.normal_map = map;
+  PlasticParams coat{Spectrum(0.5f, 0.3f, 0.2f), 1.5f, 0.3f};
+  coat.normal_map = map;
+  PlasticParams glaze{Spectrum(0.2f, 0.4f, 0.6f), 1.5f, 0.f};
+  glaze.normal_map = map;
+  DielectricParams frosted{1.5f, 0.4f};
+  frosted.normal_map = map;
+  DielectricParams glass{1.5f, 0.f};
+  glass.normal_map = map;
+  const Case cases[] = {
+      {"diffuse", StageModel::kLambert, diffuse},
+      {"rough conductor", StageModel::kRoughConductor, rough},
+      {"mirror", StageModel::kSmoothConductor, mirror},
+      {"rough plastic", StageModel::kRoughPlastic, coat},
+      {"smooth plastic", StageModel::kSmoothPlastic, glaze},
+      {"rough dielectric", StageModel::kRoughDielectric, frosted},
+      {"smooth dielectric", StageModel::kSmoothDielectric, glass},
+  };
+  for (const Case& k : cases) {
+    SCOPED_TRACE(k.name);
+    const Coverage cv = expect_stage_matches_material(true, 53, k.model, k.material);
+    EXPECT_GT(cv.staged, 1000);
+    EXPECT_GT(cv.alive, 200);  // (metals lose paths to the side conditions: 250-280)
+    EXPECT_GT(cv.dead, 50);
+    EXPECT_GT(cv.back, 200);
+    EXPECT_GT(cv.ball, 500);
+    const bool delta = k.model == StageModel::kSmoothConductor || k.model == StageModel::kSmoothDielectric;
+    if (!delta) EXPECT_GT(cv.shadows, 100);
+  }
+}
+
 // Which of the scene's objects a stage of `model` takes, one digit per object.
 std::string taken(const Scene& scene, StageModel model) {
   const SurfaceStage stage(scene, model);
