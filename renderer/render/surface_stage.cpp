@@ -446,7 +446,8 @@ SurfaceStage::SurfaceStage(const Scene& scene, StageModel model)
 
 void SurfaceStage::start(size_t paths) {
   count_ = 0;
-  any_mapped_ = false;
+  unfit_.clear();
+  mapped_lanes_.clear();
   if (slot_.size() >= paths) return;
   slot_.resize(paths);
   for (int c = 0; c < 3; ++c)
@@ -460,48 +461,12 @@ void SurfaceStage::start(size_t paths) {
                   &l_distance_, &l_pdf_, &l_pmf_, &s_t_max_, &prev_pdf_, &eta_out_})
     a->resize(paths);
   for (auto* a : {&table_, &nodes_, &depth_, &light_, &light_ok_, &l_delta_, &staged_, &alive_,
-                  &has_shadow_, &nee_ray_, &dims_, &prev_delta_, &fits_, &mapped_})
+                  &has_shadow_, &nee_ray_, &dims_, &prev_delta_, &mapped_})
     a->resize(paths);
 }
 
-void SurfaceStage::add(uint32_t slot, const PathState& s, const SurfaceHit& hit, const float* x,
-                       const float* y, bool next_event) {
-  const size_t i = count_++;
-  slot_[i] = slot;
-  SurfaceParams textured;
-  const SurfaceParams* params = &params_[size_t(params_of_[hit.object])];
-  fits_[i] = 1;
-  mapped_[i] = 0;
-  if (textured_of_[hit.object]) {
-    // path_scatter's lookup, at the same point: the same parameters to the bit.
-    const Material& m = scene_.material(scene_.object(hit.object).material);
-    textured = *params;
-    const SurfaceBsdf b = m.bsdf_at(TextureQuery{hit.p, hit.uv, s.ray.time});
-    fits_[i] = fill_params(b, &textured);
-    params = &textured;
-    if (b.normal_mapped()) {
-      // path_scatter's frame for a normal map, along dp/du (its n is the hit's ns).
-      SurfaceHit h = hit;
-      const Frame f = path_step_detail::tangent_frame(scene_, s.ray.time, &h);
-      mapped_[i] = -1;
-      any_mapped_ = true;
-      for (int c = 0; c < 3; ++c) {
-        frame_s_[c][i] = f.s[c];
-        frame_t_[c][i] = f.t[c];
-        mapped_n_[c][i] = b.mapped_normal()[c];
-      }
-    }
-  }
-  const SurfaceParams& q = *params;
-  for (int c = 0; c < 3; ++c) {
-    p_[c][i] = hit.p[c];
-    p_error_[c][i] = hit.p_error[c];
-    ng_[c][i] = hit.ng[c];
-    ns_[c][i] = hit.ns[c];
-    dir_[c][i] = s.ray.direction[c];
-    beta_[c][i] = s.beta[c];
-    colour_[c][i] = q.colour[c];
-  }
+void SurfaceStage::write_params(size_t i, const SurfaceParams& q) {
+  for (int c = 0; c < 3; ++c) colour_[c][i] = q.colour[c];
   // (Each model reads only its own constants: a Lambertian surface's colour alone.)
   if (model_ != StageModel::kLambert) {
     alpha_[i] = q.alpha;
@@ -510,6 +475,44 @@ void SurfaceStage::add(uint32_t slot, const PathState& s, const SurfaceHit& hit,
     diffuse_scale_[i] = q.diffuse_scale;
     table_[i] = q.table;
     nodes_[i] = q.nodes;
+  }
+}
+
+void SurfaceStage::add_textured(size_t i, const PathState& s, const SurfaceHit& hit) {
+  // path_scatter's lookup, at the same point: the same parameters to the bit.
+  const Material& m = scene_.material(scene_.object(hit.object).material);
+  SurfaceParams q = params_[size_t(params_of_[hit.object])];
+  const SurfaceBsdf b = m.bsdf_at(TextureQuery{hit.p, hit.uv, s.ray.time});
+  if (!fill_params(b, &q)) unfit_.push_back(uint32_t(i));
+  write_params(i, q);
+  if (b.normal_mapped()) {
+    // path_scatter's frame for a normal map, along dp/du (its n is the hit's ns).
+    SurfaceHit h = hit;
+    const Frame f = path_step_detail::tangent_frame(scene_, s.ray.time, &h);
+    mapped_lanes_.push_back(uint32_t(i));
+    for (int c = 0; c < 3; ++c) {
+      frame_s_[c][i] = f.s[c];
+      frame_t_[c][i] = f.t[c];
+      mapped_n_[c][i] = b.mapped_normal()[c];
+    }
+  }
+}
+
+void SurfaceStage::add(uint32_t slot, const PathState& s, const SurfaceHit& hit, const float* x,
+                       const float* y, bool next_event) {
+  const size_t i = count_++;
+  slot_[i] = slot;
+  if (textured_of_[hit.object])
+    add_textured(i, s, hit);
+  else
+    write_params(i, params_[size_t(params_of_[hit.object])]);
+  for (int c = 0; c < 3; ++c) {
+    p_[c][i] = hit.p[c];
+    p_error_[c][i] = hit.p_error[c];
+    ng_[c][i] = hit.ng[c];
+    ns_[c][i] = hit.ns[c];
+    dir_[c][i] = s.ray.direction[c];
+    beta_[c][i] = s.beta[c];
   }
   time_[i] = s.ray.time;
   eta_[i] = s.eta;
@@ -530,7 +533,15 @@ void SurfaceStage::compute(const IntegratorSettings& settings, bool scene_next_e
   const bool next_event = estimates_light(scene_next_event);
   const size_t n = count_;
   if (n == 0) return;
-  for (size_t i = 0; i < n; ++i) staged_[i] = fits_[i];
+  // Lanes are staged unless their parameters leave the model; normal-mapped lanes are marked
+  // (listed by add, which so writes nothing per plain lane).
+  for (size_t i = 0; i < n; ++i) staged_[i] = 1;
+  for (const uint32_t i : unfit_) staged_[i] = 0;
+  const bool any_mapped = !mapped_lanes_.empty();
+  if (any_mapped) {
+    for (size_t i = 0; i < n; ++i) mapped_[i] = 0;
+    for (const uint32_t i : mapped_lanes_) mapped_[i] = -1;
+  }
   const LightSampler& sampler = scene_.mis_light_sampler();  // stages: path integrator
   if (next_event) {
     choose_lights(sampler.cdf().data(), int32_t(sampler.cdf().size()), n, u_light_.data(),
@@ -656,7 +667,7 @@ void SurfaceStage::compute(const IntegratorSettings& settings, bool scene_next_e
       rough_plastic_step_kernel,    rough_dielectric_step_kernel, smooth_conductor_step_kernel,
       smooth_dielectric_step_kernel};
   static_assert(std::size(kKernels) == std::size(kStageModels));
-  kKernels[size_t(model_)](L, n, next_event, any_mapped_, int32_t(settings.rr_depth));
+  kKernels[size_t(model_)](L, n, next_event, any_mapped, int32_t(settings.rr_depth));
 }
 
 void SurfaceStage::shadow(size_t i, ShadowQuery* q) const {

@@ -96,6 +96,10 @@ class SurfaceStage {
   // q's fields for this stage's model from BSDF b; false if b is not of the model (or has a
   // non-finite colour, or coating tables the stage does not hold).
   bool fill_params(const SurfaceBsdf& b, SurfaceParams* q) const;
+  // Lane i's model parameters from q.
+  [[gnu::always_inline]] inline void write_params(size_t i, const SurfaceParams& q);
+  // Lane i's parameters looked up at a textured hit (and its normal map's frame and normal).
+  [[gnu::noinline]] void add_textured(size_t i, const PathState& s, const SurfaceHit& hit);
 
   const Scene& scene_;
   StageModel model_;
@@ -118,13 +122,12 @@ class SurfaceStage {
   // The light sample per lane.
   std::vector<int32_t> light_, light_ok_, l_delta_;
   std::vector<float> l_wi_[3], l_distance_, l_pdf_, l_p_[3], l_error_[3], l_n_[3], l_value_[3], l_pmf_;
-  // Whether a lane's parameters fit the model (a textured hit's may not).
-  std::vector<int32_t> fits_;
-  // Normal-mapped lanes (mask), their tangent frames' s and t and mapped normals; whether any
-  // lane is (the kernels' mapped case costs the others nothing then).
+  // The lanes whose looked-up parameters leave the model (a textured hit's may), and the
+  // normal-mapped lanes: their mask (set in compute, only when there are any: the kernels'
+  // mapped case then costs the other batches nothing), tangent frames' s and t, mapped normals.
+  std::vector<uint32_t> unfit_, mapped_lanes_;
   std::vector<int32_t> mapped_;
   std::vector<float> frame_s_[3], frame_t_[3], mapped_n_[3];
-  bool any_mapped_ = false;
   // Results per lane.
   std::vector<int32_t> staged_, alive_, has_shadow_, nee_ray_, dims_, prev_delta_;
   std::vector<float> s_origin_[3], s_dir_[3], s_t_max_, s_contrib_[3];
