@@ -1,7 +1,7 @@
 #pragma once
 // The wavefront driver's surface stages: the step of every path that hit a surface of one
-// BSDF model (Lambertian, conductors, plastics and dielectrics, constant or textured parameters,
-// no normal map), after its
+// BSDF model (Lambertian, conductors, plastics and dielectrics; constant or textured parameters,
+// with or without a normal map), after its
 // emission, as loops over arrays: the light choice and light sample (light_kernels.h), the
 // BSDF's value, pdf and MIS weight towards the light, the shadow ray and its contribution, then
 // the BSDF's sample (lane_bsdfs.h), the throughput, the spawned ray and Russian roulette. One
@@ -46,8 +46,8 @@ class SurfaceStage {
   const Scene& scene() const { return scene_; }
   StageModel model() const { return model_; }
 
-  // Whether the stage can take hits on `object`: its material is one of the stage's model, no
-  // normal map (textured parameters are looked up per hit in add; a hit whose looked-up
+  // Whether the stage can take hits on `object`: its material is one of the stage's model
+  // (textured parameters and a normal map are looked up per hit in add; a hit whose looked-up
   // parameters leave the model, such as a roughness texture at zero, is not `staged`).
   bool takes(uint32_t object) const { return params_of_[object] >= 0; }
 
