@@ -433,7 +433,9 @@ TEST(SurfaceStage, TexturedSurfacesArePathScatterToTheBit) {
     EXPECT_GT(cv.alive, 300);
     EXPECT_GT(cv.ball, k.smooth_texels ? 250 : 500);
     // Otherwise only the sphere light's lanes fall back (a few percent).
-    if (k.smooth_texels) EXPECT_GT(cv.fallback, 400);
+    if (k.smooth_texels) {
+      EXPECT_GT(cv.fallback, 400);
+    }
   }
 }
 
@@ -490,8 +492,11 @@ TEST(SurfaceStage, NormalMappedSurfacesArePathScatterToTheBit) {
     EXPECT_GT(cv.dead, 50);
     EXPECT_GT(cv.back, 200);
     EXPECT_GT(cv.ball, 500);
-    const bool delta = k.model == StageModel::kSmoothConductor || k.model == StageModel::kSmoothDielectric;
-    if (!delta) EXPECT_GT(cv.shadows, 100);
+    const bool delta =
+        k.model == StageModel::kSmoothConductor || k.model == StageModel::kSmoothDielectric;
+    if (!delta) {
+      EXPECT_GT(cv.shadows, 100);
+    }
   }
 }
 
