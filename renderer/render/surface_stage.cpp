@@ -81,6 +81,19 @@ struct Lanes {
   float *origin[3], *wo[3], *beta_out[3], *prev_pdf, *eta_out;
 };
 
+// Frame(n) on one lane: Duff et al. 2017 (core/frame.h), its operations in order.
+[[gnu::always_inline]] inline void duff_frame(float nx, float ny, float nz, float* s, float* t) {
+  const float sign = std::copysign(1.f, nz);
+  const float a = -1.f / (sign + nz);
+  const float b = nx * ny * a;
+  s[0] = 1.f + sign * nx * nx * a;
+  s[1] = sign * b;
+  s[2] = -sign * nx;
+  t[0] = b;
+  t[1] = sign + ny * ny * a;
+  t[2] = -ny;
+}
+
 // SurfaceBsdf's normal map (materials/surface_bsdf.cpp) on one lane: the perturbed frame of
 // mapped normal m for the (front-mirrored) direction a, and the shadow terminator.
 struct PerturbedFrame {
@@ -97,11 +110,8 @@ struct PerturbedFrame {
   const float r[3] = {1.f - n[0] * n[0], 0.f - n[1] * n[0], 0.f - n[2] * n[0]};
   const float ls = std::sqrt(lane::dot3(r, r));
   const Mask tangent = mask(ls > 1e-6f);
-  const float sign = std::copysign(1.f, n[2]);
-  const float fa = -1.f / (sign + n[2]);
-  const float fb = n[0] * n[1] * fa;
-  const float ds[3] = {1.f + sign * n[0] * n[0] * fa, sign * fb, -sign * n[0]};
-  const float dt[3] = {fb, sign + n[1] * n[1] * fa, -n[1]};
+  float ds[3], dt[3];
+  duff_frame(n[0], n[1], n[2], ds, dt);
   const float ts[3] = {r[0] / ls, r[1] / ls, r[2] / ls};
   // glm::cross(n, ts).
   const float tt[3] = {n[1] * ts[2] - ts[1] * n[2], n[2] * ts[0] - ts[2] * n[0],
@@ -164,12 +174,11 @@ template <class Model, bool kNextEvent, bool kMapped>
                          L.table[i],
                          L.nodes[i],
                          L.tables};
-    // Frame(ns): Duff et al. 2017 (core/frame.h).
-    const float sign = std::copysign(1.f, nz);
-    const float fa = -1.f / (sign + nz);
-    const float fb = nx * ny * fa;
-    float sx = 1.f + sign * nx * nx * fa, sy = sign * fb, sz = -sign * nx;
-    float tx = fb, ty = sign + ny * ny * fa, tz = -ny;
+    // Frame(ns).
+    float fs[3], ft[3];
+    duff_frame(nx, ny, nz, fs, ft);
+    float sx = fs[0], sy = fs[1], sz = fs[2];
+    float tx = ft[0], ty = ft[1], tz = ft[2];
     // A normal-mapped surface's frame follows dp/du (tangent_frame, computed in add).
     const Mask mapped = kMapped ? L.mapped[i] : 0;
     if constexpr (kMapped) {
@@ -439,7 +448,7 @@ SurfaceStage::SurfaceStage(const Scene& scene, StageModel model)
     SurfaceParams q;
     if (!fill_params(m.bsdf(), &q)) continue;
     params_of_[o] = int32_t(params_.size());
-    textured_of_[o] = m.varies() || m.normal_mapped();
+    textured_of_[o] = m.varies();  // (a normal map makes a material vary)
     params_.push_back(q);
   }
 }
