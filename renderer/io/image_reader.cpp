@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "renderer/io/oiio_module.h"
+#include "renderer/io/png_reader.h"
 
 namespace penumbra {
 namespace {
@@ -35,29 +36,48 @@ AssetImageInfo check_header(const std::string& path, const PenumbraImageSpec& sp
   return info;
 }
 
-// Through the OpenImageIO plug-in, loaded on first use (oiio_module.h); its errors name the path
-// (for an image in memory, its name).
-std::unique_ptr<PluginImage> open_image(const ImageSource& source) {
-  return open_plugin_image(source);
-}
+// An opened image: PNG through libpng (png_reader.h), any other format through the OpenImageIO
+// plug-in, loaded on first use (oiio_module.h). Errors name the path (for an image in memory,
+// its name).
+class OpenedImage {
+ public:
+  explicit OpenedImage(const ImageSource& source) {
+    if (has_png_signature(source))
+      png_ = PngImage::open(source);
+    else
+      plugin_ = open_plugin_image(source);
+  }
+  const PenumbraImageSpec& spec() const { return png_ ? png_->spec() : plugin_->spec(); }
+  template <class T>
+  void read(int channels, T* pixels) {
+    if (png_)
+      png_->read(channels, pixels);
+    else
+      plugin_->read(channels, pixels);
+  }
+
+ private:
+  std::unique_ptr<PngImage> png_;
+  std::unique_ptr<PluginImage> plugin_;
+};
 
 }  // namespace
 
 AssetImageInfo probe_asset_image(const ImageSource& source, const ImageReadLimits& limits) {
-  return check_header(source.path, open_image(source)->spec(), limits);
+  return check_header(source.path, OpenedImage(source).spec(), limits);
 }
 
 AssetImage read_asset_image(const ImageSource& source, const ImageReadLimits& limits) {
   const std::string& path = source.path;
-  auto in = open_image(source);
-  const AssetImageInfo info = check_header(path, in->spec(), limits);
+  OpenedImage in(source);
+  const AssetImageInfo info = check_header(path, in.spec(), limits);
   AssetImage img;
   img.width = info.width;
   img.height = info.height;
   img.channels = info.channels;
   img.is_float = info.is_float;
   img.pixels.resize(size_t(img.width) * size_t(img.height) * size_t(img.channels));
-  in->read(img.channels, img.pixels.data());
+  in.read(img.channels, img.pixels.data());
   for (float& v : img.pixels)
     if (!std::isfinite(v)) v = 0.f;
   return img;
@@ -65,15 +85,15 @@ AssetImage read_asset_image(const ImageSource& source, const ImageReadLimits& li
 
 AssetImage8 read_asset_image_8bit(const ImageSource& source, const ImageReadLimits& limits) {
   const std::string& path = source.path;
-  auto in = open_image(source);
-  const AssetImageInfo info = check_header(path, in->spec(), limits);
+  OpenedImage in(source);
+  const AssetImageInfo info = check_header(path, in.spec(), limits);
   if (!info.is_8bit) fail(path, "the image does not store 8-bit values");
   AssetImage8 img;
   img.width = info.width;
   img.height = info.height;
   img.channels = info.channels;
   img.pixels.resize(size_t(img.width) * size_t(img.height) * size_t(img.channels));
-  in->read(img.channels, img.pixels.data());
+  in.read(img.channels, img.pixels.data());
   return img;
 }
 

@@ -1,9 +1,10 @@
 #pragma once
 // OpenImageIO, loaded on first use. Linking it costs every run of the binary its ~250 shared
 // libraries (OpenCV, GDAL, DCMTK, ffmpeg, ...): 0.3 s and 130 MB before main() on this machine.
-// PNG and EXR output go through libpng and OpenEXR directly; reading image assets (any format
-// OpenImageIO knows) goes through a plug-in, libpenumbra_oiio.so, loaded by this module the first
-// time a scene reads one. Where it is looked for, in order:
+// PNG and EXR output go through libpng and OpenEXR directly, and so does reading PNG assets
+// (png_reader.h); reading image assets of any other format OpenImageIO knows goes through a
+// plug-in, libpenumbra_oiio.so, loaded by this module the first time a scene reads one. Where it
+// is looked for, in order:
 //   $PENUMBRA_OIIO_MODULE (a path: only that file is tried)
 //   <dir of the executable>/../lib/penumbra/libpenumbra_oiio.so   (build tree; installed prefix)
 //   <dir of the executable>/libpenumbra_oiio.so

@@ -1,0 +1,185 @@
+#include "renderer/io/png_reader.h"
+
+#include <png.h>
+
+#include <cstdio>
+#include <cstring>
+#include <string>
+
+#include "renderer/io/image_io.h"
+#include "renderer/io/image_reader.h"
+
+namespace penumbra {
+namespace {
+
+constexpr size_t kSignatureBytes = 8;
+
+// What libpng's callbacks reach through their pointers: the bytes' source and the last error.
+struct PngIo {
+  std::FILE* file = nullptr;                      // a file source, or
+  const std::vector<uint8_t>* bytes = nullptr;    // bytes in memory, read from `offset`
+  size_t offset = 0;
+  char error[256] = "";
+};
+
+// libpng's contract: an error handler must not return; it longjmps to the setjmp point of the
+// call that failed (below), after the message is kept for the exception thrown there. Nothing is
+// printed: hostile files must not write to the service's log through stderr.
+[[noreturn]] void on_error(png_structp png, png_const_charp message) {
+  auto* io = static_cast<PngIo*>(png_get_error_ptr(png));
+  std::snprintf(io->error, sizeof io->error, "%s", message ? message : "libpng failed");
+  png_longjmp(png, 1);
+}
+void on_warning(png_structp, png_const_charp) {}
+
+void read_bytes(png_structp png, png_bytep out, size_t n) {
+  auto* io = static_cast<PngIo*>(png_get_io_ptr(png));
+  if (io->file) {
+    if (std::fread(out, 1, n, io->file) != n) png_error(png, "the file ends early");
+    return;
+  }
+  if (n > io->bytes->size() - io->offset) png_error(png, "the image ends early");
+  std::memcpy(out, io->bytes->data() + io->offset, n);
+  io->offset += n;
+}
+
+// The libpng calls that may fail, each behind its own setjmp point: these frames hold nothing
+// with a destructor and change no local after setjmp, so an error's longjmp is well defined.
+bool read_info(png_structp png, png_infop info) {
+  if (setjmp(png_jmpbuf(png))) return false;
+  png_read_info(png, info);
+  const int type = png_get_color_type(png, info);
+  const int depth = png_get_bit_depth(png, info);
+  // OpenImageIO's PNG reader's expansions, so both give the same channels and values.
+  if (type == PNG_COLOR_TYPE_PALETTE) png_set_palette_to_rgb(png);
+  if (type == PNG_COLOR_TYPE_GRAY && depth < 8) png_set_expand_gray_1_2_4_to_8(png);
+  if (png_get_valid(png, info, PNG_INFO_tRNS)) png_set_tRNS_to_alpha(png);
+#if __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+  if (depth == 16) png_set_swap(png);  // PNG stores 16-bit values big-endian
+#endif
+  png_set_interlace_handling(png);
+  png_read_update_info(png, info);
+  return true;
+}
+
+bool read_rows(png_structp png, png_bytepp rows) {
+  if (setjmp(png_jmpbuf(png))) return false;
+  png_read_image(png, rows);
+  return true;
+}
+
+}  // namespace
+
+struct PngImage::State {
+  std::string path;
+  std::shared_ptr<const std::vector<uint8_t>> bytes;  // an image in memory: kept alive
+  PngIo io;
+  png_structp png = nullptr;
+  png_infop info = nullptr;
+  ~State() {
+    if (png) png_destroy_read_struct(&png, info ? &info : nullptr, nullptr);
+    if (io.file) std::fclose(io.file);
+  }
+  [[noreturn]] void fail(const std::string& what) const {
+    throw ImageIoError(path + ": " + what + ": " + io.error);
+  }
+};
+
+bool has_png_signature(const ImageSource& source) {
+  uint8_t head[kSignatureBytes];
+  if (source.bytes) {
+    if (source.bytes->size() < kSignatureBytes) return false;
+    std::memcpy(head, source.bytes->data(), kSignatureBytes);
+  } else {
+    std::FILE* f = std::fopen(source.path.c_str(), "rb");
+    if (!f) return false;
+    const size_t n = std::fread(head, 1, kSignatureBytes, f);
+    std::fclose(f);
+    if (n != kSignatureBytes) return false;
+  }
+  return png_sig_cmp(head, 0, kSignatureBytes) == 0;
+}
+
+PngImage::PngImage(std::unique_ptr<State> state) : state_(std::move(state)) {}
+PngImage::~PngImage() = default;
+
+std::unique_ptr<PngImage> PngImage::open(const ImageSource& source) {
+  auto s = std::make_unique<State>();
+  s->path = source.path;
+  if (source.bytes) {
+    s->bytes = source.bytes;
+    s->io.bytes = s->bytes.get();
+  } else {
+    s->io.file = std::fopen(source.path.c_str(), "rb");
+    if (!s->io.file) throw ImageIoError(source.path + ": cannot open the file");
+  }
+  s->png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &s->io, on_error, on_warning);
+  if (s->png) s->info = png_create_info_struct(s->png);
+  if (!s->png || !s->info) throw ImageIoError(source.path + ": cannot read the image: libpng could not start");
+  png_set_read_fn(s->png, &s->io, read_bytes);
+  // Sizes are checked by the caller against its limits (image_reader.cpp) before any row is
+  // allocated, with its own messages; libpng's default limit (a million per side) would answer
+  // first for some of them.
+  png_set_user_limits(s->png, PNG_UINT_31_MAX, PNG_UINT_31_MAX);
+  png_set_chunk_malloc_max(s->png, 8u << 20);  // text, ICC profiles: bounded, as libpng's default
+  if (!read_info(s->png, s->info)) s->fail("cannot read the image");
+
+  auto image = std::unique_ptr<PngImage>(new PngImage(std::move(s)));
+  png_structp png = image->state_->png;
+  png_infop info = image->state_->info;
+  PenumbraImageSpec& spec = image->spec_;
+  spec.width = int(png_get_image_width(png, info));
+  spec.height = int(png_get_image_height(png, info));
+  spec.depth = 1;
+  spec.channels = png_get_channels(png, info);
+  spec.is_float = 0;
+  spec.is_uint8 = png_get_bit_depth(png, info) == 16 ? 0 : 1;
+  return image;
+}
+
+std::vector<uint8_t> PngImage::decode() {
+  png_structp png = state_->png;
+  const size_t row_bytes = png_get_rowbytes(png, state_->info);
+  const size_t expected = size_t(spec_.width) * size_t(spec_.channels) * (spec_.is_uint8 ? 1 : 2);
+  if (row_bytes != expected) throw ImageIoError(state_->path + ": cannot decode the image: unexpected row size");
+  std::vector<uint8_t> data(row_bytes * size_t(spec_.height));
+  std::vector<png_bytep> rows(size_t(spec_.height));
+  for (size_t y = 0; y < rows.size(); ++y) rows[y] = data.data() + y * row_bytes;
+  if (!read_rows(png, rows.data())) state_->fail("cannot decode the image");
+  return data;
+}
+
+void PngImage::read(int channels, float* pixels) {
+  if (channels < 1 || channels > spec_.channels) throw ImageIoError(state_->path + ": no such channels");
+  const std::vector<uint8_t> data = decode();
+  const size_t n = size_t(spec_.width) * size_t(spec_.height);
+  const size_t in_channels = size_t(spec_.channels);
+  // The conversions OpenImageIO makes (value times 1/255 or 1/65535, in float), so textures
+  // decode to the same floats through either reader.
+  if (spec_.is_uint8) {
+    const float scale = 1.f / 255.f;
+    for (size_t i = 0; i < n; ++i)
+      for (int c = 0; c < channels; ++c)
+        pixels[i * size_t(channels) + size_t(c)] = float(data[i * in_channels + size_t(c)]) * scale;
+  } else {
+    const float scale = 1.f / 65535.f;
+    for (size_t i = 0; i < n; ++i)
+      for (int c = 0; c < channels; ++c) {
+        uint16_t v;
+        std::memcpy(&v, data.data() + 2 * (i * in_channels + size_t(c)), sizeof v);
+        pixels[i * size_t(channels) + size_t(c)] = float(v) * scale;
+      }
+  }
+}
+
+void PngImage::read(int channels, uint8_t* pixels) {
+  if (!spec_.is_uint8) throw ImageIoError(state_->path + ": the image does not store 8-bit values");
+  if (channels < 1 || channels > spec_.channels) throw ImageIoError(state_->path + ": no such channels");
+  const std::vector<uint8_t> data = decode();
+  const size_t n = size_t(spec_.width) * size_t(spec_.height);
+  const size_t in_channels = size_t(spec_.channels);
+  for (size_t i = 0; i < n; ++i)
+    std::memcpy(pixels + i * size_t(channels), data.data() + i * in_channels, size_t(channels));
+}
+
+}  // namespace penumbra
