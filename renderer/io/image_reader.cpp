@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "renderer/io/exr_reader.h"
 #include "renderer/io/oiio_module.h"
 #include "renderer/io/png_reader.h"
 
@@ -36,28 +37,35 @@ AssetImageInfo check_header(const std::string& path, const PenumbraImageSpec& sp
   return info;
 }
 
-// An opened image: PNG through libpng (png_reader.h), any other format through the OpenImageIO
-// plug-in, loaded on first use (oiio_module.h). Errors name the path (for an image in memory,
+// An opened image: PNG through libpng (png_reader.h), the common form of EXR through OpenEXR
+// (exr_reader.h), anything else through the OpenImageIO plug-in, loaded on first use
+// (oiio_module.h). Errors name the path (for an image in memory,
 // its name).
 class OpenedImage {
  public:
   explicit OpenedImage(const ImageSource& source) {
     if (has_png_signature(source))
       png_ = PngImage::open(source);
-    else
-      plugin_ = open_plugin_image(source);
+    else if (has_exr_signature(source))
+      exr_ = ExrImage::open(source);  // null: an EXR of a form left to the plug-in
+    if (!png_ && !exr_) plugin_ = open_plugin_image(source);
   }
-  const PenumbraImageSpec& spec() const { return png_ ? png_->spec() : plugin_->spec(); }
+  const PenumbraImageSpec& spec() const {
+    return png_ ? png_->spec() : exr_ ? exr_->spec() : plugin_->spec();
+  }
   template <class T>
   void read(int channels, T* pixels) {
     if (png_)
       png_->read(channels, pixels);
+    else if (exr_)
+      exr_->read(channels, pixels);
     else
       plugin_->read(channels, pixels);
   }
 
  private:
   std::unique_ptr<PngImage> png_;
+  std::unique_ptr<ExrImage> exr_;
   std::unique_ptr<PluginImage> plugin_;
 };
 

@@ -32,9 +32,10 @@ std::string temp_path(const std::string& ext) {
       .string();
 }
 
-// Runs first in this binary (gtest runs tests in file order; ctest runs each test in its own
-// process): encoding touches no OpenImageIO.
+// Encoding touches no OpenImageIO (ctest runs each test in its own process; run in one process
+// with others, an earlier test may have loaded the plug-in, and this one is skipped).
 TEST(ImageCodec, EncodingDoesNotLoadTheOpenImageIoPlugin) {
+  if (oiio_module_loaded()) GTEST_SKIP() << "an earlier test of this process loaded the plug-in";
   const Image img = gradient(8, 4);
   EXPECT_GT(encode_image(img, ImageFormat::kPng).size(), 50u);
   EXPECT_GT(encode_image(img, ImageFormat::kExr).size(), 50u);

@@ -1,5 +1,5 @@
 #pragma once
-// Writing small images for texture tests, through OpenImageIO (the same library that reads them).
+// Writing small images for texture tests, through OpenImageIO.
 #include <OpenImageIO/imageio.h>
 
 #include <filesystem>
@@ -12,13 +12,15 @@
 namespace penumbra::test {
 
 // Writes `values` (width * height * channels, rows from the top) to `path`, stored as `type`
-// (UINT8 values are given in [0, 1] and quantised by OpenImageIO).
+// (UINT8 values are given in [0, 1] and quantised by OpenImageIO). Colour is stored as given,
+// not divided by alpha (OpenImageIO's default for PNG): the readers take stored values.
 inline void write_test_image(const std::string& path, int width, int height, int channels,
                              const std::vector<float>& values,
                              OIIO::TypeDesc type = OIIO::TypeDesc::FLOAT) {
   auto out = OIIO::ImageOutput::create(path);
   if (!out) throw std::runtime_error("no writer for " + path);
-  const OIIO::ImageSpec spec(width, height, channels, type);
+  OIIO::ImageSpec spec(width, height, channels, type);
+  spec.attribute("oiio:UnassociatedAlpha", 1);
   if (!out->open(path, spec) || !out->write_image(OIIO::TypeDesc::FLOAT, values.data()) || !out->close())
     throw std::runtime_error("cannot write " + path + ": " + out->geterror());
 }

@@ -1,0 +1,43 @@
+#pragma once
+// EXR image assets (environment maps, float textures) decoded by OpenEXR directly, which the
+// binary links already for writing EXR: such a scene does not load the OpenImageIO plug-in
+// (oiio_module.h). This reader takes the common form, a single-part scanline or tiled image
+// (its full-resolution level) whose channels are exactly R, G, B (A) or Y (A), half or float,
+// unsubsampled; any other EXR (layers, luminance-chroma, multi-part, deep, integer channels) goes
+// to the plug-in, as before. Values are the stored ones converted to float, as OpenImageIO gives
+// them (half to float is exact), the data window as the image (tests compare the two readers).
+#include <cstdint>
+#include <memory>
+
+#include "renderer/io/oiio_plugin/oiio_plugin_abi.h"
+
+namespace penumbra {
+
+struct ImageSource;
+
+// True when the source's first four bytes are OpenEXR's magic number.
+bool has_exr_signature(const ImageSource& source);
+
+class ExrImage {
+ public:
+  // Reads and checks the header (exr_header_check.h; ImageIoError naming the source when it is
+  // broken); null for a valid EXR this reader leaves to the plug-in.
+  static std::unique_ptr<ExrImage> open(const ImageSource& source);
+  ~ExrImage();
+  ExrImage(const ExrImage&) = delete;
+  ExrImage& operator=(const ExrImage&) = delete;
+
+  const PenumbraImageSpec& spec() const { return spec_; }
+  // The first `channels` channels as float, channel-interleaved, top row first.
+  void read(int channels, float* pixels);
+  // EXR stores no 8-bit values: always throws ImageIoError.
+  void read(int channels, uint8_t* pixels);
+
+ private:
+  struct State;
+  explicit ExrImage(std::unique_ptr<State> state);
+  std::unique_ptr<State> state_;
+  PenumbraImageSpec spec_{};
+};
+
+}  // namespace penumbra
