@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "renderer/io/exr_reader.h"
+#include "renderer/io/hdr_reader.h"
 #include "renderer/io/oiio_module.h"
 #include "renderer/io/png_reader.h"
 
@@ -38,8 +39,8 @@ AssetImageInfo check_header(const std::string& path, const PenumbraImageSpec& sp
 }
 
 // An opened image: PNG through libpng (png_reader.h), the common form of EXR through OpenEXR
-// (exr_reader.h), anything else through the OpenImageIO plug-in, loaded on first use
-// (oiio_module.h). Errors name the path (for an image in memory,
+// (exr_reader.h), Radiance HDR here (hdr_reader.h), anything else through the OpenImageIO
+// plug-in, loaded on first use (oiio_module.h). Errors name the path (for an image in memory,
 // its name).
 class OpenedImage {
  public:
@@ -48,10 +49,12 @@ class OpenedImage {
       png_ = PngImage::open(source);
     else if (has_exr_signature(source))
       exr_ = ExrImage::open(source);  // null: an EXR of a form left to the plug-in
-    if (!png_ && !exr_) plugin_ = open_plugin_image(source);
+    else if (has_hdr_signature(source))
+      hdr_ = HdrImage::open(source);  // null: an orientation or XYZE left to the plug-in
+    if (!png_ && !exr_ && !hdr_) plugin_ = open_plugin_image(source);
   }
   const PenumbraImageSpec& spec() const {
-    return png_ ? png_->spec() : exr_ ? exr_->spec() : plugin_->spec();
+    return png_ ? png_->spec() : exr_ ? exr_->spec() : hdr_ ? hdr_->spec() : plugin_->spec();
   }
   template <class T>
   void read(int channels, T* pixels) {
@@ -59,6 +62,8 @@ class OpenedImage {
       png_->read(channels, pixels);
     else if (exr_)
       exr_->read(channels, pixels);
+    else if (hdr_)
+      hdr_->read(channels, pixels);
     else
       plugin_->read(channels, pixels);
   }
@@ -66,6 +71,7 @@ class OpenedImage {
  private:
   std::unique_ptr<PngImage> png_;
   std::unique_ptr<ExrImage> exr_;
+  std::unique_ptr<HdrImage> hdr_;
   std::unique_ptr<PluginImage> plugin_;
 };
 
