@@ -6,6 +6,7 @@
 #   obj_reader    renderer/io/obj_reader (screening + tinyobjloader)
 #   gltf_reader   renderer/io/gltf_file (GLB checks + tinygltf + accessors, hierarchy)
 #   exr_window    renderer/io/exr_window_file (a frame's window as penumbra merge reads it)
+#   image_asset   renderer/io/image_reader's own readers: PNG, EXR, Radiance HDR, JPEG
 #   http_head     the HTTP service's head-line checks and Range decisions (server/http)
 #   multipart     the one-shot job form parser and the job envelope's manifest (server/http, api)
 #   scripts/fuzz.sh [SECONDS] [TARGET...]     (default 60 seconds, all targets)
@@ -17,7 +18,7 @@ set -euo pipefail
 seconds="${1:-60}"
 shift || true
 targets=("$@")
-if [ ${#targets[@]} -eq 0 ]; then targets=(scene_loader ply_reader obj_reader gltf_reader exr_window http_head multipart); fi
+if [ ${#targets[@]} -eq 0 ]; then targets=(scene_loader ply_reader obj_reader gltf_reader exr_window image_asset http_head multipart); fi
 root="$(cd "$(dirname "$0")/.." && pwd)"
 build="$root/build-fuzz"
 jobs="${JOBS:-2}"

@@ -25,7 +25,7 @@ PKGS=(
   libembree-dev libopenimageio-dev openimageio-tools libglm-dev
   libcpp-httplib-dev nlohmann-json3-dev libtbb-dev libsqlite3-dev
   libgtest-dev libgmock-dev libbenchmark-dev libtinyobjloader-dev libtinygltf-dev libpng-dev
-  libopenexr-dev libssl-dev
+  libopenexr-dev libjpeg62-turbo-dev libssl-dev
   libpq-dev
 )
 if want --farm; then PKGS+=(postgresql postgresql-client); fi

@@ -5,6 +5,7 @@
 
 #include "renderer/io/exr_reader.h"
 #include "renderer/io/hdr_reader.h"
+#include "renderer/io/jpeg_reader.h"
 #include "renderer/io/oiio_module.h"
 #include "renderer/io/png_reader.h"
 
@@ -39,8 +40,8 @@ AssetImageInfo check_header(const std::string& path, const PenumbraImageSpec& sp
 }
 
 // An opened image: PNG through libpng (png_reader.h), the common form of EXR through OpenEXR
-// (exr_reader.h), Radiance HDR here (hdr_reader.h), anything else through the OpenImageIO
-// plug-in, loaded on first use (oiio_module.h). Errors name the path (for an image in memory,
+// (exr_reader.h), Radiance HDR here (hdr_reader.h), JPEG through libjpeg-turbo (jpeg_reader.h),
+// anything else through the OpenImageIO plug-in, loaded on first use (oiio_module.h). Errors name the path (for an image in memory,
 // its name).
 class OpenedImage {
  public:
@@ -51,10 +52,16 @@ class OpenedImage {
       exr_ = ExrImage::open(source);  // null: an EXR of a form left to the plug-in
     else if (has_hdr_signature(source))
       hdr_ = HdrImage::open(source);  // null: an orientation or XYZE left to the plug-in
-    if (!png_ && !exr_ && !hdr_) plugin_ = open_plugin_image(source);
+    else if (has_jpeg_signature(source))
+      jpeg_ = JpegImage::open(source);  // null: CMYK or YCCK, left to the plug-in
+    if (!png_ && !exr_ && !hdr_ && !jpeg_) plugin_ = open_plugin_image(source);
   }
   const PenumbraImageSpec& spec() const {
-    return png_ ? png_->spec() : exr_ ? exr_->spec() : hdr_ ? hdr_->spec() : plugin_->spec();
+    return png_    ? png_->spec()
+           : exr_  ? exr_->spec()
+           : hdr_  ? hdr_->spec()
+           : jpeg_ ? jpeg_->spec()
+                   : plugin_->spec();
   }
   template <class T>
   void read(int channels, T* pixels) {
@@ -64,6 +71,8 @@ class OpenedImage {
       exr_->read(channels, pixels);
     else if (hdr_)
       hdr_->read(channels, pixels);
+    else if (jpeg_)
+      jpeg_->read(channels, pixels);
     else
       plugin_->read(channels, pixels);
   }
@@ -72,6 +81,7 @@ class OpenedImage {
   std::unique_ptr<PngImage> png_;
   std::unique_ptr<ExrImage> exr_;
   std::unique_ptr<HdrImage> hdr_;
+  std::unique_ptr<JpegImage> jpeg_;
   std::unique_ptr<PluginImage> plugin_;
 };
 
