@@ -25,6 +25,7 @@ class Sphere final : public Shape {
   vec3 center_at(float time) const {
     return motion_.is_static() ? center_ + vec3(0.f) : center_ + motion_.displacement(time);
   }
+  const vec3& center() const { return center_; }  // at time 0
   float radius() const { return radius_; }
   // bounds() padded by the intersection test's rounding error, for Embree's BVH.
   Bounds3 embree_bounds() const;
@@ -45,6 +46,11 @@ class Sphere final : public Shape {
 // are small or far away compared with the ray origin.
 float intersect_sphere(const vec3& center, float radius, const vec3& origin, const vec3& dir,
                        float t_max);
+
+// The Embree callbacks of a sphere's user geometry (user data: the Sphere); declared for tests,
+// which compare packets of 4, 8 and 16 rays with single rays.
+void sphere_intersect_fn(const RTCIntersectFunctionNArguments* args);
+void sphere_occluded_fn(const RTCOccludedFunctionNArguments* args);
 
 // Mitsuba 3's sphere mapping of a unit normal: u = phi / 2 pi with phi = atan2(y, x) in
 // [0, 2 pi), v = theta / pi from +z (the sphere's frame is unrotated).
