@@ -9,6 +9,7 @@
 #include <memory>
 #include <vector>
 
+#include "renderer/io/asset_decoder.h"
 #include "renderer/io/exr_reader.h"
 #include "renderer/io/hdr_reader.h"
 #include "renderer/io/image_io.h"
@@ -19,8 +20,9 @@
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace penumbra;
   const ImageSource source("fuzz", std::make_shared<const std::vector<uint8_t>>(data, data + size), "png");
-  const bool png = has_png_signature(source), exr = has_exr_signature(source),
-             hdr = has_hdr_signature(source), jpeg = has_jpeg_signature(source);
+  const SourceHead head = read_source_head(source);
+  const bool png = has_png_signature(head), exr = has_exr_signature(head),
+             hdr = has_hdr_signature(head), jpeg = has_jpeg_signature(head);
   if (!png && !exr && !hdr && !jpeg) return 0;
   ImageReadLimits limits;
   limits.max_pixels = 256 * 256;  // small caps keep each input fast

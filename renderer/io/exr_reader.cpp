@@ -70,19 +70,9 @@ struct ExrImage::State {
   int layout = -1;
 };
 
-bool has_exr_signature(const ImageSource& source) {
-  uint8_t head[4];
-  if (source.bytes) {
-    if (source.bytes->size() < 4) return false;
-    std::memcpy(head, source.bytes->data(), 4);
-  } else {
-    std::FILE* f = std::fopen(source.path.c_str(), "rb");
-    if (!f) return false;
-    const size_t n = std::fread(head, 1, 4, f);
-    std::fclose(f);
-    if (n != 4) return false;
-  }
-  return head[0] == 0x76 && head[1] == 0x2f && head[2] == 0x31 && head[3] == 0x01;
+bool has_exr_signature(const SourceHead& head) {
+  const uint8_t* b = head.bytes;
+  return head.size >= 4 && b[0] == 0x76 && b[1] == 0x2f && b[2] == 0x31 && b[3] == 0x01;
 }
 
 ExrImage::ExrImage(std::unique_ptr<State> state) : state_(std::move(state)) {}

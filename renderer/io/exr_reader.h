@@ -9,16 +9,14 @@
 #include <cstdint>
 #include <memory>
 
-#include "renderer/io/oiio_plugin/oiio_plugin_abi.h"
+#include "renderer/io/asset_decoder.h"
 
 namespace penumbra {
 
-struct ImageSource;
-
 // True when the source's first four bytes are OpenEXR's magic number.
-bool has_exr_signature(const ImageSource& source);
+bool has_exr_signature(const SourceHead& head);
 
-class ExrImage {
+class ExrImage final : public AssetDecoder {
  public:
   // Reads and checks the header (exr_header_check.h; ImageIoError naming the source when it is
   // broken); null for a valid EXR this reader leaves to the plug-in.
@@ -27,11 +25,11 @@ class ExrImage {
   ExrImage(const ExrImage&) = delete;
   ExrImage& operator=(const ExrImage&) = delete;
 
-  const PenumbraImageSpec& spec() const { return spec_; }
+  const PenumbraImageSpec& spec() const override { return spec_; }
   // The first `channels` channels as float, channel-interleaved, top row first.
-  void read(int channels, float* pixels);
+  void read(int channels, float* pixels) override;
   // EXR stores no 8-bit values: always throws ImageIoError.
-  void read(int channels, uint8_t* pixels);
+  void read(int channels, uint8_t* pixels) override;
 
  private:
   struct State;

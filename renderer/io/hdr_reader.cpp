@@ -67,10 +67,8 @@ struct HdrImage::State {
   std::unique_ptr<ByteReader> in;  // positioned at the first scanline
 };
 
-bool has_hdr_signature(const ImageSource& source) {
-  ByteReader in(source);
-  uint8_t head[2];
-  return in.ok() && in.read(head, 2) && head[0] == '#' && head[1] == '?';
+bool has_hdr_signature(const SourceHead& head) {
+  return head.size >= 2 && head.bytes[0] == '#' && head.bytes[1] == '?';
 }
 
 HdrImage::HdrImage(std::unique_ptr<State> state) : state_(std::move(state)) {}

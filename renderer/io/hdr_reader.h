@@ -9,16 +9,14 @@
 #include <cstdint>
 #include <memory>
 
-#include "renderer/io/oiio_plugin/oiio_plugin_abi.h"
+#include "renderer/io/asset_decoder.h"
 
 namespace penumbra {
 
-struct ImageSource;
-
 // True when the source starts with "#?" (Radiance's header magic).
-bool has_hdr_signature(const ImageSource& source);
+bool has_hdr_signature(const SourceHead& head);
 
-class HdrImage {
+class HdrImage final : public AssetDecoder {
  public:
   // Reads the header (ImageIoError naming the source when it is broken); null for a valid file
   // this reader leaves to the plug-in.
@@ -27,11 +25,11 @@ class HdrImage {
   HdrImage(const HdrImage&) = delete;
   HdrImage& operator=(const HdrImage&) = delete;
 
-  const PenumbraImageSpec& spec() const { return spec_; }
+  const PenumbraImageSpec& spec() const override { return spec_; }
   // The first `channels` channels (R, G, B) as float, channel-interleaved, top row first.
-  void read(int channels, float* pixels);
+  void read(int channels, float* pixels) override;
   // RGBE stores no 8-bit values: always throws ImageIoError.
-  void read(int channels, uint8_t* pixels);
+  void read(int channels, uint8_t* pixels) override;
 
  private:
   struct State;

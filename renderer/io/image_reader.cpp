@@ -39,69 +39,42 @@ AssetImageInfo check_header(const std::string& path, const PenumbraImageSpec& sp
   return info;
 }
 
-// An opened image: PNG through libpng (png_reader.h), the common form of EXR through OpenEXR
-// (exr_reader.h), Radiance HDR here (hdr_reader.h), JPEG through libjpeg-turbo (jpeg_reader.h),
-// anything else through the OpenImageIO plug-in, loaded on first use (oiio_module.h). Errors name the path (for an image in memory,
-// its name).
-class OpenedImage {
- public:
-  explicit OpenedImage(const ImageSource& source) {
-    if (has_png_signature(source))
-      png_ = PngImage::open(source);
-    else if (has_exr_signature(source))
-      exr_ = ExrImage::open(source);  // null: an EXR of a form left to the plug-in
-    else if (has_hdr_signature(source))
-      hdr_ = HdrImage::open(source);  // null: an orientation or XYZE left to the plug-in
-    else if (has_jpeg_signature(source))
-      jpeg_ = JpegImage::open(source);  // null: CMYK or YCCK, left to the plug-in
-    if (!png_ && !exr_ && !hdr_ && !jpeg_) plugin_ = open_plugin_image(source);
-  }
-  const PenumbraImageSpec& spec() const {
-    return png_    ? png_->spec()
-           : exr_  ? exr_->spec()
-           : hdr_  ? hdr_->spec()
-           : jpeg_ ? jpeg_->spec()
-                   : plugin_->spec();
-  }
-  template <class T>
-  void read(int channels, T* pixels) {
-    if (png_)
-      png_->read(channels, pixels);
-    else if (exr_)
-      exr_->read(channels, pixels);
-    else if (hdr_)
-      hdr_->read(channels, pixels);
-    else if (jpeg_)
-      jpeg_->read(channels, pixels);
-    else
-      plugin_->read(channels, pixels);
-  }
-
- private:
-  std::unique_ptr<PngImage> png_;
-  std::unique_ptr<ExrImage> exr_;
-  std::unique_ptr<HdrImage> hdr_;
-  std::unique_ptr<JpegImage> jpeg_;
-  std::unique_ptr<PluginImage> plugin_;
-};
+// The reader of a source: PNG through libpng (png_reader.h), the common form of EXR through
+// OpenEXR (exr_reader.h), Radiance HDR here (hdr_reader.h), JPEG through libjpeg-turbo
+// (jpeg_reader.h), anything else (and what those leave) through the OpenImageIO plug-in, loaded
+// on first use (oiio_module.h). Errors name the path (for an image in memory, its name).
+std::unique_ptr<AssetDecoder> open_decoder(const ImageSource& source) {
+  const SourceHead head = read_source_head(source);
+  std::unique_ptr<AssetDecoder> decoder;
+  if (has_png_signature(head))
+    decoder = PngImage::open(source);
+  else if (has_exr_signature(head))
+    decoder = ExrImage::open(source);  // null: an EXR of a form left to the plug-in
+  else if (has_hdr_signature(head))
+    decoder = HdrImage::open(source);  // null: an orientation or XYZE left to the plug-in
+  else if (has_jpeg_signature(head))
+    decoder = JpegImage::open(source);  // null: CMYK or YCCK, left to the plug-in
+  if (!decoder) decoder = open_plugin_image(source);
+  return decoder;
+}
 
 }  // namespace
 
 AssetImageInfo probe_asset_image(const ImageSource& source, const ImageReadLimits& limits) {
-  return check_header(source.path, OpenedImage(source).spec(), limits);
+  return check_header(source.path, open_decoder(source)->spec(), limits);
 }
 
 AssetImage read_asset_image(const ImageSource& source, const ImageReadLimits& limits) {
   const std::string& path = source.path;
-  OpenedImage in(source);
-  const AssetImageInfo info = check_header(path, in.spec(), limits);
+  const auto in = open_decoder(source);
+  const AssetImageInfo info = check_header(path, in->spec(), limits);
   AssetImage img;
   img.width = info.width;
   img.height = info.height;
   img.channels = info.channels;
   img.is_float = info.is_float;
   img.pixels.resize(size_t(img.width) * size_t(img.height) * size_t(img.channels));
-  in.read(img.channels, img.pixels.data());
+  in->read(img.channels, img.pixels.data());
   for (float& v : img.pixels)
     if (!std::isfinite(v)) v = 0.f;
   return img;
@@ -109,15 +82,15 @@ AssetImage read_asset_image(const ImageSource& source, const ImageReadLimits& li
 
 AssetImage8 read_asset_image_8bit(const ImageSource& source, const ImageReadLimits& limits) {
   const std::string& path = source.path;
-  OpenedImage in(source);
-  const AssetImageInfo info = check_header(path, in.spec(), limits);
+  const auto in = open_decoder(source);
+  const AssetImageInfo info = check_header(path, in->spec(), limits);
   if (!info.is_8bit) fail(path, "the image does not store 8-bit values");
   AssetImage8 img;
   img.width = info.width;
   img.height = info.height;
   img.channels = info.channels;
   img.pixels.resize(size_t(img.width) * size_t(img.height) * size_t(img.channels));
-  in.read(img.channels, img.pixels.data());
+  in->read(img.channels, img.pixels.data());
   return img;
 }
 

@@ -100,19 +100,9 @@ bool decode_rows(JpegErrors* errors, jpeg_decompress_struct* cinfo, uint8_t* dat
 
 }  // namespace
 
-bool has_jpeg_signature(const ImageSource& source) {
-  uint8_t head[3];
-  if (source.bytes) {
-    if (source.bytes->size() < 3) return false;
-    std::memcpy(head, source.bytes->data(), 3);
-  } else {
-    std::FILE* f = std::fopen(source.path.c_str(), "rb");
-    if (!f) return false;
-    const size_t n = std::fread(head, 1, 3, f);
-    std::fclose(f);
-    if (n != 3) return false;
-  }
-  return head[0] == 0xff && head[1] == 0xd8 && head[2] == 0xff;
+bool has_jpeg_signature(const SourceHead& head) {
+  const uint8_t* b = head.bytes;
+  return head.size >= 3 && b[0] == 0xff && b[1] == 0xd8 && b[2] == 0xff;
 }
 
 JpegImage::JpegImage(std::unique_ptr<State> state) : state_(std::move(state)) {}

@@ -7,16 +7,14 @@
 #include <memory>
 #include <vector>
 
-#include "renderer/io/oiio_plugin/oiio_plugin_abi.h"
+#include "renderer/io/asset_decoder.h"
 
 namespace penumbra {
 
-struct ImageSource;
-
 // True when the source starts with a JPEG start-of-image marker (FF D8 FF).
-bool has_jpeg_signature(const ImageSource& source);
+bool has_jpeg_signature(const SourceHead& head);
 
-class JpegImage {
+class JpegImage final : public AssetDecoder {
  public:
   // Reads the header (ImageIoError naming the source when it is broken); null for a valid file
   // this reader leaves to the plug-in (CMYK, YCCK).
@@ -25,11 +23,11 @@ class JpegImage {
   JpegImage(const JpegImage&) = delete;
   JpegImage& operator=(const JpegImage&) = delete;
 
-  const PenumbraImageSpec& spec() const { return spec_; }
+  const PenumbraImageSpec& spec() const override { return spec_; }
   // The first `channels` channels, channel-interleaved, top row first: as float (value / 255,
   // computed as OpenImageIO does) or as the decoded 8-bit values.
-  void read(int channels, float* pixels);
-  void read(int channels, uint8_t* pixels);
+  void read(int channels, float* pixels) override;
+  void read(int channels, uint8_t* pixels) override;
 
  struct State;  // libjpeg's state (jpeg_reader.cpp)
 

@@ -14,22 +14,23 @@
 
 #include <vector>
 
+#include "renderer/io/asset_decoder.h"
 #include "renderer/io/oiio_plugin/oiio_plugin_abi.h"
 
 namespace penumbra {
 
 // An image opened by the plug-in; its header is known, its pixels not yet decoded.
-class PluginImage {
+class PluginImage final : public AssetDecoder {
  public:
-  ~PluginImage();
+  ~PluginImage() override;
   PluginImage(const PluginImage&) = delete;
   PluginImage& operator=(const PluginImage&) = delete;
 
-  const PenumbraImageSpec& spec() const { return spec_; }
+  const PenumbraImageSpec& spec() const override { return spec_; }
   // Decodes the first `channels` channels as float (or as 8-bit values) into `pixels`; throws
   // ImageIoError.
-  void read(int channels, float* pixels);
-  void read(int channels, uint8_t* pixels);
+  void read(int channels, float* pixels) override;
+  void read(int channels, uint8_t* pixels) override;
 
  private:
   friend std::unique_ptr<PluginImage> open_plugin_image(const std::string& path);

@@ -85,19 +85,8 @@ struct PngImage::State {
   }
 };
 
-bool has_png_signature(const ImageSource& source) {
-  uint8_t head[kSignatureBytes];
-  if (source.bytes) {
-    if (source.bytes->size() < kSignatureBytes) return false;
-    std::memcpy(head, source.bytes->data(), kSignatureBytes);
-  } else {
-    std::FILE* f = std::fopen(source.path.c_str(), "rb");
-    if (!f) return false;
-    const size_t n = std::fread(head, 1, kSignatureBytes, f);
-    std::fclose(f);
-    if (n != kSignatureBytes) return false;
-  }
-  return png_sig_cmp(head, 0, kSignatureBytes) == 0;
+bool has_png_signature(const SourceHead& head) {
+  return head.size == kSignatureBytes && png_sig_cmp(head.bytes, 0, kSignatureBytes) == 0;
 }
 
 PngImage::PngImage(std::unique_ptr<State> state) : state_(std::move(state)) {}

@@ -15,19 +15,16 @@
 #include <string>
 #include <vector>
 
-#include "renderer/io/oiio_plugin/oiio_plugin_abi.h"
+#include "renderer/io/asset_decoder.h"
 
 namespace penumbra {
 
-struct ImageSource;
-
-// True when the source's first eight bytes are the PNG signature (a file that cannot be opened
-// is not: its error comes from the reader that is tried next).
-bool has_png_signature(const ImageSource& source);
+// True when the source's first eight bytes are the PNG signature.
+bool has_png_signature(const SourceHead& head);
 
 // A PNG whose header has been read; its pixels are decoded by read(). Errors throw ImageIoError
 // naming the source ("<path>: <reason>").
-class PngImage {
+class PngImage final : public AssetDecoder {
  public:
   // Reads the header (and nothing more: the caller checks the size before read()).
   static std::unique_ptr<PngImage> open(const ImageSource& source);
@@ -35,11 +32,11 @@ class PngImage {
   PngImage(const PngImage&) = delete;
   PngImage& operator=(const PngImage&) = delete;
 
-  const PenumbraImageSpec& spec() const { return spec_; }
+  const PenumbraImageSpec& spec() const override { return spec_; }
   // The first `channels` channels (at most spec().channels), channel-interleaved, top row first:
   // as float in [0, 1] (value / 255 or / 65535), or as the stored 8-bit values (8-bit images only).
-  void read(int channels, float* pixels);
-  void read(int channels, uint8_t* pixels);
+  void read(int channels, float* pixels) override;
+  void read(int channels, uint8_t* pixels) override;
 
  private:
   struct State;

@@ -16,6 +16,7 @@
 #include "renderer/io/image_io.h"
 #include "renderer/io/image_reader.h"
 #include "renderer/io/oiio_module.h"
+#include "tests/renderer/io/asset_reader_test_util.h"
 #include "tests/renderer/textures/texture_test_util.h"
 
 namespace penumbra::test {
@@ -99,11 +100,6 @@ void write_png(const std::string& path, const PngKind& kind, int w, int h) {
   png_write_end(png, nullptr);
   png_destroy_write_struct(&png, &info);
   std::fclose(f);
-}
-
-std::string read_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 const PngKind kKinds[] = {
@@ -202,7 +198,7 @@ TEST(PngReader, ImageInMemoryDecodesAsItsFile) {
   TempFolder dir("png_memory");
   const std::string path = dir.file("m.png");
   write_png(path, kKinds[1], 19, 11);
-  const std::string bytes = read_file(path);
+  const std::string bytes = file_bytes(path);
   const ImageSource source("embedded image 3",
                            std::make_shared<const std::vector<uint8_t>>(bytes.begin(), bytes.end()), "png");
   const AssetImage from_memory = read_asset_image(source), from_file = read_asset_image(path);
@@ -210,39 +206,26 @@ TEST(PngReader, ImageInMemoryDecodesAsItsFile) {
   EXPECT_EQ(from_memory.channels, 4);
 }
 
-// The call throws ImageIoError naming `name` and containing `reason`.
-template <typename F>
-void expect_error(F&& call, const std::string& name, const std::string& reason) {
-  try {
-    call();
-    ADD_FAILURE() << name << " was accepted";
-  } catch (const ImageIoError& e) {
-    const std::string what = e.what();
-    EXPECT_NE(what.find(name), std::string::npos) << what;
-    EXPECT_NE(what.find(reason), std::string::npos) << what;
-  }
-}
-
 TEST(PngReader, BrokenFilesFailWithTheSourceNamed) {
   TempFolder dir("png_broken");
   const std::string path = dir.file("whole.png");
   write_png(path, kKinds[0], 64, 64);
-  const std::string bytes = read_file(path);
+  const std::string bytes = file_bytes(path);
   // Cut anywhere after the signature: the header or the rows end early.
   for (size_t cut : {size_t(9), size_t(20), size_t(40), bytes.size() / 2, bytes.size() - 13}) {
     SCOPED_TRACE(cut);
     const std::string name = dir.file("cut" + std::to_string(cut) + ".png");
     std::ofstream(name, std::ios::binary) << bytes.substr(0, cut);
-    expect_error([&] { read_asset_image(name); }, name, "cannot");
+    expect_refused_naming([&] { read_asset_image(name); }, name, "cannot");
     auto memory = std::make_shared<const std::vector<uint8_t>>(bytes.begin(), bytes.begin() + std::ptrdiff_t(cut));
-    expect_error([&] { read_asset_image(ImageSource("embedded", memory, "png")); }, "embedded", "cannot");
+    expect_refused_naming([&] { read_asset_image(ImageSource("embedded", memory, "png")); }, "embedded", "cannot");
   }
   // A flipped bit in the image data: the chunk's CRC no longer matches.
   std::string flipped = bytes;
   flipped[bytes.size() / 2] = char(flipped[bytes.size() / 2] ^ 0x10);
   const std::string bad = dir.file("flipped.png");
   std::ofstream(bad, std::ios::binary) << flipped;
-  expect_error([&] { read_asset_image(bad); }, bad, "cannot decode the image");
+  expect_refused_naming([&] { read_asset_image(bad); }, bad, "cannot decode the image");
 }
 
 }  // namespace
