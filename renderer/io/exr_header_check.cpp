@@ -27,6 +27,25 @@ int fixed_attribute_size(const std::string& type) {
 
 uint32_t le32(const uint8_t* p) { return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24; }
 
+// OpenEXR 3.1 sizes a tiled file's offset table by the tile count its header implies before it
+// reads a tile: 1 x 1 tiles over a 100k x 100k window would be 80 GB. Refused above 2^22 tiles
+// (32 MB of offsets; a 65536 x 65536 image in 32 x 32 tiles), counting every level of a mipmap
+// (at most twice the first level's) or ripmap (four times).
+constexpr uint64_t kMaxExrTiles = uint64_t(1) << 22;
+
+void check_tile_count(bool tiled, int64_t w, int64_t h, uint32_t tile_w, uint32_t tile_h,
+                      uint32_t level_mode, const std::string& path) {
+  if (!tiled) return;
+  if (tile_w == 0 || tile_h == 0) throw ImageIoError(path + ": the tile description has a tile of size 0");
+  if (w <= 0 || h <= 0) return;  // OpenEXR refuses an empty or inverted window itself
+  const uint64_t nx = (uint64_t(w) + tile_w - 1) / tile_w, ny = (uint64_t(h) + tile_h - 1) / tile_h;
+  const uint64_t levels_factor = level_mode == 0 ? 1 : level_mode == 1 ? 2 : 4;
+  if (nx > kMaxExrTiles || ny > kMaxExrTiles || nx * ny * levels_factor > kMaxExrTiles)
+    throw ImageIoError(path + ": the image's " + std::to_string(w) + " x " + std::to_string(h) +
+                       " pixels in tiles of " + std::to_string(tile_w) + " x " + std::to_string(tile_h) +
+                       " make more than " + std::to_string(kMaxExrTiles) + " tiles");
+}
+
 }  // namespace
 
 // OpenEXR 3.1 allocates an attribute's value at the size the file declares before reading it, so
@@ -46,10 +65,17 @@ uint32_t check_exr_header(const uint8_t* head, size_t head_size, uint64_t file_s
     if (!zero) throw ImageIoError(path + ": the header's attribute " + what + " is unterminated or too long");
     pos = size_t(zero - head) + 1;
   };
+  // The data window and the tile description, for the tile count below.
+  int64_t window_w = 0, window_h = 0;
+  uint32_t tile_w = 0, tile_h = 0, level_mode = 0;
+  bool tiled = false;
   while (true) {
     if (pos >= head_size)
       throw ImageIoError(path + ": the header is truncated or larger than " + std::to_string(kMaxExrHeaderBytes) + " bytes");
-    if (head[pos] == 0) return flags;
+    if (head[pos] == 0) {
+      check_tile_count(tiled, window_w, window_h, tile_w, tile_h, level_mode, path);
+      return flags;
+    }
     const size_t name_at = pos;
     skip_text("name");
     const std::string name(reinterpret_cast<const char*>(head + name_at));
@@ -70,6 +96,15 @@ uint32_t check_exr_header(const uint8_t* head, size_t head_size, uint64_t file_s
     };
     if (const int fixed = fixed_attribute_size(type); fixed >= 0) {
       if (size != fixed) throw bad("wrong size");
+      if (available == size_t(size) && name == "dataWindow" && type == "box2i") {
+        window_w = int64_t(int32_t(le32(value + 8))) - int32_t(le32(value)) + 1;
+        window_h = int64_t(int32_t(le32(value + 12))) - int32_t(le32(value + 4)) + 1;
+      } else if (available == size_t(size) && name == "tiles" && type == "tiledesc") {
+        tiled = true;
+        tile_w = le32(value);
+        tile_h = le32(value + 4);
+        level_mode = value[8] & 0x0fu;
+      }
     } else if (type == "chlist") {
       // Entries "name\0" + 16 bytes, then a null byte ending exactly at the declared size.
       size_t at = 0;

@@ -58,12 +58,16 @@ bool read_info(png_structp png, png_infop info) {
   if (depth == 16) png_set_swap(png);  // PNG stores 16-bit values big-endian
 #endif
   png_set_interlace_handling(png);
-  png_read_update_info(png, info);
   return true;
 }
 
-bool read_rows(png_structp png, png_bytepp rows) {
+// libpng allocates (and clears) its row buffers at png_read_update_info, by the width the header
+// claims: it runs here, after the caller has checked the size against its limits, not when the
+// header is read (a header claiming 2^31 pixels per row would make that 16 GB).
+bool read_rows(png_structp png, png_infop info, png_bytepp rows, size_t expected_row_bytes) {
   if (setjmp(png_jmpbuf(png))) return false;
+  png_read_update_info(png, info);
+  if (png_get_rowbytes(png, info) != expected_row_bytes) png_error(png, "unexpected row size");
   png_read_image(png, rows);
   return true;
 }
@@ -125,21 +129,23 @@ std::unique_ptr<PngImage> PngImage::open(const ImageSource& source) {
   spec.width = int(png_get_image_width(png, info));
   spec.height = int(png_get_image_height(png, info));
   spec.depth = 1;
-  spec.channels = png_get_channels(png, info);
+  // The channels after read_info's expansions (libpng reports them only after
+  // png_read_update_info, which decode() calls): palettes become RGB, a tRNS chunk adds alpha.
+  const int type = png_get_color_type(png, info);
+  spec.channels = type == PNG_COLOR_TYPE_GRAY ? 1 : type == PNG_COLOR_TYPE_GRAY_ALPHA ? 2
+                  : type == PNG_COLOR_TYPE_RGB_ALPHA ? 4 : 3;
+  if (png_get_valid(png, info, PNG_INFO_tRNS) && (type & PNG_COLOR_MASK_ALPHA) == 0) ++spec.channels;
   spec.is_float = 0;
   spec.is_uint8 = png_get_bit_depth(png, info) == 16 ? 0 : 1;
   return image;
 }
 
 std::vector<uint8_t> PngImage::decode() {
-  png_structp png = state_->png;
-  const size_t row_bytes = png_get_rowbytes(png, state_->info);
-  const size_t expected = size_t(spec_.width) * size_t(spec_.channels) * (spec_.is_uint8 ? 1 : 2);
-  if (row_bytes != expected) throw ImageIoError(state_->path + ": cannot decode the image: unexpected row size");
+  const size_t row_bytes = size_t(spec_.width) * size_t(spec_.channels) * (spec_.is_uint8 ? 1 : 2);
   std::vector<uint8_t> data(row_bytes * size_t(spec_.height));
   std::vector<png_bytep> rows(size_t(spec_.height));
   for (size_t y = 0; y < rows.size(); ++y) rows[y] = data.data() + y * row_bytes;
-  if (!read_rows(png, rows.data())) state_->fail("cannot decode the image");
+  if (!read_rows(state_->png, state_->info, rows.data(), row_bytes)) state_->fail("cannot decode the image");
   return data;
 }
 

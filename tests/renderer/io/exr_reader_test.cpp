@@ -144,6 +144,29 @@ TEST(ExrReader, ImageInMemoryDecodesAsItsFile) {
   EXPECT_EQ(read_asset_image(source).pixels, read_asset_image(path).pixels);
 }
 
+// A tiled header whose data window is far larger than its pixels: 16 x 8 tiles over 100000 x
+// 100000 pixels, 78 million of them, would make OpenEXR allocate a 625 MB offset table before
+// reading a tile (1 x 1 tiles: 80 GB).
+TEST(ExrReader, HeaderImplyingTooManyTilesIsRefusedBeforeOpenExrSizesThem) {
+  TempFolder dir("exr_tiles");
+  const std::string path = dir.file("tiles.exr");
+  ExrKind kind{"tiny_tiles", {"R", "G", "B"}, Imf::HALF, true};
+  write_exr(path, kind, 4, 4);
+  std::string bytes = file_bytes(path);
+  // The attribute "dataWindow" (box2i, 16 bytes: xMin yMin xMax yMax, little-endian int32).
+  const std::string key = std::string("dataWindow") + '\0' + "box2i" + '\0';
+  const size_t at = bytes.find(key);
+  ASSERT_NE(at, std::string::npos);
+  const size_t value = at + key.size() + 4;
+  for (int k = 2; k < 4; ++k) {  // xMax = yMax = 99999
+    const uint32_t v = 99999;
+    std::memcpy(&bytes[value + 4 * size_t(k)], &v, 4);
+  }
+  const std::string huge = dir.file("huge.exr");
+  std::ofstream(huge, std::ios::binary) << bytes;
+  expect_refused_naming([&] { read_asset_image(huge); }, huge, "tiles of 16 x 8 make more than");
+}
+
 TEST(ExrReader, BrokenFilesFailWithTheSourceNamed) {
   TempFolder dir("exr_broken");
   const std::string path = dir.file("whole.exr");

@@ -77,6 +77,12 @@ TEST(ImageReader, HeaderClaimingTenGigapixelsIsRefusedBeforeDecoding) {
   // would allocate 120 GB as float.
   expect_refused([&] { probe_asset_image(png); }, png, "at most");
   expect_refused([&] { read_asset_image(png); }, png, "at most");
+  // A row of 2^31 - 1 pixels: refused from the header, before libpng sizes its row buffers (6 GB
+  // here, cleared when they are made).
+  const std::string wide = dir.file("wide.png");
+  write_bytes(wide, png_claiming(0x7fffffffu, 1));
+  expect_refused([&] { probe_asset_image(wide); }, wide, "at most");
+  expect_refused([&] { read_asset_image(wide); }, wide, "at most");
   ImageReadLimits pixels_only;
   pixels_only.max_pixels = 1000 * 1000;
   pixels_only.max_dimension = 1 << 30;
