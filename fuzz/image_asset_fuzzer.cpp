@@ -29,8 +29,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   limits.max_dimension = 4096;
   try {
     // Forms these readers leave to the plug-in are skipped.
-    if ((exr && !ExrImage::open(source)) || (hdr && !HdrImage::open(source)) ||
-        (jpeg && !JpegImage::open(source)))
+    if ((exr && !open_exr(source)) || (hdr && !open_hdr(source)) ||
+        (jpeg && !open_jpeg(source)))
       return 0;
     const AssetImageInfo info = probe_asset_image(source, limits);
     const AssetImage image = read_asset_image(source, limits);

@@ -21,7 +21,30 @@
 #include "renderer/io/image_reader.h"
 
 namespace penumbra {
+
+// The decoder open_exr returns (the header declares only that).
 namespace {
+class ExrImage final : public AssetDecoder {
+ public:
+  // open_exr (exr_reader.h).
+  static std::unique_ptr<ExrImage> open(const ImageSource& source);
+  ~ExrImage();
+  ExrImage(const ExrImage&) = delete;
+  ExrImage& operator=(const ExrImage&) = delete;
+
+  const PenumbraImageSpec& spec() const override { return spec_; }
+  // The first `channels` channels as float, channel-interleaved, top row first.
+  void read(int channels, float* pixels) override;
+  // EXR stores no 8-bit values: always throws ImageIoError.
+  void read(int channels, uint8_t* pixels) override;
+
+ private:
+  struct State;
+  explicit ExrImage(std::unique_ptr<State> state);
+  std::unique_ptr<State> state_;
+  PenumbraImageSpec spec_{};
+};
+
 
 // The channel sets this reader takes, in the order OpenImageIO gives them.
 constexpr std::array<std::array<const char*, 4>, 4> kLayouts = {{
@@ -120,7 +143,7 @@ std::unique_ptr<ExrImage> ExrImage::open(const ImageSource& source) {
 }
 
 void ExrImage::read(int channels, float* pixels) {
-  if (channels < 1 || channels > spec_.channels) throw ImageIoError(state_->path + ": no such channels");
+  check_read_channels(spec_, channels, state_->path);
   try {
     Imf::InputFile& file = *state_->file;
     const Imath::Box2i dw = file.header().dataWindow();
@@ -139,5 +162,7 @@ void ExrImage::read(int channels, float* pixels) {
 void ExrImage::read(int, uint8_t*) {
   throw ImageIoError(state_->path + ": the image does not store 8-bit values");
 }
+
+std::unique_ptr<AssetDecoder> open_exr(const ImageSource& source) { return ExrImage::open(source); }
 
 }  // namespace penumbra

@@ -6,7 +6,6 @@
 // unsubsampled; any other EXR (layers, luminance-chroma, multi-part, deep, integer channels) goes
 // to the plug-in, as before. Values are the stored ones converted to float, as OpenImageIO gives
 // them (half to float is exact), the data window as the image (tests compare the two readers).
-#include <cstdint>
 #include <memory>
 
 #include "renderer/io/asset_decoder.h"
@@ -16,26 +15,8 @@ namespace penumbra {
 // True when the source's first four bytes are OpenEXR's magic number.
 bool has_exr_signature(const SourceHead& head);
 
-class ExrImage final : public AssetDecoder {
- public:
-  // Reads and checks the header (exr_header_check.h; ImageIoError naming the source when it is
-  // broken); null for a valid EXR this reader leaves to the plug-in.
-  static std::unique_ptr<ExrImage> open(const ImageSource& source);
-  ~ExrImage();
-  ExrImage(const ExrImage&) = delete;
-  ExrImage& operator=(const ExrImage&) = delete;
-
-  const PenumbraImageSpec& spec() const override { return spec_; }
-  // The first `channels` channels as float, channel-interleaved, top row first.
-  void read(int channels, float* pixels) override;
-  // EXR stores no 8-bit values: always throws ImageIoError.
-  void read(int channels, uint8_t* pixels) override;
-
- private:
-  struct State;
-  explicit ExrImage(std::unique_ptr<State> state);
-  std::unique_ptr<State> state_;
-  PenumbraImageSpec spec_{};
-};
+// Reads and checks the header (exr_header_check.h; ImageIoError naming the source when it is
+// broken); null for a valid EXR this reader leaves to the plug-in.
+std::unique_ptr<AssetDecoder> open_exr(const ImageSource& source);
 
 }  // namespace penumbra

@@ -10,43 +10,35 @@
 #include "renderer/io/image_reader.h"
 
 namespace penumbra {
+
+// The decoder open_hdr returns (the header declares only that).
 namespace {
+class HdrImage final : public AssetDecoder {
+ public:
+  // open_hdr (hdr_reader.h).
+  static std::unique_ptr<HdrImage> open(const ImageSource& source);
+  ~HdrImage();
+  HdrImage(const HdrImage&) = delete;
+  HdrImage& operator=(const HdrImage&) = delete;
+
+  const PenumbraImageSpec& spec() const override { return spec_; }
+  // The first `channels` channels (R, G, B) as float, channel-interleaved, top row first.
+  void read(int channels, float* pixels) override;
+  // RGBE stores no 8-bit values: always throws ImageIoError.
+  void read(int channels, uint8_t* pixels) override;
+
+ private:
+  struct State;
+  explicit HdrImage(std::unique_ptr<State> state);
+  std::unique_ptr<State> state_;
+  PenumbraImageSpec spec_{};
+};
+
 
 constexpr size_t kMaxHeaderBytes = 64 * 1024;  // real headers are a few hundred bytes
 
-// Bytes of a file or of memory, read in order.
-class ByteReader {
- public:
-  explicit ByteReader(const ImageSource& source) : bytes_(source.bytes) {
-    if (!bytes_) file_ = std::fopen(source.path.c_str(), "rb");
-  }
-  ~ByteReader() {
-    if (file_) std::fclose(file_);
-  }
-  ByteReader(const ByteReader&) = delete;
-  ByteReader& operator=(const ByteReader&) = delete;
-  bool ok() const { return bytes_ || file_; }
-  // Reads n bytes; false at the end of the data.
-  bool read(uint8_t* out, size_t n) {
-    if (file_) return std::fread(out, 1, n, file_) == n;
-    if (n > bytes_->size() - offset_) return false;
-    std::memcpy(out, bytes_->data() + offset_, n);
-    offset_ += n;
-    return true;
-  }
-  int get() {
-    uint8_t c;
-    return read(&c, 1) ? c : -1;
-  }
-
- private:
-  std::shared_ptr<const std::vector<uint8_t>> bytes_;
-  std::FILE* file_ = nullptr;
-  size_t offset_ = 0;
-};
-
 // One line of the header without its newline; false at the end of the data or past the cap.
-bool read_line(ByteReader& in, std::string* line, size_t* header_bytes) {
+bool read_line(SourceReader& in, std::string* line, size_t* header_bytes) {
   line->clear();
   for (;;) {
     const int c = in.get();
@@ -64,7 +56,7 @@ float rgbe_component(uint8_t mantissa, uint8_t exponent) {
 
 struct HdrImage::State {
   std::string path;
-  std::unique_ptr<ByteReader> in;  // positioned at the first scanline
+  std::unique_ptr<SourceReader> in;  // positioned at the first scanline
 };
 
 bool has_hdr_signature(const SourceHead& head) {
@@ -77,7 +69,7 @@ HdrImage::~HdrImage() = default;
 std::unique_ptr<HdrImage> HdrImage::open(const ImageSource& source) {
   auto s = std::make_unique<State>();
   s->path = source.path;
-  s->in = std::make_unique<ByteReader>(source);
+  s->in = std::make_unique<SourceReader>(source);
   if (!s->in->ok()) throw ImageIoError(source.path + ": cannot open the file");
   auto fail = [&](const std::string& why) -> ImageIoError {
     return ImageIoError(source.path + ": cannot read the image: " + why);
@@ -107,9 +99,9 @@ std::unique_ptr<HdrImage> HdrImage::open(const ImageSource& source) {
 }
 
 void HdrImage::read(int channels, float* pixels) {
-  if (channels < 1 || channels > 3) throw ImageIoError(state_->path + ": no such channels");
+  check_read_channels(spec_, channels, state_->path);
   const size_t w = size_t(spec_.width);
-  ByteReader& in = *state_->in;
+  SourceReader& in = *state_->in;
   auto fail = [&](const char* why) {
     return ImageIoError(state_->path + ": cannot decode the image: " + why);
   };
@@ -167,5 +159,7 @@ void HdrImage::read(int channels, float* pixels) {
 void HdrImage::read(int, uint8_t*) {
   throw ImageIoError(state_->path + ": the image does not store 8-bit values");
 }
+
+std::unique_ptr<AssetDecoder> open_hdr(const ImageSource& source) { return HdrImage::open(source); }
 
 }  // namespace penumbra

@@ -6,7 +6,6 @@
 // 4-byte pixels. A value is mantissa * 2^(exponent - 136), 0 where the exponent is 0: exact in
 // float, so the same floats as OpenImageIO's reader (tests compare the two). Taken: the standard
 // orientation "-Y h +X w" and 32-bit_rle_rgbe; other orientations and XYZE go to the plug-in.
-#include <cstdint>
 #include <memory>
 
 #include "renderer/io/asset_decoder.h"
@@ -16,26 +15,8 @@ namespace penumbra {
 // True when the source starts with "#?" (Radiance's header magic).
 bool has_hdr_signature(const SourceHead& head);
 
-class HdrImage final : public AssetDecoder {
- public:
-  // Reads the header (ImageIoError naming the source when it is broken); null for a valid file
-  // this reader leaves to the plug-in.
-  static std::unique_ptr<HdrImage> open(const ImageSource& source);
-  ~HdrImage();
-  HdrImage(const HdrImage&) = delete;
-  HdrImage& operator=(const HdrImage&) = delete;
-
-  const PenumbraImageSpec& spec() const override { return spec_; }
-  // The first `channels` channels (R, G, B) as float, channel-interleaved, top row first.
-  void read(int channels, float* pixels) override;
-  // RGBE stores no 8-bit values: always throws ImageIoError.
-  void read(int channels, uint8_t* pixels) override;
-
- private:
-  struct State;
-  explicit HdrImage(std::unique_ptr<State> state);
-  std::unique_ptr<State> state_;
-  PenumbraImageSpec spec_{};
-};
+// Reads the header (ImageIoError naming the source when it is broken); null for a valid file
+// this reader leaves to the plug-in.
+std::unique_ptr<AssetDecoder> open_hdr(const ImageSource& source);
 
 }  // namespace penumbra

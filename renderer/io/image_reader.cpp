@@ -47,13 +47,13 @@ std::unique_ptr<AssetDecoder> open_decoder(const ImageSource& source) {
   const SourceHead head = read_source_head(source);
   std::unique_ptr<AssetDecoder> decoder;
   if (has_png_signature(head))
-    decoder = PngImage::open(source);
+    decoder = open_png(source);
   else if (has_exr_signature(head))
-    decoder = ExrImage::open(source);  // null: an EXR of a form left to the plug-in
+    decoder = open_exr(source);  // null: an EXR of a form left to the plug-in
   else if (has_hdr_signature(head))
-    decoder = HdrImage::open(source);  // null: an orientation or XYZE left to the plug-in
+    decoder = open_hdr(source);  // null: an orientation or XYZE left to the plug-in
   else if (has_jpeg_signature(head))
-    decoder = JpegImage::open(source);  // null: CMYK or YCCK, left to the plug-in
+    decoder = open_jpeg(source);  // null: CMYK or YCCK, left to the plug-in
   if (!decoder) decoder = open_plugin_image(source);
   return decoder;
 }

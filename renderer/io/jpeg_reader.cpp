@@ -14,7 +14,32 @@
 #include "renderer/io/image_reader.h"
 
 namespace penumbra {
+
+// The decoder open_jpeg returns (the header declares only that).
 namespace {
+class JpegImage final : public AssetDecoder {
+ public:
+  // open_jpeg (jpeg_reader.h).
+  static std::unique_ptr<JpegImage> open(const ImageSource& source);
+  ~JpegImage();
+  JpegImage(const JpegImage&) = delete;
+  JpegImage& operator=(const JpegImage&) = delete;
+
+  const PenumbraImageSpec& spec() const override { return spec_; }
+  // The first `channels` channels, channel-interleaved, top row first: as float (value / 255,
+  // computed as OpenImageIO does) or as the decoded 8-bit values.
+  void read(int channels, float* pixels) override;
+  void read(int channels, uint8_t* pixels) override;
+
+ struct State;  // libjpeg's state (jpeg_reader.cpp)
+
+ private:
+  explicit JpegImage(std::unique_ptr<State> state);
+  std::vector<uint8_t> decode();
+  std::unique_ptr<State> state_;
+  PenumbraImageSpec spec_{};
+};
+
 
 // A progressive JPEG may hold any number of scans, each a pass over the whole coefficient
 // buffer: a small file can cost minutes of CPU. libjpeg-turbo's djpeg -maxscan guards against it
@@ -145,21 +170,17 @@ std::vector<uint8_t> JpegImage::decode() {
 }
 
 void JpegImage::read(int channels, float* pixels) {
-  if (channels < 1 || channels > spec_.channels) throw ImageIoError(state_->path + ": no such channels");
+  check_read_channels(spec_, channels, state_->path);
   const std::vector<uint8_t> data = decode();
-  const size_t n = size_t(spec_.width) * size_t(spec_.height), in_channels = size_t(spec_.channels);
-  const float scale = 1.f / 255.f;  // OpenImageIO's conversion (png_reader.cpp)
-  for (size_t i = 0; i < n; ++i)
-    for (int c = 0; c < channels; ++c)
-      pixels[i * size_t(channels) + size_t(c)] = float(data[i * in_channels + size_t(c)]) * scale;
+  widen_8bit(data.data(), size_t(spec_.width) * size_t(spec_.height), spec_.channels, channels, pixels);
 }
 
 void JpegImage::read(int channels, uint8_t* pixels) {
-  if (channels < 1 || channels > spec_.channels) throw ImageIoError(state_->path + ": no such channels");
+  check_read_channels(spec_, channels, state_->path);
   const std::vector<uint8_t> data = decode();
-  const size_t n = size_t(spec_.width) * size_t(spec_.height), in_channels = size_t(spec_.channels);
-  for (size_t i = 0; i < n; ++i)
-    std::memcpy(pixels + i * size_t(channels), data.data() + i * in_channels, size_t(channels));
+  keep_8bit(data.data(), size_t(spec_.width) * size_t(spec_.height), spec_.channels, channels, pixels);
 }
+
+std::unique_ptr<AssetDecoder> open_jpeg(const ImageSource& source) { return JpegImage::open(source); }
 
 }  // namespace penumbra

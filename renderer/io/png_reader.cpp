@@ -10,15 +10,38 @@
 #include "renderer/io/image_reader.h"
 
 namespace penumbra {
+
+// The decoder open_png returns (the header declares only that).
 namespace {
+class PngImage final : public AssetDecoder {
+ public:
+  // open_png (png_reader.h).
+  static std::unique_ptr<PngImage> open(const ImageSource& source);
+  ~PngImage();
+  PngImage(const PngImage&) = delete;
+  PngImage& operator=(const PngImage&) = delete;
+
+  const PenumbraImageSpec& spec() const override { return spec_; }
+  // The first `channels` channels (at most spec().channels), channel-interleaved, top row first:
+  // as float in [0, 1] (value / 255 or / 65535), or as the stored 8-bit values (8-bit images only).
+  void read(int channels, float* pixels) override;
+  void read(int channels, uint8_t* pixels) override;
+
+ private:
+  struct State;
+  explicit PngImage(std::unique_ptr<State> state);
+  std::vector<uint8_t> decode();  // every row at the stored depth, after the expansions above
+  std::unique_ptr<State> state_;
+  PenumbraImageSpec spec_{};
+};
+
 
 constexpr size_t kSignatureBytes = 8;
 
 // What libpng's callbacks reach through their pointers: the bytes' source and the last error.
 struct PngIo {
-  std::FILE* file = nullptr;                      // a file source, or
-  const std::vector<uint8_t>* bytes = nullptr;    // bytes in memory, read from `offset`
-  size_t offset = 0;
+  explicit PngIo(const ImageSource& source) : in(source) {}
+  SourceReader in;
   char error[256] = "";
 };
 
@@ -33,14 +56,7 @@ struct PngIo {
 void on_warning(png_structp, png_const_charp) {}
 
 void read_bytes(png_structp png, png_bytep out, size_t n) {
-  auto* io = static_cast<PngIo*>(png_get_io_ptr(png));
-  if (io->file) {
-    if (std::fread(out, 1, n, io->file) != n) png_error(png, "the file ends early");
-    return;
-  }
-  if (n > io->bytes->size() - io->offset) png_error(png, "the image ends early");
-  std::memcpy(out, io->bytes->data() + io->offset, n);
-  io->offset += n;
+  if (!static_cast<PngIo*>(png_get_io_ptr(png))->in.read(out, n)) png_error(png, "the data ends early");
 }
 
 // The libpng calls that may fail, each behind its own setjmp point: these frames hold nothing
@@ -75,14 +91,13 @@ bool read_rows(png_structp png, png_infop info, png_bytepp rows, size_t expected
 }  // namespace
 
 struct PngImage::State {
+  explicit State(const ImageSource& source) : path(source.path), io(source) {}
   std::string path;
-  std::shared_ptr<const std::vector<uint8_t>> bytes;  // an image in memory: kept alive
   PngIo io;
   png_structp png = nullptr;
   png_infop info = nullptr;
   ~State() {
     if (png) png_destroy_read_struct(&png, info ? &info : nullptr, nullptr);
-    if (io.file) std::fclose(io.file);
   }
   [[noreturn]] void fail(const std::string& what) const {
     throw ImageIoError(path + ": " + what + ": " + io.error);
@@ -97,15 +112,8 @@ PngImage::PngImage(std::unique_ptr<State> state) : state_(std::move(state)) {}
 PngImage::~PngImage() = default;
 
 std::unique_ptr<PngImage> PngImage::open(const ImageSource& source) {
-  auto s = std::make_unique<State>();
-  s->path = source.path;
-  if (source.bytes) {
-    s->bytes = source.bytes;
-    s->io.bytes = s->bytes.get();
-  } else {
-    s->io.file = std::fopen(source.path.c_str(), "rb");
-    if (!s->io.file) throw ImageIoError(source.path + ": cannot open the file");
-  }
+  auto s = std::make_unique<State>(source);
+  if (!s->io.in.ok()) throw ImageIoError(source.path + ": cannot open the file");
   s->png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &s->io, on_error, on_warning);
   if (s->png) s->info = png_create_info_struct(s->png);
   if (!s->png || !s->info) throw ImageIoError(source.path + ": cannot read the image: libpng could not start");
@@ -150,36 +158,28 @@ std::vector<uint8_t> PngImage::decode() {
 }
 
 void PngImage::read(int channels, float* pixels) {
-  if (channels < 1 || channels > spec_.channels) throw ImageIoError(state_->path + ": no such channels");
+  check_read_channels(spec_, channels, state_->path);
   const std::vector<uint8_t> data = decode();
   const size_t n = size_t(spec_.width) * size_t(spec_.height);
+  if (spec_.is_uint8) return widen_8bit(data.data(), n, spec_.channels, channels, pixels);
+  // 16 bits: value times 1/65535 in float, OpenImageIO's conversion, as widen_8bit's.
+  const float scale = 1.f / 65535.f;
   const size_t in_channels = size_t(spec_.channels);
-  // The conversions OpenImageIO makes (value times 1/255 or 1/65535, in float), so textures
-  // decode to the same floats through either reader.
-  if (spec_.is_uint8) {
-    const float scale = 1.f / 255.f;
-    for (size_t i = 0; i < n; ++i)
-      for (int c = 0; c < channels; ++c)
-        pixels[i * size_t(channels) + size_t(c)] = float(data[i * in_channels + size_t(c)]) * scale;
-  } else {
-    const float scale = 1.f / 65535.f;
-    for (size_t i = 0; i < n; ++i)
-      for (int c = 0; c < channels; ++c) {
-        uint16_t v;
-        std::memcpy(&v, data.data() + 2 * (i * in_channels + size_t(c)), sizeof v);
-        pixels[i * size_t(channels) + size_t(c)] = float(v) * scale;
-      }
-  }
+  for (size_t i = 0; i < n; ++i)
+    for (int c = 0; c < channels; ++c) {
+      uint16_t v;
+      std::memcpy(&v, data.data() + 2 * (i * in_channels + size_t(c)), sizeof v);
+      pixels[i * size_t(channels) + size_t(c)] = float(v) * scale;
+    }
 }
 
 void PngImage::read(int channels, uint8_t* pixels) {
   if (!spec_.is_uint8) throw ImageIoError(state_->path + ": the image does not store 8-bit values");
-  if (channels < 1 || channels > spec_.channels) throw ImageIoError(state_->path + ": no such channels");
+  check_read_channels(spec_, channels, state_->path);
   const std::vector<uint8_t> data = decode();
-  const size_t n = size_t(spec_.width) * size_t(spec_.height);
-  const size_t in_channels = size_t(spec_.channels);
-  for (size_t i = 0; i < n; ++i)
-    std::memcpy(pixels + i * size_t(channels), data.data() + i * in_channels, size_t(channels));
+  keep_8bit(data.data(), size_t(spec_.width) * size_t(spec_.height), spec_.channels, channels, pixels);
 }
+
+std::unique_ptr<AssetDecoder> open_png(const ImageSource& source) { return PngImage::open(source); }
 
 }  // namespace penumbra

@@ -10,10 +10,7 @@
 // difference, on purpose: colour is not multiplied by alpha. PNG stores unassociated alpha, glTF
 // and Mitsuba 3 read it so; OpenImageIO premultiplies unless asked not to, which darkens the
 // colour of partly transparent texels of a cut-out leaf or a glTF base colour.
-#include <cstdint>
 #include <memory>
-#include <string>
-#include <vector>
 
 #include "renderer/io/asset_decoder.h"
 
@@ -24,26 +21,7 @@ bool has_png_signature(const SourceHead& head);
 
 // A PNG whose header has been read; its pixels are decoded by read(). Errors throw ImageIoError
 // naming the source ("<path>: <reason>").
-class PngImage final : public AssetDecoder {
- public:
-  // Reads the header (and nothing more: the caller checks the size before read()).
-  static std::unique_ptr<PngImage> open(const ImageSource& source);
-  ~PngImage();
-  PngImage(const PngImage&) = delete;
-  PngImage& operator=(const PngImage&) = delete;
-
-  const PenumbraImageSpec& spec() const override { return spec_; }
-  // The first `channels` channels (at most spec().channels), channel-interleaved, top row first:
-  // as float in [0, 1] (value / 255 or / 65535), or as the stored 8-bit values (8-bit images only).
-  void read(int channels, float* pixels) override;
-  void read(int channels, uint8_t* pixels) override;
-
- private:
-  struct State;
-  explicit PngImage(std::unique_ptr<State> state);
-  std::vector<uint8_t> decode();  // every row at the stored depth, after the expansions above
-  std::unique_ptr<State> state_;
-  PenumbraImageSpec spec_{};
-};
+// Reads the header (and nothing more: the caller checks the size before read()).
+std::unique_ptr<AssetDecoder> open_png(const ImageSource& source);
 
 }  // namespace penumbra

@@ -75,7 +75,7 @@ TEST(HdrReader, RunLengthEncodedFilesDecodeAsOpenImageIoDoesBitForBit) {
     const std::string path = dir.file("rle" + std::to_string(w) + ".hdr");
     const int h = 13;
     write_test_image(path, w, h, 3, radiance(w, h));
-    ASSERT_NE(HdrImage::open(path), nullptr);
+    ASSERT_NE(open_hdr(path), nullptr);
     const AssetImage ours = read_asset_image(path);
     EXPECT_EQ(ours.width, w);
     EXPECT_EQ(ours.channels, 3);
@@ -100,7 +100,7 @@ TEST(HdrReader, OtherOrientationsAreLeftToThePlugin) {
   TempFolder dir("hdr_orientation");
   const std::string path = dir.file("up.hdr");
   std::ofstream(path, std::ios::binary) << flat_hdr(4, 2, "+Y 2 +X 4");
-  EXPECT_EQ(HdrImage::open(path), nullptr);
+  EXPECT_EQ(open_hdr(path), nullptr);
 }
 
 TEST(HdrReader, BrokenFilesFailWithTheSourceNamed) {

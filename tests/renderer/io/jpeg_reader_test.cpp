@@ -81,7 +81,7 @@ TEST(JpegReader, DecodesAsOpenImageIoDoesBitForBit) {
     const std::string path = dir.file(std::string(kind.name) + ".jpg");
     const int w = 53, h = 37;  // not multiples of the 8x8 blocks or the 16x16 macroblocks
     write_jpeg(path, w, h, kind.channels, kind.subsampling, kind.progressive);
-    ASSERT_NE(JpegImage::open(path), nullptr);
+    ASSERT_NE(open_jpeg(path), nullptr);
     auto plugin = open_plugin_image(path);
     ASSERT_EQ(plugin->spec().channels, kind.channels);
     std::vector<float> expected(size_t(w) * size_t(h) * size_t(kind.channels));
@@ -131,7 +131,7 @@ TEST(JpegReader, CmykIsLeftToThePlugin) {
   TempFolder dir("jpeg_cmyk");
   const std::string path = dir.file("cmyk.jpg");
   write_cmyk_jpeg(path, 16, 8);
-  EXPECT_EQ(JpegImage::open(path), nullptr);
+  EXPECT_EQ(open_jpeg(path), nullptr);
   EXPECT_EQ(read_asset_image(path).channels, 3);  // the plug-in's RGB
 }
 
