@@ -119,7 +119,7 @@ void choose_lights(const float* __restrict cdf, int32_t lights, size_t n,
 
 StagedLights::StagedLights(const Scene& scene) {
   const size_t lights = size_t(scene.light_count());
-  kind.assign(lights, kNotStaged);
+  kind.assign(lights, kOwnCode);
   index.assign(lights, -1);
   for (size_t l = 0; l < lights; ++l) {
     const Light& light = scene.light(int(l));

@@ -2,12 +2,14 @@
 // Next-event light choices and light samples over arrays, for the wavefront driver's SIMD
 // stages: one path at a time a quad light's sample is a dependent chain of multiplies, a square
 // root and two divisions; over arrays eight or sixteen paths go at once. Static, untextured quad
-// lights (the emitters of most scenes), point and directional lights have kernels; a path that
-// chose any other light samples it with its scalar code (the stages' path integrator never
-// chooses a constant environment: Light::left_to_bsdf_sampling). The values are the scalar
-// code's to the bit: the kernels are LightSampler::choose, Quad::sample with AreaLight::sample,
-// and PointLight::sample operation for operation, compiled without contraction into fused
-// multiply-adds (renderer/CMakeLists.txt).
+// lights (the emitters of most scenes), point and directional lights have kernels (the stages'
+// path integrator never chooses a constant environment: Light::left_to_bsdf_sampling). The
+// values are the scalar code's to the bit: the kernels are LightSampler::choose, Quad::sample
+// with AreaLight::sample, and PointLight::sample operation for operation, compiled without
+// contraction into fused multiply-adds (renderer/CMakeLists.txt). Every other light (spheres,
+// emitting meshes, textured or moving quads, spot lights, environment maps) is `kOwnCode`: the
+// stage calls its Light::sample lane by lane, with the lane's point, time and sampler values,
+// and the rest of the step stays in the lanes.
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -22,7 +24,8 @@ namespace penumbra {
 struct StagedLights {
   explicit StagedLights(const Scene& scene);
 
-  enum Kind : int32_t { kNotStaged, kQuad, kPoint, kDirectional };
+  // kOwnCode: no kernel; sampled lane by lane through Light::sample.
+  enum Kind : int32_t { kOwnCode, kQuad, kPoint, kDirectional };
   // A static, untextured quad light: what Quad::sample and AreaLight::sample read.
   struct QuadLight {
     int32_t light;

@@ -423,13 +423,6 @@ SurfaceStage::SurfaceStage(const Scene& scene, StageModel model)
     : scene_(scene), model_(model), lights_(scene) {
   params_of_.assign(scene.object_count(), -1);
   textured_of_.assign(scene.object_count(), 0);
-  // Where every light a path can choose lacks a kernel, each lane of a model that estimates
-  // direct light would go back to path_scatter after the stage's work: take nothing.
-  const LightSampler& sampler = scene.mis_light_sampler();
-  bool kernel_light = false;
-  for (int l = 0; l < int(lights_.kind.size()); ++l)
-    kernel_light |= lights_.kind[size_t(l)] != StagedLights::kNotStaged && sampler.pmf(l) > 0.f;
-  if (estimates_light(!sampler.empty()) && !kernel_light) return;
   for (size_t o = 0; o < scene.object_count(); ++o) {
     const Material& m = scene.material(scene.object(uint32_t(o)).material);
     // A rough plastic's coating tables join the stage's list the first time a surface uses them.
@@ -456,6 +449,7 @@ SurfaceStage::SurfaceStage(const Scene& scene, StageModel model)
 void SurfaceStage::start(size_t paths) {
   count_ = 0;
   unfit_.clear();
+  own_code_lanes_.clear();
   mapped_lanes_.clear();
   if (slot_.size() >= paths) return;
   slot_.resize(paths);
@@ -609,11 +603,11 @@ void SurfaceStage::compute(const IntegratorSettings& settings, bool scene_next_e
           break;
         }
         default:
-          staged_[i] = 0;  // path_scatter samples this light itself
-          light_ok_[i] = 0;
+          own_code_lanes_.push_back(uint32_t(i));
       }
     }
   }
+  if (!own_code_lanes_.empty()) sample_own_code_lights();
   Lanes L;
   for (int c = 0; c < 3; ++c) {
     L.p[c] = p_[c].data();
@@ -677,6 +671,28 @@ void SurfaceStage::compute(const IntegratorSettings& settings, bool scene_next_e
       smooth_dielectric_step_kernel};
   static_assert(std::size(kKernels) == std::size(kStageModels));
   kKernels[size_t(model_)](L, n, next_event, any_mapped, int32_t(settings.rr_depth));
+}
+
+void SurfaceStage::sample_own_code_lights() {
+  // path_scatter's call with the same point, time and sampler values: the same sample to the
+  // bit, which the kernel then takes as it takes a quad's (a zero normal marks a point in free
+  // space, an infinite distance a direction).
+  for (const uint32_t i : own_code_lanes_) {
+    const vec3 ref(p_[0][i], p_[1][i], p_[2][i]);
+    LightSample ls;
+    const vec2 u(u_point_[0][i], u_point_[1][i]);
+    light_ok_[i] = scene_.light(light_[i]).sample(ref, time_[i], u, &ls);
+    l_delta_[i] = ls.is_delta;
+    l_distance_[i] = ls.distance;
+    l_pdf_[i] = ls.pdf;
+    for (int c = 0; c < 3; ++c) {
+      l_wi_[c][i] = ls.wi[c];
+      l_p_[c][i] = ls.p[c];
+      l_error_[c][i] = ls.p_error[c];
+      l_n_[c][i] = ls.n[c];
+      l_value_[c][i] = ls.value[c];
+    }
+  }
 }
 
 void SurfaceStage::shadow(size_t i, ShadowQuery* q) const {

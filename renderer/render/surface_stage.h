@@ -13,9 +13,9 @@
 // The results are path_scatter's to the bit for the path integrator: the same operations in the
 // same order (glm's dot is (x + y) + z, to_world is (s x + t y) + n z, std::max and std::min
 // as their comparisons), the branches as selects between values all lanes compute, the file
-// compiled without contraction into fused multiply-adds (renderer/CMakeLists.txt). A path whose
-// chosen light has no kernel (sphere, mesh and image lights) takes path_scatter
-// itself (`staged(lane)` false).
+// compiled without contraction into fused multiply-adds (renderer/CMakeLists.txt). A light
+// without a kernel (spheres, emitting meshes, spot lights, environment maps: light_kernels.h)
+// is sampled lane by lane by its own Light::sample, the rest of the step in the lanes.
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -66,9 +66,8 @@ class SurfaceStage {
 
   size_t size() const { return count_; }
   uint32_t slot(size_t lane) const { return slot_[lane]; }
-  // False if the lane's chosen light has no kernel, or its model could not repeat the scalar
-  // arithmetic exactly (lane_bsdfs.h): the caller takes the step with path_scatter instead of
-  // the results below.
+  // False if the lane's looked-up parameters leave the model (a textured hit's may): the caller
+  // takes the step with path_scatter instead of the results below.
   bool staged(size_t lane) const { return staged_[lane] != 0; }
   // The step's results, as path_scatter leaves them: whether the path goes on (then `apply`
   // updates its state and sampler cursor), whether it has a shadow query, and whether it
@@ -100,6 +99,9 @@ class SurfaceStage {
   [[gnu::always_inline]] inline void write_params(size_t i, const SurfaceParams& q);
   // Lane i's parameters looked up at a textured hit (and its normal map's frame and normal).
   [[gnu::noinline]] void add_textured(size_t i, const PathState& s, const SurfaceHit& hit);
+  // The light samples of the lanes whose chosen light has no kernel (own_code_lanes_), each by
+  // its Light::sample, into the lanes' light arrays.
+  [[gnu::noinline]] void sample_own_code_lights();
 
   const Scene& scene_;
   StageModel model_;
@@ -122,6 +124,7 @@ class SurfaceStage {
   // The light sample per lane.
   std::vector<int32_t> light_, light_ok_, l_delta_;
   std::vector<float> l_wi_[3], l_distance_, l_pdf_, l_p_[3], l_error_[3], l_n_[3], l_value_[3], l_pmf_;
+  std::vector<uint32_t> own_code_lanes_;  // lanes whose light is StagedLights::kOwnCode
   // The lanes whose looked-up parameters leave the model (a textured hit's may), and the
   // normal-mapped lanes: their mask (set in compute, only when there are any: the kernels'
   // mapped case then costs the other batches nothing), tangent frames' s and t, mapped normals.

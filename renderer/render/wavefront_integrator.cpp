@@ -122,7 +122,7 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
         const size_t k = stage->slot(lane);
         const uint32_t p = live[k];
         PathState& s = b.states_[p];
-        if (!stage->staged(lane)) {  // its light has no kernel: the step one path at a time
+        if (!stage->staged(lane)) {  // its parameters leave the model: the step one path at a time
           PrefetchedSampler sampler(*b.samplers_[p], b.cursors_[p], samples, hit_of[k]);
           bool shadow;
           goes_on[k] = path_scatter<kDistributed, kFeatures>(scene, settings, s, b.hits_[k],

@@ -6,7 +6,9 @@
 // result must be path_scatter's to the bit: whether the path goes on, its new state and how
 // many sampler values it took, its shadow ray and contribution, and the ray count. The lights:
 // two quads and an environment (area lights with MIS), a point and a directional light (deltas),
-// and an emitting sphere, which has no kernel: lanes that choose it must say so.
+// and an emitting sphere and an emitting box mesh, which have no kernel (their own
+// Light::sample per lane); in a second scene an environment map and a moving quad light (also
+// sampled by their own code).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -80,6 +82,10 @@ MaterialParams stage_material(StageModel model, float roughness, float ior) {
   return DiffuseParams{};
 }
 
+// The lights of floor_scene: none; quads, a sphere, a mesh, point and directional lights in a
+// constant environment; or an environment map and a moving quad light.
+enum class Lights { kNone, kMixed, kMapAndMovingQuad };
+
 SceneInput floor_scene(bool lights, const MaterialParams& material) {
   SceneInput in;
   in.camera = camera_looking({0, 2, 4}, {0, 0, 0}, 40.f);
@@ -93,9 +99,35 @@ SceneInput floor_scene(bool lights, const MaterialParams& material) {
     in.objects.push_back(
         quad_object({1.5f, -1, 1}, {0, 0, -2}, {0, 1.5f, 0}, 1, Spectrum(1.f, 2.f, 3.f)));
     in.objects.push_back(sphere_object({2.f, 2.5f, -1.5f}, 0.3f, 1, Spectrum(3.f, 3.f, 2.f)));
+    ObjectDesc box;
+    box.shape = box_mesh({-2.5f, 1.8f, 1.f}, {-2.f, 2.2f, 1.4f});
+    box.material = 1;
+    box.emission = Spectrum(2.f, 1.f, 0.5f);
+    in.objects.push_back(box);
     in.lights = {PointLightDesc{{-1, 1, 1}, Spectrum(2.f)},
                  DirectionalLightDesc{{-0.3f, -1.f, -0.2f}, Spectrum(0.8f, 0.6f, 0.4f)}};
   }
+  return in;
+}
+
+SceneInput floor_scene(Lights lights, const MaterialParams& material) {
+  if (lights != Lights::kMapAndMovingQuad) return floor_scene(lights == Lights::kMixed, material);
+  SceneInput in = floor_scene(false, material);
+  // A map with a bright patch (its sampling far from uniform) over a dim gradient.
+  EnvironmentMapDesc map;
+  map.width = 32;
+  map.height = 16;
+  for (int y = 0; y < map.height; ++y)
+    for (int x = 0; x < map.width; ++x)
+      for (int c = 0; c < 3; ++c)
+        map.rgb.push_back((x > 20 && x < 24 && y > 3 && y < 6) ? 40.f + float(c)
+                                                                  : 0.05f * float(x + y + c));
+  map.scale = 0.7f;
+  in.environment_map = map;
+  ObjectDesc moving = quad_object({-0.5f, 2, -0.5f}, {1, 0, 0}, {0, 0, 1}, 1, Spectrum(5.f));
+  moving.velocity = vec3(0.3f, 0.f, 0.1f);
+  in.objects.push_back(moving);
+  in.camera.shutter_close = 1.f;  // (without a shutter interval nothing moves)
   return in;
 }
 
@@ -148,11 +180,14 @@ std::vector<Lane> floor_hits(const Scene& scene, size_t count, uint32_t seed) {
 struct Coverage {
   int staged = 0, fallback = 0, alive = 0, dead = 0, shadows = 0, back = 0, ball = 0, delta = 0;
   int delta_lights = 0;  // staged lanes whose chosen light is a point or directional light
+  int own_code_lights = 0;  // staged lanes whose chosen light has no kernel
 };
 
-Coverage expect_stage_matches_material(bool lights, uint32_t seed, StageModel model,
+Coverage expect_stage_matches_material(Lights which, uint32_t seed, StageModel model,
                                        const MaterialParams& material) {
-  const auto scene = Scene::build(floor_scene(lights, material));
+  const bool lights = which != Lights::kNone;
+  const auto scene = Scene::build(floor_scene(which, material));
+  const StagedLights staged_lights(*scene);
   IntegratorSettings settings;
   settings.max_depth = 16;
   settings.rr_depth = 4;
@@ -186,8 +221,10 @@ Coverage expect_stage_matches_material(bool lights, uint32_t seed, StageModel mo
     ++cover.staged;
     if (next_event) {
       LightSample ls;
-      const Light& light = scene->light(scene->light_sampler().choose(lanes[k].x[0]));
+      const int chosen = scene->mis_light_sampler().choose(lanes[k].x[0]);
+      const Light& light = scene->light(chosen);
       cover.delta_lights += light.sample(hit.p, 0.f, vec2(0.5f), &ls) && ls.is_delta;
+      cover.own_code_lights += staged_lights.kind[size_t(chosen)] == StagedLights::kOwnCode;
     }
     cover.back += glm::dot(lanes[k].state.ray.direction, hit.ng) > 0.f;
     cover.ball += hit.object == 1;
@@ -231,25 +268,49 @@ Coverage expect_stage_matches_material(bool lights, uint32_t seed, StageModel mo
   return cover;
 }
 
-Coverage expect_stage_matches_scatter(bool lights, uint32_t seed, StageModel model,
+Coverage expect_stage_matches_material(bool lights, uint32_t seed, StageModel model,
+                                       const MaterialParams& material) {
+  return expect_stage_matches_material(lights ? Lights::kMixed : Lights::kNone, seed, model,
+                                       material);
+}
+
+Coverage expect_stage_matches_scatter(Lights lights, uint32_t seed, StageModel model,
                                       float roughness = 0.f, float ior = 1.5f) {
   return expect_stage_matches_material(lights, seed, model,
                                        stage_material(model, roughness, ior));
 }
 
-TEST(SurfaceStage, LambertStepIsPathScatterToTheBitWithAreaDeltaAndUnstagedLights) {
+Coverage expect_stage_matches_scatter(bool lights, uint32_t seed, StageModel model,
+                                      float roughness = 0.f, float ior = 1.5f) {
+  return expect_stage_matches_scatter(lights ? Lights::kMixed : Lights::kNone, seed, model,
+                                      roughness, ior);
+}
+
+TEST(SurfaceStage, LambertStepIsPathScatterToTheBitWithAreaDeltaAndOwnCodeLights) {
   const Coverage c = expect_stage_matches_scatter(true, 7, StageModel::kLambert);
   // Every branch of the step was taken: lanes on both sides, paths that die (roulette, the
-  // disk's edge) and go on, shadow rays, lanes lit by delta lights, and lanes left to
-  // path_scatter for the sphere light.
+  // disk's edge) and go on, shadow rays, lanes lit by delta lights and by the sphere and mesh
+  // lights (sampled by their own code), none left to path_scatter.
   EXPECT_GT(c.staged, 1000);
-  EXPECT_GT(c.fallback, 50);
+  EXPECT_EQ(c.fallback, 0);
+  EXPECT_GT(c.own_code_lights, 100);
   EXPECT_GT(c.delta_lights, 200);
   EXPECT_GT(c.alive, 500);
   EXPECT_GT(c.dead, 50);
   EXPECT_GT(c.shadows, 500);
   EXPECT_GT(c.back, 200);
   EXPECT_GT(c.ball, 500);
+}
+
+// An environment map and a moving quad light: every lane's light sampled by its own code.
+TEST(SurfaceStage, LambertStepIsPathScatterToTheBitUnderAnEnvironmentMap) {
+  const Coverage c = expect_stage_matches_scatter(Lights::kMapAndMovingQuad, 9, StageModel::kLambert);
+  EXPECT_GT(c.staged, 1000);
+  EXPECT_EQ(c.fallback, 0);
+  EXPECT_EQ(c.own_code_lights, c.staged);
+  EXPECT_GT(c.shadows, 500);
+  EXPECT_GT(c.alive, 500);
+  EXPECT_GT(c.back, 200);
 }
 
 TEST(SurfaceStage, LambertStepIsPathScatterToTheBitWithoutLights) {
@@ -270,7 +331,8 @@ void expect_model_cases(StageModel model, std::initializer_list<float> roughness
       SCOPED_TRACE("roughness " + std::to_string(roughness) + " ior " + std::to_string(ior));
       const Coverage c = expect_stage_matches_scatter(true, seed, model, roughness, ior);
       EXPECT_GT(c.staged, 1000);
-      EXPECT_GT(c.fallback, 50);  // the sphere light
+      EXPECT_EQ(c.fallback, 0);
+      EXPECT_GT(c.own_code_lights, 100);  // the sphere and mesh lights
       EXPECT_GT(c.delta_lights, 200);
       EXPECT_GT(c.alive, 300);
       EXPECT_GT(c.dead, 50);
@@ -289,6 +351,11 @@ void expect_model_cases(StageModel model, std::initializer_list<float> roughness
   EXPECT_EQ(c.shadows, 0);
   EXPECT_GT(c.alive, 300);
   EXPECT_GT(c.dead, 50);
+  const Coverage m = expect_stage_matches_scatter(Lights::kMapAndMovingQuad, seed + 2, model, 0.4f, 1.5f);
+  EXPECT_EQ(m.fallback, 0);
+  EXPECT_EQ(m.own_code_lights, m.staged);
+  EXPECT_GT(m.shadows, 100);
+  EXPECT_GT(m.alive, 300);
 }
 
 TEST(SurfaceStage, RoughConductorStepIsPathScatterToTheBit) {
@@ -388,7 +455,7 @@ TEST(SurfaceStage, MirrorAndSmoothDielectricStepsArePathScatterToTheBit) {
 // Textured parameters, looked up per hit by the stage (add) as path_scatter looks them up: a
 // colour texture and a roughness texture whose texels reach 0 (where a conductor's or a
 // dielectric's lobe turns into the smooth model's Dirac delta, which the rough stage leaves to
-// path_scatter: fallback lanes besides the sphere light's).
+// path_scatter: the only fallback lanes).
 TEST(SurfaceStage, TexturedSurfacesArePathScatterToTheBit) {
   TempFolder dir("surface_stage_textures");
   std::mt19937 rng(41);
@@ -432,9 +499,10 @@ TEST(SurfaceStage, TexturedSurfacesArePathScatterToTheBit) {
     EXPECT_GT(cv.shadows, 100);
     EXPECT_GT(cv.alive, 300);
     EXPECT_GT(cv.ball, k.smooth_texels ? 250 : 500);
-    // Otherwise only the sphere light's lanes fall back (a few percent).
     if (k.smooth_texels) {
       EXPECT_GT(cv.fallback, 400);
+    } else {
+      EXPECT_EQ(cv.fallback, 0);
     }
   }
 }
@@ -530,22 +598,18 @@ TEST(SurfaceStage, TakesOnlyPlainSurfacesOfItsModel) {
   EXPECT_EQ(taken(*scene, StageModel::kRoughDielectric), "0000000");
 }
 
-// With lights of which none has a kernel (here an emitting sphere), every lane of a model that
-// estimates direct light would go back to path_scatter: such stages take nothing; a mirror's
-// step samples no light and stays.
-TEST(SurfaceStage, TakesNothingThatEstimatesLightWhenNoLightHasAKernel) {
+// Lights without a kernel (here an emitting sphere) are sampled by their own code in the lanes:
+// the stages take their surfaces as under any other light.
+TEST(SurfaceStage, TakesSurfacesLitOnlyByLightsWithoutAKernel) {
   SceneInput in = floor_scene(false, DiffuseParams{Spectrum(0.5f)});
   in.materials.push_back(ConductorParams{Spectrum(0.9f), 0.f});
   in.objects.push_back(quad_object({-2, 1, 2}, {4, 0, 0}, {0, 0, -4}, 2));
   in.objects.push_back(sphere_object({2.f, 2.5f, -1.5f}, 0.3f, 1, Spectrum(3.f)));
   const auto scene = Scene::build(in);
   ASSERT_FALSE(scene->mis_light_sampler().empty());
-  EXPECT_EQ(taken(*scene, StageModel::kLambert), "0000");
+  // Objects: floor and ball (Lambertian), a mirror, the sphere light (black Lambertian).
+  EXPECT_EQ(taken(*scene, StageModel::kLambert), "1101");
   EXPECT_EQ(taken(*scene, StageModel::kSmoothConductor), "0010");
-  // A quad light beside it gives the Lambertian stage work again (the lights' own black
-  // Lambertian surfaces too).
-  in.objects.push_back(quad_object({-0.5f, 2, -0.5f}, {1, 0, 0}, {0, 0, 1}, 1, Spectrum(5.f)));
-  EXPECT_EQ(taken(*Scene::build(in), StageModel::kLambert), "11011");
 }
 
 TEST(SurfaceStage, TakesDielectricsThatRefractByTheirRoughness) {
