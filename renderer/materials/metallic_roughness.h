@@ -53,6 +53,14 @@ class MetallicRoughnessBsdf : public OpaqueBsdf {
   // OIDN asks for (docs/output-layers.md).
   Spectrum albedo() const { return base_color_; }
 
+  // The constants the surface stage's lane version reads (render/lane_bsdfs.h).
+  float metallic() const { return metallic_; }
+  float roughness() const { return roughness_; }
+  float alpha() const { return distr_.alpha(); }  // GGX alpha, clamped as the lobe uses it
+  float e_avg() const { return e_avg_; }
+  float dielectric_avg() const { return dielectric_avg_; }
+  const Spectrum& f_ms() const { return f_ms_; }
+
   // The dielectric's specular reflectance f0 (ior 1.5, as glTF: ((1.5 - 1) / (1.5 + 1))^2).
   static constexpr float kDielectricF0 = 0.04f;
 

@@ -121,6 +121,12 @@ MicrofacetAlbedo ggx_albedo(float cos_theta, float roughness) {
               lerp(t.albedo[j + 1][i], t.albedo[j + 1][i + 1], fi), fj);
 }
 
+const float* ggx_albedo_table() {
+  static_assert(sizeof(MicrofacetAlbedo) == 2 * sizeof(float));
+  static_assert(sizeof(Table::albedo) == sizeof(float) * 2 * kN * kN);
+  return &table().albedo[0][0].e;
+}
+
 MicrofacetAlbedo ggx_albedo_average(float roughness) {
   const Table& t = table();
   int j;

@@ -31,4 +31,9 @@ MicrofacetAlbedo ggx_albedo_average(float roughness);
 // Table resolution (nodes along cos theta and along roughness), for tests.
 inline constexpr int kAlbedoTableRes = 48;
 
+// The table ggx_albedo interpolates, for the surface stages' lane version of it
+// (render/lane_bsdfs.h): E and E5 of node (roughness j, cos i) at [2 (j kAlbedoTableRes + i)]
+// and the next float.
+const float* ggx_albedo_table();
+
 }  // namespace penumbra

@@ -18,6 +18,7 @@
 
 #include "renderer/core/math.h"
 #include "renderer/materials/lane_microfacet.h"
+#include "renderer/materials/microfacet_albedo.h"
 #include "renderer/render/light_kernels.h"
 #include "renderer/sampling/sampling.h"
 
@@ -28,17 +29,21 @@ namespace penumbra::lane {
 struct Tables {
   const float* cosines;
   const float* transmittance;
+  const float* ggx_albedo;  // materials/microfacet_albedo.h's ggx_albedo_table()
 };
 
 // A lane's surface parameters: a colour; for microfacet models GGX alpha (already clamped to
 // kMinMicrofacetAlpha as GgxDistribution holds it); for plastics the coating's ior, the
-// coating's sampling weight, the diffuse factor and its table (first entry and node count).
+// coating's sampling weight, the diffuse factor and its table (first entry and node count);
+// for glTF's metallic-roughness model its metallic factor, roughness (the albedo table's
+// coordinate), E_avg, E_F,avg of the dielectric and F_ms of the metal.
 struct Params {
   float c[3];
   float alpha;
   float eta, spec_weight, diffuse_scale;
   int32_t table, nodes;
   Tables tables;
+  float metallic, roughness, e_avg, dielectric_avg, f_ms[3];
 };
 
 // The BSDF's answer towards a light: f (times the cosine) and the pdf of its own sampling.
@@ -438,6 +443,147 @@ struct SmoothDielectric {
     r.eta = when(pick_r, 1.f, fr.eta_it);
     r.ok = ~mask(a[2] == 0.f) & finite(weight) & finite(r.wo[0]) & finite(r.wo[1]) &
            finite(r.wo[2]);
+    return r;
+  }
+};
+
+// ggx_albedo (materials/microfacet_albedo.cpp) on one lane: the bilinear lookup, its locate
+// and lerp operation for operation, the four nodes gathered from the table.
+struct Albedo {
+  float e, e5;
+};
+[[gnu::always_inline]] inline void albedo_locate(float x, int32_t* i, float* f) {
+  constexpr int32_t kN = kAlbedoTableRes;
+  const float p = (x < 0.f ? 0.f : (1.f < x ? 1.f : x)) * float(kN - 1);  // std::clamp
+  const int32_t k = int32_t(p);
+  const int32_t node = kN - 2 < k ? kN - 2 : k;  // std::min
+  *f = p - float(node);
+  // (A NaN x, which only a lane the model answers zero for can hold, converts to INT_MIN: kept
+  // inside the table.)
+  *i = node < 0 ? 0 : node;
+}
+[[gnu::always_inline]] inline Albedo ggx_albedo(const float* table, float mu, float roughness) {
+  constexpr int32_t kN = kAlbedoTableRes;
+  int32_t i, j;
+  float fi, fj;
+  albedo_locate(mu, &i, &fi);
+  albedo_locate(roughness, &j, &fj);
+  const int32_t k0 = 2 * (j * kN + i), k1 = k0 + 2 * kN;
+  const float e0 = table[k0] + (table[k0 + 2] - table[k0]) * fi;
+  const float e50 = table[k0 + 1] + (table[k0 + 3] - table[k0 + 1]) * fi;
+  const float e1 = table[k1] + (table[k1 + 2] - table[k1]) * fi;
+  const float e51 = table[k1 + 1] + (table[k1 + 3] - table[k1 + 1]) * fi;
+  return {e0 + (e1 - e0) * fj, e50 + (e51 - e50) * fj};
+}
+
+// MetallicRoughnessBsdf (materials/metallic_roughness.h) when rough (not the smooth limit's
+// Dirac mirror): a Lambertian base under an f0 = 0.04 GGX layer mixed with a GGX metal by the
+// metallic factor, albedo-scaled (Kulla and Conty 2017); the specular lobe and the diffuse-like
+// part chosen in proportion to their albedos towards wi, one-sample MIS over the two.
+struct MetallicRoughness {
+  static constexpr bool kTwoSided = true;
+  static constexpr bool kDeltaOnly = false;
+  static constexpr float kF0 = 0.04f;  // MetallicRoughnessBsdf::kDielectricF0
+  [[gnu::always_inline]] static float positive(float x) { return 0.f < x ? x : 0.f; }  // max(0, x)
+  // specular_probability with both lobes enabled, from wi's albedo a.
+  [[gnu::always_inline]] static float specular_probability(const Params& q, const Albedo& a) {
+    const float ei = kF0 * (a.e - a.e5) + a.e5;
+    const float one_m = 1.f - q.metallic;
+    const float kd = one_m * positive(1.f - ei);
+    const float km = q.metallic * positive(1.f - a.e);
+    float dv[3], sv[3];
+    for (int c = 0; c < 3; ++c) {
+      dv[c] = kd * q.c[c] + km * q.f_ms[c];
+      // specular_albedo: Schlick is linear in f0.
+      const float metal = q.c[c] * (a.e - a.e5) + a.e5;
+      sv[c] = one_m * ei + q.metallic * metal;
+    }
+    const float d = ((dv[0] + dv[1]) + dv[2]) / 3.f;
+    const float s = ((sv[0] + sv[1]) + sv[2]) / 3.f;
+    const float ratio = s / (s + d);
+    const float clamped = ratio < 0.05f ? 0.05f : (0.95f < ratio ? 0.95f : ratio);
+    return when(~mask(d > 0.f), 1.f, when(~mask(s > 0.f), 0.f, clamped));
+  }
+  // MetallicRoughnessBsdf::evaluate<true, true> with every lobe (sample weighs with it;
+  // eval_pdf cleans it as SurfaceBsdf does); ai = wi's albedo, p_spec = specular_probability
+  // (q, ai), which sample has already (computed once there, GCC vectorises the loop).
+  [[gnu::always_inline]] static EvalPdf evaluate(const Params& q, const float* a, const float* b,
+                                                 const Albedo& ai, float p_spec) {
+    const Albedo ao = ggx_albedo(q.tables.ggx_albedo, b[2], q.roughness);
+    float h[3] = {a[0] + b[0], a[1] + b[1], a[2] + b[2]};
+    normalize(h);
+    const float d = Ggx::ndf(q.alpha, h);
+    const float g1_i = Ggx::smith_g1(q.alpha, a, h);
+    // diffuse_value: the dielectric's albedo-scaled base, then the metal's multiple scattering.
+    const float one_m = 1.f - q.metallic;
+    const float ei = kF0 * (ai.e - ai.e5) + ai.e5;
+    const float eo = kF0 * (ao.e - ao.e5) + ao.e5;
+    const float floor_avg = 1.f - q.dielectric_avg;
+    const float scale_d =
+        positive(1.f - ei) * positive(1.f - eo) / (kPi * (1e-6f < floor_avg ? floor_avg : 1e-6f));
+    const Mask has_d = mask(q.metallic < 1.f);
+    const Mask has_m = mask(q.metallic > 0.f) & mask(1.f - q.e_avg > 1e-6f);
+    const float scale_m = positive(1.f - ai.e) * positive(1.f - ao.e) / (kPi * (1.f - q.e_avg));
+    // The specular lobe: Walter et al. 2007 eq. 20 times cos_o, Schlick's Fresnel at wi.h.
+    const float s = d * (g1_i * Ggx::smith_g1(q.alpha, b, h)) / (4.f * a[2]);
+    const float cos_ih = dot3(a, h);
+    const float x = 1.f - cos_ih;
+    const float xc = x < 0.f ? 0.f : (1.f < x ? 1.f : x);  // std::clamp
+    const float x2 = xc * xc;
+    const float w = x2 * x2 * xc;
+    const float dielectric = kF0 + (1.f - kF0) * w;
+    const Mask has_s = finite(s);
+    EvalPdf r;
+    for (int c = 0; c < 3; ++c) {
+      float v = when(has_d, 0.f + (one_m * scale_d) * q.c[c], 0.f);
+      v = when(has_m, v + (q.metallic * scale_m) * q.f_ms[c], v);
+      const float f = 0.f + v * b[2];
+      const float fresnel = one_m * dielectric + q.metallic * (q.c[c] + (1.f - q.c[c]) * w);
+      r.f[c] = when(has_s, f + fresnel * s, f);
+    }
+    float p = 0.f + (1.f - p_spec) * (b[2] > 0.f ? b[2] * kInvPi : 0.f);
+    const float g = d * g1_i / (4.f * a[2]);
+    p = when(mask(dot3(b, h) > 0.f) & finite(g), p + p_spec * g, p);
+    r.pdf = p;
+    const Mask zero = mask(a[2] <= 0.f) | mask(b[2] <= 0.f);
+    for (int c = 0; c < 3; ++c) r.f[c] = when(zero, 0.f, r.f[c]);
+    r.pdf = when(zero, 0.f, r.pdf);
+    return r;
+  }
+
+  [[gnu::always_inline]] static EvalPdf eval_pdf(const Params& q, const float* a,
+                                                 const float* b) {
+    const Albedo ai = ggx_albedo(q.tables.ggx_albedo, a[2], q.roughness);
+    EvalPdf r = evaluate(q, a, b, ai, specular_probability(q, ai));
+    // SurfaceBsdf zeroes a value with a component that is not finite, and such a pdf.
+    const Mask f_finite = finite(r.f[0]) & finite(r.f[1]) & finite(r.f[2]);
+    for (int c = 0; c < 3; ++c) r.f[c] = when(f_finite, r.f[c], 0.f);
+    r.pdf = when(finite(r.pdf), r.pdf, 0.f);
+    return r;
+  }
+
+  [[gnu::always_inline]] static Sample sample(const Params& q, const float* a, float u_lobe,
+                                              float u0, float u1) {
+    const Albedo ai = ggx_albedo(q.tables.ggx_albedo, a[2], q.roughness);
+    const float p_spec = specular_probability(q, ai);
+    const Mask pick_spec = mask(u_lobe < p_spec);
+    // The specular lobe's direction: visible normals, reflect; the base's: cosine-weighted.
+    float m[3];
+    Ggx::sample_visible(q.alpha, a, u0, u1, m);
+    const float two_dot = 2.f * dot3(a, m);
+    float wo[3];
+    disk_concentric(u0, u1, &wo[0], &wo[1]);
+    wo[2] = safe_root(1.f - wo[0] * wo[0] - wo[1] * wo[1]);
+    Sample r;
+    for (int c = 0; c < 3; ++c) r.wo[c] = when(pick_spec, two_dot * m[c] - a[c], wo[c]);
+    // One-sample MIS over the lobes: weight = f cos / (mixture pdf) (Veach 1997 ch. 9).
+    const EvalPdf e = evaluate(q, a, r.wo, ai, p_spec);
+    r.pdf = e.pdf;
+    for (int c = 0; c < 3; ++c) r.weight[c] = e.f[c] / e.pdf;
+    // MetallicRoughnessBsdf::sample's conditions, then SurfaceBsdf::sample's checks.
+    r.ok = ~mask(a[2] <= 0.f) & ~mask(r.wo[2] <= 0.f) & mask(r.pdf > 0.f) & finite(r.pdf) &
+           finite(r.weight[0]) & finite(r.weight[1]) & finite(r.weight[2]) & finite(r.wo[0]) &
+           finite(r.wo[1]) & finite(r.wo[2]);
     return r;
   }
 };

@@ -9,6 +9,8 @@
 #include "renderer/materials/conductor.h"
 #include "renderer/materials/dielectric.h"
 #include "renderer/materials/diffuse.h"
+#include "renderer/materials/metallic_roughness.h"
+#include "renderer/materials/microfacet_albedo.h"
 #include "renderer/materials/plastic.h"
 #include "renderer/render/lane_bsdfs.h"
 #include "renderer/sampling/sampling.h"
@@ -66,6 +68,7 @@ namespace {
 struct Lanes {
   const float *p[3], *e[3], *ng[3], *ns[3], *dir[3], *beta[3];
   const float *colour[3], *alpha, *coat_eta, *spec_weight, *diffuse_scale;
+  const float *metallic, *roughness, *e_avg, *dielectric_avg, *f_ms[3];
   const int32_t *table, *nodes;
   lane::Tables tables;
   // Normal-mapped lanes: whether, the tangent frame's s and t (path_step.h tangent_frame; its
@@ -173,7 +176,12 @@ template <class Model, bool kNextEvent, bool kMapped>
                          L.diffuse_scale[i],
                          L.table[i],
                          L.nodes[i],
-                         L.tables};
+                         L.tables,
+                         L.metallic[i],
+                         L.roughness[i],
+                         L.e_avg[i],
+                         L.dielectric_avg[i],
+                         {L.f_ms[0][i], L.f_ms[1][i], L.f_ms[2][i]}};
     // Frame(ns).
     float fs[3], ft[3];
     duff_frame(nx, ny, nz, fs, ft);
@@ -370,6 +378,19 @@ void rough_dielectric_step_kernel(const Lanes& lanes, size_t n, bool next_event,
                                   int32_t rr_depth) {
   step_cases<lane::RoughDielectric>(lanes, n, next_event, mapped, rr_depth);
 }
+// Without partial redundancy elimination: GCC's PRE turned this model's zero tests (evaluate's
+// wi.z <= 0 or wo.z <= 0, sample's own) into selects between booleans of different widths,
+// which its vectoriser refuses, and the loop stayed scalar (no ymm instruction in any clone).
+#if defined(__GNUC__) && !defined(__clang__)
+#define PENUMBRA_NO_TREE_PRE __attribute__((optimize("no-tree-pre")))
+#else
+#define PENUMBRA_NO_TREE_PRE
+#endif
+PENUMBRA_SIMD_CLONES PENUMBRA_NO_TREE_PRE
+void metallic_roughness_step_kernel(const Lanes& lanes, size_t n, bool next_event, bool mapped,
+                                    int32_t rr_depth) {
+  step_cases<lane::MetallicRoughness>(lanes, n, next_event, mapped, rr_depth);
+}
 
 }  // namespace
 
@@ -387,6 +408,17 @@ bool SurfaceStage::fill_params(const SurfaceBsdf& b, SurfaceParams* q) const {
     q->eta = dielectric->ior();
   } else if (!b.two_sided()) {
     return false;
+  } else if (model_ == StageModel::kMetallicRoughness) {
+    const auto* mr = std::get_if<MetallicRoughnessBsdf>(&bsdf);
+    if (!mr || mr->smooth()) return false;
+    q->colour = mr->albedo();
+    q->alpha = mr->alpha();
+    q->metallic = mr->metallic();
+    q->roughness = mr->roughness();
+    q->e_avg = mr->e_avg();
+    q->dielectric_avg = mr->dielectric_avg();
+    q->f_ms = mr->f_ms();
+    if (!is_finite(q->f_ms)) return false;
   } else if (model_ == StageModel::kLambert) {
     const auto* diffuse = std::get_if<DiffuseBsdf>(&bsdf);
     if (!diffuse) return false;
@@ -444,6 +476,9 @@ SurfaceStage::SurfaceStage(const Scene& scene, StageModel model)
     textured_of_[o] = m.varies();  // (a normal map makes a material vary)
     params_.push_back(q);
   }
+  // (The albedo table is built on first use: only for a stage that takes a surface.)
+  if (model == StageModel::kMetallicRoughness && !params_.empty())
+    albedo_table_ = ggx_albedo_table();
 }
 
 void SurfaceStage::start(size_t paths) {
@@ -457,9 +492,10 @@ void SurfaceStage::start(size_t paths) {
     for (auto* a : {&p_[c], &p_error_[c], &ng_[c], &ns_[c], &dir_[c], &beta_[c], &colour_[c],
                     &l_wi_[c], &l_p_[c], &l_error_[c], &l_n_[c], &l_value_[c], &s_origin_[c],
                     &s_dir_[c], &s_contrib_[c], &origin_[c], &wo_[c], &beta_out_[c],
-                    &frame_s_[c], &frame_t_[c], &mapped_n_[c]})
+                    &frame_s_[c], &frame_t_[c], &mapped_n_[c], &f_ms_[c]})
       a->resize(paths);
-  for (auto* a : {&alpha_, &coat_eta_, &spec_weight_, &diffuse_scale_, &time_, &eta_, &u_light_,
+  for (auto* a : {&alpha_, &coat_eta_, &spec_weight_, &diffuse_scale_, &metallic_, &roughness_,
+                  &e_avg_, &dielectric_avg_, &time_, &eta_, &u_light_,
                   &u_point_[0], &u_point_[1], &u_lobe_, &u_dir_[0], &u_dir_[1], &u_rr_,
                   &l_distance_, &l_pdf_, &l_pmf_, &s_t_max_, &prev_pdf_, &eta_out_})
     a->resize(paths);
@@ -478,6 +514,13 @@ void SurfaceStage::write_params(size_t i, const SurfaceParams& q) {
     diffuse_scale_[i] = q.diffuse_scale;
     table_[i] = q.table;
     nodes_[i] = q.nodes;
+  }
+  if (model_ == StageModel::kMetallicRoughness) {
+    metallic_[i] = q.metallic;
+    roughness_[i] = q.roughness;
+    e_avg_[i] = q.e_avg;
+    dielectric_avg_[i] = q.dielectric_avg;
+    for (int c = 0; c < 3; ++c) f_ms_[c][i] = q.f_ms[c];
   }
 }
 
@@ -617,6 +660,7 @@ void SurfaceStage::compute(const IntegratorSettings& settings, bool scene_next_e
     L.dir[c] = dir_[c].data();
     L.beta[c] = beta_[c].data();
     L.colour[c] = colour_[c].data();
+    L.f_ms[c] = f_ms_[c].data();
     L.l_wi[c] = l_wi_[c].data();
     L.l_p[c] = l_p_[c].data();
     L.l_error[c] = l_error_[c].data();
@@ -633,9 +677,13 @@ void SurfaceStage::compute(const IntegratorSettings& settings, bool scene_next_e
   L.coat_eta = coat_eta_.data();
   L.spec_weight = spec_weight_.data();
   L.diffuse_scale = diffuse_scale_.data();
+  L.metallic = metallic_.data();
+  L.roughness = roughness_.data();
+  L.e_avg = e_avg_.data();
+  L.dielectric_avg = dielectric_avg_.data();
   L.table = table_.data();
   L.nodes = nodes_.data();
-  L.tables = lane::Tables{table_cosines_.data(), table_values_.data()};
+  L.tables = lane::Tables{table_cosines_.data(), table_values_.data(), albedo_table_};
   L.u_lobe = u_lobe_.data();
   L.time = time_.data();
   L.mapped = mapped_.data();
@@ -668,7 +716,7 @@ void SurfaceStage::compute(const IntegratorSettings& settings, bool scene_next_e
   static constexpr Kernel kKernels[] = {
       lambert_step_kernel,          rough_conductor_step_kernel,  smooth_plastic_step_kernel,
       rough_plastic_step_kernel,    rough_dielectric_step_kernel, smooth_conductor_step_kernel,
-      smooth_dielectric_step_kernel};
+      smooth_dielectric_step_kernel, metallic_roughness_step_kernel};
   static_assert(std::size(kKernels) == std::size(kStageModels));
   kKernels[size_t(model_)](L, n, next_event, any_mapped, int32_t(settings.rr_depth));
 }

@@ -1,6 +1,7 @@
 #pragma once
 // The wavefront driver's surface stages: the step of every path that hit a surface of one
-// BSDF model (Lambertian, conductors, plastics and dielectrics; constant or textured parameters,
+// BSDF model (Lambertian, conductors, plastics, dielectrics and glTF's metallic-roughness;
+// constant or textured parameters,
 // with or without a normal map), after its
 // emission, as loops over arrays: the light choice and light sample (light_kernels.h), the
 // BSDF's value, pdf and MIS weight towards the light, the shadow ray and its contribution, then
@@ -34,11 +35,12 @@ enum class StageModel : uint8_t {
   kRoughDielectric, // DielectricBsdf with microfacet lobes (not smooth, not index-matched)
   kSmoothConductor, // ConductorBsdf's mirror
   kSmoothDielectric,  // DielectricBsdf's Dirac reflection and refraction (not index-matched)
+  kMetallicRoughness,  // MetallicRoughnessBsdf (glTF) with a microfacet lobe (not the mirror)
 };
 inline constexpr StageModel kStageModels[] = {
     StageModel::kLambert,         StageModel::kRoughConductor,  StageModel::kSmoothPlastic,
     StageModel::kRoughPlastic,    StageModel::kRoughDielectric, StageModel::kSmoothConductor,
-    StageModel::kSmoothDielectric};
+    StageModel::kSmoothDielectric, StageModel::kMetallicRoughness};
 
 class SurfaceStage {
  public:
@@ -91,6 +93,8 @@ class SurfaceStage {
     Spectrum colour;
     float alpha = 0.f, eta = 1.f, spec_weight = 0.f, diffuse_scale = 0.f;
     int32_t table = 0, nodes = 0;
+    float metallic = 0.f, roughness = 0.f, e_avg = 0.f, dielectric_avg = 0.f;
+    Spectrum f_ms{0.f};
   };
   // q's fields for this stage's model from BSDF b; false if b is not of the model (or has a
   // non-finite colour, or coating tables the stage does not hold).
@@ -113,11 +117,13 @@ class SurfaceStage {
   // The rough plastics' coating tables, one after another (lane::Tables), and whose they are.
   std::vector<float> table_cosines_, table_values_;
   std::vector<const CoatingTables*> tables_;
+  const float* albedo_table_ = nullptr;  // ggx_albedo_table(), for the metallic-roughness model
   size_t count_ = 0;
   std::vector<uint32_t> slot_;
   // Inputs per lane.
   std::vector<float> p_[3], p_error_[3], ng_[3], ns_[3], dir_[3], beta_[3], colour_[3];
   std::vector<float> alpha_, coat_eta_, spec_weight_, diffuse_scale_;
+  std::vector<float> metallic_, roughness_, e_avg_, dielectric_avg_, f_ms_[3];
   std::vector<int32_t> table_, nodes_;
   std::vector<float> time_, eta_, u_light_, u_point_[2], u_lobe_, u_dir_[2], u_rr_;
   std::vector<int32_t> depth_;

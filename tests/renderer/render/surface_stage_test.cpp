@@ -78,6 +78,8 @@ MaterialParams stage_material(StageModel model, float roughness, float ior) {
       return ConductorParams{Spectrum(0.9f, 0.6f, 0.3f), 0.f};
     case StageModel::kSmoothDielectric:
       return DielectricParams{ior, 0.f, Spectrum(0.2f, 0.f, 0.5f)};
+    case StageModel::kMetallicRoughness:
+      return MetallicRoughnessParams{Spectrum(0.8f, 0.5f, 0.3f), 0.5f, roughness};
   }
   return DiffuseParams{};
 }
@@ -367,6 +369,40 @@ TEST(SurfaceStage, RoughPlasticStepIsPathScatterToTheBit) {
                      {1.f, 1.33f, 1.6f, 3.f}, 19);
 }
 
+// glTF's metallic-roughness model over metallic factors (the dielectric alone, a mix, the metal
+// alone) and roughnesses (near the smooth limit to 1), under every kind of light, then without
+// lights and under an environment map.
+TEST(SurfaceStage, MetallicRoughnessStepIsPathScatterToTheBit) {
+  uint32_t seed = 61;
+  for (const float metallic : {0.f, 0.35f, 1.f}) {
+    for (const float roughness : {0.12f, 0.4f, 1.f}) {
+      SCOPED_TRACE("metallic " + std::to_string(metallic) + " roughness " +
+                   std::to_string(roughness));
+      const MetallicRoughnessParams mr{Spectrum(0.9f, 0.6f, 0.2f), metallic, roughness};
+      const Coverage c =
+          expect_stage_matches_material(Lights::kMixed, ++seed, StageModel::kMetallicRoughness, mr);
+      EXPECT_GT(c.staged, 1000);
+      EXPECT_EQ(c.fallback, 0);
+      EXPECT_GT(c.own_code_lights, 100);
+      EXPECT_GT(c.delta_lights, 200);
+      EXPECT_GT(c.alive, 300);
+      EXPECT_GT(c.dead, 50);
+      EXPECT_GT(c.shadows, 300);
+      EXPECT_GT(c.back, 200);
+      EXPECT_GT(c.ball, 500);
+      EXPECT_EQ(c.delta, 0);
+      const Coverage none =
+          expect_stage_matches_material(Lights::kNone, ++seed, StageModel::kMetallicRoughness, mr);
+      EXPECT_EQ(none.shadows, 0);
+      EXPECT_GT(none.alive, 300);
+      const Coverage map = expect_stage_matches_material(Lights::kMapAndMovingQuad, ++seed,
+                                                         StageModel::kMetallicRoughness, mr);
+      EXPECT_EQ(map.own_code_lights, map.staged);
+      EXPECT_GT(map.shadows, 300);
+    }
+  }
+}
+
 TEST(SurfaceStage, SmoothPlasticStepIsPathScatterToTheBit) {
   for (const float ior : {1.f, 1.33f, 1.5f, 3.f}) {
     SCOPED_TRACE("ior " + std::to_string(ior));
@@ -490,6 +526,8 @@ TEST(SurfaceStage, TexturedSurfacesArePathScatterToTheBit) {
        false},
       {"dielectric", StageModel::kRoughDielectric, DielectricParams{1.5f, 0.6f, Spectrum(0.f), r},
        true},
+      {"metallic-roughness", StageModel::kMetallicRoughness,
+       MetallicRoughnessParams{Spectrum(0.9f, 0.7f, 0.5f), 0.6f, 0.8f, c, r, r}, true},
   };
   for (const Case& k : cases) {
     SCOPED_TRACE(k.name);
@@ -543,6 +581,8 @@ TEST(SurfaceStage, NormalMappedSurfacesArePathScatterToTheBit) {
   frosted.normal_map = map;
   DielectricParams glass{1.5f, 0.f};
   glass.normal_map = map;
+  MetallicRoughnessParams gltf{Spectrum(0.7f, 0.6f, 0.3f), 0.4f, 0.5f};
+  gltf.normal_map = map;
   const Case cases[] = {
       {"diffuse", StageModel::kLambert, diffuse},
       {"rough conductor", StageModel::kRoughConductor, rough},
@@ -551,6 +591,7 @@ TEST(SurfaceStage, NormalMappedSurfacesArePathScatterToTheBit) {
       {"smooth plastic", StageModel::kSmoothPlastic, glaze},
       {"rough dielectric", StageModel::kRoughDielectric, frosted},
       {"smooth dielectric", StageModel::kSmoothDielectric, glass},
+      {"metallic-roughness", StageModel::kMetallicRoughness, gltf},
   };
   for (const Case& k : cases) {
     SCOPED_TRACE(k.name);
