@@ -24,6 +24,10 @@
 //
 // Roughness below 0.01 (alpha < 1e-4, as the other models) makes the specular lobe a Dirac
 // mirror with the same Fresnel weights.
+//
+// The wavefront driver's surface stage repeats the rough model operation for operation
+// (render/lane_bsdfs.h, lane::MetallicRoughness): a change here must be made there too, which
+// tests/renderer/render/surface_stage_test.cpp catches.
 #include "renderer/materials/bsdf.h"
 #include "renderer/materials/material_params.h"
 #include "renderer/materials/microfacet.h"

@@ -55,6 +55,20 @@ struct EvalPdf {
   Mask exact = -1;
 };
 
+// A model's answer is zero where wi (a) or wo (b) lies below the surface.
+[[gnu::always_inline]] inline void zero_below_surface(const float* a, const float* b, EvalPdf* r) {
+  const Mask zero = mask(a[2] <= 0.f) | mask(b[2] <= 0.f);
+  for (int c = 0; c < 3; ++c) r->f[c] = when(zero, 0.f, r->f[c]);
+  r->pdf = when(zero, 0.f, r->pdf);
+}
+
+// SurfaceBsdf zeroes a value with a component that is not finite, and such a pdf.
+[[gnu::always_inline]] inline void clean_answer(EvalPdf* r) {
+  const Mask f_finite = finite(r->f[0]) & finite(r->f[1]) & finite(r->f[2]);
+  for (int c = 0; c < 3; ++c) r->f[c] = when(f_finite, r->f[c], 0.f);
+  r->pdf = when(finite(r->pdf), r->pdf, 0.f);
+}
+
 // A sampled direction: wo in the front-mirrored local frame, weight = f cos / pdf, whether the
 // model gave a sample at all, whether it is a Dirac lobe's (pdf 0), and `exact` as above.
 struct Sample {
@@ -175,9 +189,7 @@ struct Plastic {
     const float p = (1.f - p_spec) * (b[2] > 0.f ? b[2] * kInvPi : 0.f);
     r.pdf = when(mask(p_spec > 0.f) & mask(Coating::kRough) & finite(spec_pdf),
                  p + p_spec * spec_pdf, p);
-    const Mask zero = mask(a[2] <= 0.f) | mask(b[2] <= 0.f);
-    for (int c = 0; c < 3; ++c) r.f[c] = when(zero, 0.f, r.f[c]);
-    r.pdf = when(zero, 0.f, r.pdf);
+    zero_below_surface(a, b, &r);
     return r;
   }
 
@@ -185,10 +197,7 @@ struct Plastic {
                                                  const float* b) {
     Mask exact = -1;
     EvalPdf r = evaluate(q, a, b, &exact);
-    // SurfaceBsdf zeroes a value with a component that is not finite, and such a pdf.
-    const Mask f_finite = finite(r.f[0]) & finite(r.f[1]) & finite(r.f[2]);
-    for (int c = 0; c < 3; ++c) r.f[c] = when(f_finite, r.f[c], 0.f);
-    r.pdf = when(finite(r.pdf), r.pdf, 0.f);
+    clean_answer(&r);
     r.exact = exact;
     return r;
   }
@@ -545,9 +554,7 @@ struct MetallicRoughness {
     const float g = d * g1_i / (4.f * a[2]);
     p = when(mask(dot3(b, h) > 0.f) & finite(g), p + p_spec * g, p);
     r.pdf = p;
-    const Mask zero = mask(a[2] <= 0.f) | mask(b[2] <= 0.f);
-    for (int c = 0; c < 3; ++c) r.f[c] = when(zero, 0.f, r.f[c]);
-    r.pdf = when(zero, 0.f, r.pdf);
+    zero_below_surface(a, b, &r);
     return r;
   }
 
@@ -555,10 +562,7 @@ struct MetallicRoughness {
                                                  const float* b) {
     const Albedo ai = ggx_albedo(q.tables.ggx_albedo, a[2], q.roughness);
     EvalPdf r = evaluate(q, a, b, ai, specular_probability(q, ai));
-    // SurfaceBsdf zeroes a value with a component that is not finite, and such a pdf.
-    const Mask f_finite = finite(r.f[0]) & finite(r.f[1]) & finite(r.f[2]);
-    for (int c = 0; c < 3; ++c) r.f[c] = when(f_finite, r.f[c], 0.f);
-    r.pdf = when(finite(r.pdf), r.pdf, 0.f);
+    clean_answer(&r);
     return r;
   }
 
