@@ -20,8 +20,8 @@ struct MicrofacetAlbedo {
   float e5 = 0.f;  // E5
 };
 
-// Bilinear lookup in the table (built on first use, thread-safe). Roughness 0 is the smooth
-// limit: E = 1, E5 = (1 - mu)^5 exactly.
+// Bilinear lookup in the table (its rows built on first use, thread-safe). Roughness 0 is the
+// smooth limit: E = 1, E5 = (1 - mu)^5 exactly.
 MicrofacetAlbedo ggx_albedo(float cos_theta, float roughness);
 // The averages over the cosine-weighted hemisphere of the same (interpolated) table, so that
 // 2 \int ggx_albedo(mu, r) mu dmu equals ggx_albedo_average(r) up to rounding: the
@@ -33,7 +33,8 @@ inline constexpr int kAlbedoTableRes = 48;
 
 // The table ggx_albedo interpolates, for the surface stages' lane version of it
 // (render/lane_bsdfs.h): E and E5 of node (roughness j, cos i) at [2 (j kAlbedoTableRes + i)]
-// and the next float.
-const float* ggx_albedo_table();
+// and the next float. Only the rows lookups of roughness in [roughness_lo, roughness_hi] read
+// are sure to be built.
+const float* ggx_albedo_table(float roughness_lo, float roughness_hi);
 
 }  // namespace penumbra

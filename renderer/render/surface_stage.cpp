@@ -476,9 +476,18 @@ SurfaceStage::SurfaceStage(const Scene& scene, StageModel model)
     textured_of_[o] = m.varies();  // (a normal map makes a material vary)
     params_.push_back(q);
   }
-  // (The albedo table is built on first use: only for a stage that takes a surface.)
-  if (model == StageModel::kMetallicRoughness && !params_.empty())
-    albedo_table_ = ggx_albedo_table();
+  // The albedo table's rows this stage's lookups read (built on first use): a textured
+  // roughness may take any value.
+  if (model == StageModel::kMetallicRoughness && !params_.empty()) {
+    float lo = 1.f, hi = 0.f;
+    for (size_t o = 0; o < scene.object_count(); ++o) {
+      if (params_of_[o] < 0) continue;
+      const float r = params_[size_t(params_of_[o])].roughness;
+      lo = textured_of_[o] ? 0.f : std::min(lo, r);
+      hi = textured_of_[o] ? 1.f : std::max(hi, r);
+    }
+    albedo_table_ = ggx_albedo_table(lo, hi);
+  }
 }
 
 void SurfaceStage::start(size_t paths) {

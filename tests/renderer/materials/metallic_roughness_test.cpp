@@ -5,6 +5,9 @@
 // brute-force quadrature over the outgoing hemisphere instead of visible-normal tables).
 #include <gtest/gtest.h>
 
+#include <string>
+#include <thread>
+
 #include <cmath>
 #include <vector>
 
@@ -179,6 +182,31 @@ TEST(MetallicRoughness, AlbedoTableAgreesWithItsAverage) {
   EXPECT_FLOAT_EQ(ggx_albedo(0.5f, 0.f).e, 1.f);
   EXPECT_LT(ggx_albedo_average(1.f).e, ggx_albedo_average(0.5f).e);
   EXPECT_LT(ggx_albedo_average(0.5f).e, 1.f);
+}
+
+// The table's rows are built on demand: the rows a range of roughness asks for hold what
+// ggx_albedo returns at their nodes (not zeros), each row built once whoever asks first
+// (lookups from several threads at once).
+TEST(MetallicRoughness, AlbedoTableRowsAreBuiltWhenAskedFor) {
+  constexpr int kN = kAlbedoTableRes;
+  std::vector<std::thread> threads;
+  for (int k = 0; k < 4; ++k)
+    threads.emplace_back([k] { (void)ggx_albedo(0.5f, 0.6f + 0.01f * float(k)); });
+  for (auto& t : threads) t.join();
+  // (Copied before any lookup of these rows, which would build them itself.)
+  const float* table = ggx_albedo_table(0.71f, 0.74f);
+  const std::vector<float> copy(table, table + 2 * kN * kN);
+  for (int j : {int(0.71f * (kN - 1)), int(0.74f * (kN - 1)) + 1}) {
+    SCOPED_TRACE("row " + std::to_string(j));
+    const float r = float(j) / float(kN - 1);
+    for (int i = 0; i < kN; i += 7) {
+      const float mu = float(i) / float(kN - 1);
+      const MicrofacetAlbedo a = ggx_albedo(mu, r);
+      EXPECT_NEAR(copy[size_t(2 * (j * kN + i))], a.e, 1e-6f);
+      EXPECT_NEAR(copy[size_t(2 * (j * kN + i) + 1)], a.e5, 1e-6f);
+      EXPECT_GT(a.e, 0.f);
+    }
+  }
 }
 
 }  // namespace
