@@ -31,6 +31,18 @@ namespace penumbra::lane {
 [[gnu::always_inline]] inline float dot3(const float* a, const float* b) {
   return (a[0] * b[0] + a[1] * b[1]) + a[2] * b[2];
 }
+// square_to_cosine_hemisphere (sampling.h): the concentric disk lifted to the hemisphere.
+[[gnu::always_inline]] inline void cosine_hemisphere(float u0, float u1, float* w) {
+  disk_concentric(u0, u1, &w[0], &w[1]);
+  w[2] = safe_root(1.f - w[0] * w[0] - w[1] * w[1]);
+}
+// fresnel.h's reflect of a about the unit normal m: 2 (a.m) m - a.
+[[gnu::always_inline]] inline void reflect(const float* a, const float* m, float* out) {
+  const float two_dot = 2.f * dot3(a, m);
+  for (int c = 0; c < 3; ++c) out[c] = two_dot * m[c] - a[c];
+}
+// std::clamp(x, 0.f, 1.f), NaN passing through as std::clamp's comparisons let it.
+[[gnu::always_inline]] inline float clamp01(float x) { return x < 0.f ? 0.f : (1.f < x ? 1.f : x); }
 // glm::normalize: v times 1 / sqrt(v.v).
 [[gnu::always_inline]] inline void normalize(float* v) {
   const float k = 1.f / std::sqrt(dot3(v, v));

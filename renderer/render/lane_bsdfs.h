@@ -100,8 +100,7 @@ struct Lambert {
   [[gnu::always_inline]] static Sample sample(const Params& q, const float* a, float /*u_lobe*/,
                                               float u0, float u1) {
     Sample s;
-    disk_concentric(u0, u1, &s.wo[0], &s.wo[1]);
-    s.wo[2] = safe_root(1.f - s.wo[0] * s.wo[0] - s.wo[1] * s.wo[1]);
+    cosine_hemisphere(u0, u1, s.wo);
     s.pdf = s.wo[2] > 0.f ? s.wo[2] * kInvPi : 0.f;
     for (int c = 0; c < 3; ++c) s.weight[c] = q.c[c];
     // (SurfaceBsdf::sample's finiteness checks always pass here: the colour is finite, which the
@@ -144,8 +143,7 @@ struct RoughConductor {
     // ConductorBsdf::sample: the mirror direction about m (fresnel.h's reflect), its pdf
     // (pdf_visible / (4 wo.m)) and weight colour G1(wo, m) (Heitz 2014 eq. 19).
     Sample r;
-    const float two_dot = 2.f * dot3(a, m);
-    for (int c = 0; c < 3; ++c) r.wo[c] = two_dot * m[c] - a[c];
+    lane::reflect(a, m, r.wo);
     const float dot_wo_m = dot3(r.wo, m);
     const float visible = (Ggx::ndf(alpha, m) * Ggx::smith_g1(alpha, a, m)) * std::fabs(dot3(a, m)) / a[2];
     r.pdf = when(mask(a[2] <= 0.f), 0.f, visible) / (4.f * dot_wo_m);
@@ -209,8 +207,7 @@ struct Plastic {
     const Mask pick_spec = mask(u_lobe < specular_probability(q, t_i));
     // The base's direction: square_to_cosine_hemisphere; the coating's: Coating::reflect.
     float wo[3];
-    disk_concentric(u0, u1, &wo[0], &wo[1]);
-    wo[2] = safe_root(1.f - wo[0] * wo[0] - wo[1] * wo[1]);
+    cosine_hemisphere(u0, u1, wo);
     float spec_wo[3];
     Coating::reflect(q, a, u0, u1, spec_wo);
     Sample r;
@@ -303,8 +300,7 @@ struct RoughCoating {
                                              float u1, float* wo) {
     float m[3];
     Ggx::sample_visible(q.alpha, a, u0, u1, m);
-    const float two_dot = 2.f * dot3(a, m);
-    for (int c = 0; c < 3; ++c) wo[c] = two_dot * m[c] - a[c];
+    lane::reflect(a, m, wo);  // (the free function, not this member)
   }
 };
 
@@ -463,7 +459,7 @@ struct Albedo {
 };
 [[gnu::always_inline]] inline void albedo_locate(float x, int32_t* i, float* f) {
   constexpr int32_t kN = kAlbedoTableRes;
-  const float p = (x < 0.f ? 0.f : (1.f < x ? 1.f : x)) * float(kN - 1);  // std::clamp
+  const float p = clamp01(x) * float(kN - 1);
   const int32_t k = int32_t(p);
   const int32_t node = kN - 2 < k ? kN - 2 : k;  // std::min
   *f = p - float(node);
@@ -537,7 +533,7 @@ struct MetallicRoughness {
     const float s = d * (g1_i * Ggx::smith_g1(q.alpha, b, h)) / (4.f * a[2]);
     const float cos_ih = dot3(a, h);
     const float x = 1.f - cos_ih;
-    const float xc = x < 0.f ? 0.f : (1.f < x ? 1.f : x);  // std::clamp
+    const float xc = clamp01(x);
     const float x2 = xc * xc;
     const float w = x2 * x2 * xc;
     const float dielectric = kF0 + (1.f - kF0) * w;
@@ -574,12 +570,11 @@ struct MetallicRoughness {
     // The specular lobe's direction: visible normals, reflect; the base's: cosine-weighted.
     float m[3];
     Ggx::sample_visible(q.alpha, a, u0, u1, m);
-    const float two_dot = 2.f * dot3(a, m);
-    float wo[3];
-    disk_concentric(u0, u1, &wo[0], &wo[1]);
-    wo[2] = safe_root(1.f - wo[0] * wo[0] - wo[1] * wo[1]);
+    float spec_wo[3], wo[3];
+    lane::reflect(a, m, spec_wo);
+    cosine_hemisphere(u0, u1, wo);
     Sample r;
-    for (int c = 0; c < 3; ++c) r.wo[c] = when(pick_spec, two_dot * m[c] - a[c], wo[c]);
+    for (int c = 0; c < 3; ++c) r.wo[c] = when(pick_spec, spec_wo[c], wo[c]);
     // One-sample MIS over the lobes: weight = f cos / (mixture pdf) (Veach 1997 ch. 9).
     const EvalPdf e = evaluate(q, a, r.wo, ai, p_spec);
     r.pdf = e.pdf;

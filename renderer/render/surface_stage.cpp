@@ -455,6 +455,7 @@ SurfaceStage::SurfaceStage(const Scene& scene, StageModel model)
     : scene_(scene), model_(model), lights_(scene) {
   params_of_.assign(scene.object_count(), -1);
   textured_of_.assign(scene.object_count(), 0);
+  float rough_lo = 1.f, rough_hi = 0.f;  // the metallic-roughness surfaces' roughness range
   for (size_t o = 0; o < scene.object_count(); ++o) {
     const Material& m = scene.material(scene.object(uint32_t(o)).material);
     // A rough plastic's coating tables join the stage's list the first time a surface uses them.
@@ -475,19 +476,13 @@ SurfaceStage::SurfaceStage(const Scene& scene, StageModel model)
     params_of_[o] = int32_t(params_.size());
     textured_of_[o] = m.varies();  // (a normal map makes a material vary)
     params_.push_back(q);
+    // The albedo table's rows this stage's lookups read: a textured roughness may take any value.
+    rough_lo = textured_of_[o] ? 0.f : std::min(rough_lo, q.roughness);
+    rough_hi = textured_of_[o] ? 1.f : std::max(rough_hi, q.roughness);
   }
-  // The albedo table's rows this stage's lookups read (built on first use): a textured
-  // roughness may take any value.
-  if (model == StageModel::kMetallicRoughness && !params_.empty()) {
-    float lo = 1.f, hi = 0.f;
-    for (size_t o = 0; o < scene.object_count(); ++o) {
-      if (params_of_[o] < 0) continue;
-      const float r = params_[size_t(params_of_[o])].roughness;
-      lo = textured_of_[o] ? 0.f : std::min(lo, r);
-      hi = textured_of_[o] ? 1.f : std::max(hi, r);
-    }
-    albedo_table_ = ggx_albedo_table(lo, hi);
-  }
+  // (Rows are built on first use, and only those asked for here.)
+  if (model == StageModel::kMetallicRoughness && !params_.empty())
+    albedo_table_ = ggx_albedo_table(rough_lo, rough_hi);
 }
 
 void SurfaceStage::start(size_t paths) {

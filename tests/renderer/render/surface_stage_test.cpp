@@ -435,8 +435,12 @@ TEST(SurfaceStage, RoughCoatingTableLookupIsExactEverywhere) {
       const PlasticBsdf plastic(params, PlasticBsdf::tables_for(params, cache));
       const CoatingTables& tables = plastic.tables();
       ASSERT_TRUE(tables.square_nodes);
-      const lane::Params q{{0.5f, 0.5f, 0.5f}, plastic.alpha(), ior, 0.f, 0.f, 0, tables.nodes,
-                           lane::Tables{tables.cosines.data(), tables.transmittance.data()}};
+      lane::Params q{};
+      q.c[0] = q.c[1] = q.c[2] = 0.5f;
+      q.alpha = plastic.alpha();
+      q.eta = ior;
+      q.nodes = tables.nodes;
+      q.tables = lane::Tables{tables.cosines.data(), tables.transmittance.data(), nullptr};
       std::vector<float> cosines = {-0.5f, -0.f, 0.f, 1.f, 1.5f, 1e-30f};
       for (int i = 0; i < tables.nodes; ++i) {
         const float c = tables.cosines[size_t(i)];
