@@ -30,7 +30,8 @@ int64_t mesh_arrays(const MeshDesc& m) {
 void add_mesh(const MeshDesc& mesh, bool emissive, bool moving, MemoryEstimate& e) {
   const int64_t triangles = int64_t(mesh.indices.size() / 3);
   e.scene_input += mesh_arrays(mesh);
-  e.shapes += mesh_arrays(mesh) + (emissive ? triangles * int64_t(sizeof(float)) : 0);
+  e.shapes += mesh_arrays(mesh) + (emissive ? triangles * int64_t(sizeof(float)) : 0) +
+              (moving ? 0 : triangles * int64_t(sizeof(vec3)));  // a static mesh's face normals
   // A moving mesh has at least two vertex buffers (time steps); assume two.
   const int64_t vertex_buffers = moving ? 2 : 1;
   e.embree += vertex_buffers * int64_t(mesh.positions.size() * sizeof(vec3)) +

@@ -67,6 +67,13 @@ int motion_time_steps(const Motion& motion, float span, float camera_distance) {
   *error = gamma_bound(7) * (abs_components(t0) + abs_components(t1) + abs_components(t2));
 }
 
+// The unit normal (p1 - p0) x (p2 - p0), +z for a degenerate triangle.
+[[gnu::always_inline]] inline vec3 unit_face_normal(const vec3& p0, const vec3& p1, const vec3& p2) {
+  const vec3 ng = glm::cross(p1 - p0, p2 - p0);
+  const float len = glm::length(ng);
+  return len > 0.f ? ng / len : vec3(0.f, 0.f, 1.f);
+}
+
 float triangle_area(const vec3& a, const vec3& b, const vec3& c) {
   return 0.5f * glm::length(glm::cross(b - a, c - a));
 }
@@ -116,6 +123,11 @@ TriangleMesh::TriangleMesh(const MeshDesc& desc, const ShapeContext& ctx)
     for (int k = 0; k < time_steps_; ++k)
       step_displacement_[k] = ctx.motion.motion.displacement(
           ctx.motion.shutter_open + ctx.motion.shutter_span * float(k) / float(time_steps_ - 1));
+  } else {
+    face_normals_.resize(n);
+    for (size_t t = 0; t < n; ++t)
+      face_normals_[t] = unit_face_normal(positions_[indices_[3 * t]], positions_[indices_[3 * t + 1]],
+                                          positions_[indices_[3 * t + 2]]);
   }
 }
 
@@ -162,18 +174,19 @@ void TriangleMesh::hit_geometry(const Ray& ray, float, uint32_t prim, const vec2
                                 SurfaceHit* hit) const {
   const uint32_t* tri = &indices_[size_t(prim) * 3];
   vec3 p0 = positions_[tri[0]], p1 = positions_[tri[1]], p2 = positions_[tri[2]];
+  vec3 ng;
   if (time_steps_ > 1) {  // static meshes skip adding a zero displacement
     const vec3 disp = interpolated_displacement(ray.time);
     p0 += disp;
     p1 += disp;
     p2 += disp;
+    ng = unit_face_normal(p0, p1, p2);
+  } else {
+    ng = face_normals_[prim];
   }
   const float b1 = uv.x, b2 = uv.y, b0 = 1.f - b1 - b2;
   barycentric_point(p0, p1, p2, b0, b1, b2, &hit->p, &hit->p_error);
   if (need_uv_) hit->uv = uv_at(tri, b0, b1, b2);
-  vec3 ng = glm::cross(p1 - p0, p2 - p0);
-  const float len = glm::length(ng);
-  ng = len > 0.f ? ng / len : vec3(0.f, 0.f, 1.f);
   hit->ng = ng;
   hit->ns = ng;
   if (!normals_.empty()) {
