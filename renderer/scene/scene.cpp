@@ -2,6 +2,11 @@
 
 #include <embree3/rtcore.h>
 
+#include <cstddef>
+#if defined(__SSE2__)
+#include <xmmintrin.h>
+#endif
+
 #include "renderer/embree/ray_access.h"
 #include "renderer/lights/light.h"
 #include "renderer/materials/coating_tables.h"
@@ -50,11 +55,44 @@ void Scene::complete_hit(const Ray& ray, float t, uint32_t geom_id, uint32_t ins
 
 namespace {
 
-// Lanes [0, count) of a 16-wide packet hold rays[0, count); the rest are switched off.
+// Lanes [0, count) of a 16-wide packet hold rays[0, count); the rest are switched off (and
+// hold a copy of ray 0).
 template <typename Packet>
 void fill_packet_rays(const Ray* rays, int count, int* valid, Packet* r) {
   for (int i = 0; i < Scene::kPacketSize; ++i) {
     valid[i] = i < count ? -1 : 0;
+    r->tnear[i] = 0.f;
+    r->mask[i] = 0xFFFFFFFFu;  // Debian's Embree is built with ray masks: 0 would hit nothing
+    r->id[i] = unsigned(i);
+    r->flags[i] = 0;
+  }
+#if defined(__SSE2__)
+  // A Ray is eight floats (origin, direction, time, t_max): four rays at a time as two 4x4
+  // transposes (SSE2, every x86-64 CPU), 16 loads, shuffles and stores instead of 48 scalar
+  // stores scattered over the packet's arrays (a fifth of the ray tracing calls' own time).
+  static_assert(sizeof(Ray) == 8 * sizeof(float) && offsetof(Ray, direction) == 12 &&
+                    offsetof(Ray, time) == 24 && offsetof(Ray, t_max) == 28,
+                "Ray's layout, as the transposes read it");
+  for (int g = 0; g < Scene::kPacketSize; g += 4) {
+    __m128 a[4], b[4];
+    for (int j = 0; j < 4; ++j) {
+      const float* f = &rays[g + j < count ? g + j : 0].origin.x;
+      a[j] = _mm_loadu_ps(f);      // ox oy oz dx
+      b[j] = _mm_loadu_ps(f + 4);  // dy dz time t_max
+    }
+    _MM_TRANSPOSE4_PS(a[0], a[1], a[2], a[3]);
+    _MM_TRANSPOSE4_PS(b[0], b[1], b[2], b[3]);
+    _mm_storeu_ps(&r->org_x[g], a[0]);
+    _mm_storeu_ps(&r->org_y[g], a[1]);
+    _mm_storeu_ps(&r->org_z[g], a[2]);
+    _mm_storeu_ps(&r->dir_x[g], a[3]);
+    _mm_storeu_ps(&r->dir_y[g], b[0]);
+    _mm_storeu_ps(&r->dir_z[g], b[1]);
+    _mm_storeu_ps(&r->time[g], b[2]);
+    _mm_storeu_ps(&r->tfar[g], b[3]);
+  }
+#else
+  for (int i = 0; i < Scene::kPacketSize; ++i) {
     const Ray& ray = rays[i < count ? i : 0];
     r->org_x[i] = ray.origin.x;
     r->org_y[i] = ray.origin.y;
@@ -62,13 +100,10 @@ void fill_packet_rays(const Ray* rays, int count, int* valid, Packet* r) {
     r->dir_x[i] = ray.direction.x;
     r->dir_y[i] = ray.direction.y;
     r->dir_z[i] = ray.direction.z;
-    r->tnear[i] = 0.f;
     r->tfar[i] = ray.t_max;
     r->time[i] = ray.time;
-    r->mask[i] = 0xFFFFFFFFu;  // Debian's Embree is built with ray masks: 0 would hit nothing
-    r->id[i] = unsigned(i);
-    r->flags[i] = 0;
   }
+#endif
 }
 
 }  // namespace
