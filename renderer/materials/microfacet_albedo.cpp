@@ -1,11 +1,7 @@
 #include "renderer/materials/microfacet_albedo.h"
 
 #include <array>
-#include <functional>
-#include <mutex>
 #include <vector>
-
-#include <tbb/parallel_for.h>
 
 #include "renderer/core/quadrature.h"
 #include "renderer/materials/microfacet.h"
@@ -14,15 +10,6 @@ namespace penumbra {
 namespace {
 
 constexpr int kN = kAlbedoTableRes;
-
-struct Table {
-  // [roughness node][cos node]
-  std::array<std::array<MicrofacetAlbedo, kN>, kN> albedo{};
-  std::array<MicrofacetAlbedo, kN> average{};
-  // Rows are built when first needed (ensure_rows): a scene whose glTF materials have one
-  // roughness needs two of the 48, a few milliseconds instead of the whole table's 0.1 s.
-  std::array<std::once_flag, kN> built;
-};
 
 float node(int i) { return float(i) / float(kN - 1); }
 
@@ -79,45 +66,43 @@ MicrofacetAlbedo integrate(float mu, float alpha) {
   return {float(e), float(e5)};
 }
 
-// Row j (roughness node j): E and E5 at every cos node, and their averages.
-void build_row(Table& t, int j) {
+}  // namespace
+
+MicrofacetAlbedoRow ggx_albedo_row_by_quadrature(int j) {
+  MicrofacetAlbedoRow row;
   const float r = node(j);
   for (int i = 0; i < kN; ++i) {
     const float mu = node(i);
     // Roughness 0 is the smooth limit, exactly: all light reflects about the normal.
-    t.albedo[j][i] = j == 0 ? MicrofacetAlbedo{1.f, std::pow(1.f - mu, 5.f)}
-                            : integrate(mu, std::max(r * r, kMinMicrofacetAlpha));
+    row.albedo[i] = j == 0 ? MicrofacetAlbedo{1.f, std::pow(1.f - mu, 5.f)}
+                           : integrate(mu, std::max(r * r, kMinMicrofacetAlpha));
   }
   // 2 \int E(mu) mu dmu of the piecewise-linear interpolant, exactly: on [a, b] with values
   // fa, fb the integral of the line times mu is (b - a) (fa (2a + b) + fb (a + 2b)) / 6.
   double e = 0.0, e5 = 0.0;
   for (int i = 0; i + 1 < kN; ++i) {
     const double a = node(i), b = node(i + 1);
-    const auto& fa = t.albedo[j][i];
-    const auto& fb = t.albedo[j][i + 1];
+    const auto& fa = row.albedo[i];
+    const auto& fb = row.albedo[i + 1];
     e += (b - a) * (fa.e * (2 * a + b) + fb.e * (a + 2 * b)) / 6.0;
     e5 += (b - a) * (fa.e5 * (2 * a + b) + fb.e5 * (a + 2 * b)) / 6.0;
   }
-  t.average[j] = {float(2.0 * e), float(2.0 * e5)};
+  row.average = {float(2.0 * e), float(2.0 * e5)};
+  return row;
 }
 
-Table& table() {
-  static Table t;  // thread-safe initialisation (C++11 magic statics); rows built on demand
-  return t;
-}
+namespace {
 
-// Rows j0..j1 built (each once, thread-safe: std::call_once); several in parallel.
-const Table& ensure_rows(int j0, int j1) {
-  Table& t = table();
-  if (j1 - j0 < 2) {
-    for (int j = j0; j <= j1; ++j) std::call_once(t.built[size_t(j)], build_row, std::ref(t), j);
-  } else {
-    tbb::parallel_for(j0, j1 + 1, [&](int j) {
-      std::call_once(t.built[size_t(j)], build_row, std::ref(t), j);
-    });
-  }
-  return t;
-}
+// The table as shipped (ggx_albedo_table.inc, written by tools/tables/generate_ggx_albedo_table
+// from ggx_albedo_row_by_quadrature; a test checks them against each other): building it at
+// start-up took 0.1-0.2 s of every glTF render.
+struct Table {
+  MicrofacetAlbedo albedo[kN][kN];  // [roughness node][cos node]
+  MicrofacetAlbedo average[kN];
+};
+constexpr Table kTable = {
+#include "renderer/materials/ggx_albedo_table.inc"
+};
 
 // Node index and fraction of x in [0, 1] on the table's uniform grid.
 inline void locate(float x, int* i, float* f) {
@@ -137,27 +122,22 @@ MicrofacetAlbedo ggx_albedo(float cos_theta, float roughness) {
   float fi, fj;
   locate(cos_theta, &i, &fi);
   locate(roughness, &j, &fj);
-  const Table& t = ensure_rows(j, j + 1);
+  const Table& t = kTable;
   return lerp(lerp(t.albedo[j][i], t.albedo[j][i + 1], fi),
               lerp(t.albedo[j + 1][i], t.albedo[j + 1][i + 1], fi), fj);
 }
 
-const float* ggx_albedo_table(float roughness_lo, float roughness_hi) {
+const float* ggx_albedo_table() {
   static_assert(sizeof(MicrofacetAlbedo) == 2 * sizeof(float));
   static_assert(sizeof(Table::albedo) == sizeof(float) * 2 * kN * kN);
-  int j0, j1;
-  float f;
-  locate(roughness_lo, &j0, &f);
-  locate(roughness_hi, &j1, &f);
-  return &ensure_rows(j0, j1 + 1).albedo[0][0].e;
+  return &kTable.albedo[0][0].e;
 }
 
 MicrofacetAlbedo ggx_albedo_average(float roughness) {
   int j;
   float fj;
   locate(roughness, &j, &fj);
-  const Table& t = ensure_rows(j, j + 1);
-  return lerp(t.average[j], t.average[j + 1], fj);
+  return lerp(kTable.average[j], kTable.average[j + 1], fj);
 }
 
 }  // namespace penumbra

@@ -1,7 +1,9 @@
 #pragma once
-// Directional albedo of single-scattering GGX reflection, tabulated once per process over
-// (cos theta, roughness): what the energy-compensated glTF material (metallic_roughness.h)
-// needs per hit, for any roughness a texture may give.
+// Directional albedo of single-scattering GGX reflection, tabulated over (cos theta,
+// roughness): what the energy-compensated glTF material (metallic_roughness.h) needs per hit,
+// for any roughness a texture may give. The table is computed by quadrature
+// (ggx_albedo_row_by_quadrature) and shipped as source (ggx_albedo_table.inc, written by
+// tools/tables/generate_ggx_albedo_table), as Cycles ships its precomputed BSDF tables.
 //
 // For a GGX surface of alpha = r^2 with the separable Smith G (microfacet.h), incident
 // direction wi with cos theta_i = mu, and h the half vector:
@@ -20,8 +22,7 @@ struct MicrofacetAlbedo {
   float e5 = 0.f;  // E5
 };
 
-// Bilinear lookup in the table (its rows built on first use, thread-safe). Roughness 0 is the
-// smooth limit: E = 1, E5 = (1 - mu)^5 exactly.
+// Bilinear lookup in the table. Roughness 0 is the smooth limit: E = 1, E5 = (1 - mu)^5 exactly.
 MicrofacetAlbedo ggx_albedo(float cos_theta, float roughness);
 // The averages over the cosine-weighted hemisphere of the same (interpolated) table, so that
 // 2 \int ggx_albedo(mu, r) mu dmu equals ggx_albedo_average(r) up to rounding: the
@@ -33,8 +34,16 @@ inline constexpr int kAlbedoTableRes = 48;
 
 // The table ggx_albedo interpolates, for the surface stages' lane version of it
 // (render/lane_bsdfs.h): E and E5 of node (roughness j, cos i) at [2 (j kAlbedoTableRes + i)]
-// and the next float. Only the rows lookups of roughness in [roughness_lo, roughness_hi] read
-// are sure to be built.
-const float* ggx_albedo_table(float roughness_lo, float roughness_hi);
+// and the next float.
+const float* ggx_albedo_table();
+
+// Row j of the table (roughness j / (kAlbedoTableRes - 1)) at the cos nodes i / (kAlbedoTableRes
+// - 1), and its averages, by quadrature over the visible normals (about 20 ms a row): what the
+// shipped table holds, to float rounding.
+struct MicrofacetAlbedoRow {
+  MicrofacetAlbedo albedo[kAlbedoTableRes];
+  MicrofacetAlbedo average;
+};
+MicrofacetAlbedoRow ggx_albedo_row_by_quadrature(int j);
 
 }  // namespace penumbra

@@ -455,7 +455,6 @@ SurfaceStage::SurfaceStage(const Scene& scene, StageModel model)
     : scene_(scene), model_(model), lights_(scene) {
   params_of_.assign(scene.object_count(), -1);
   textured_of_.assign(scene.object_count(), 0);
-  float rough_lo = 1.f, rough_hi = 0.f;  // the metallic-roughness surfaces' roughness range
   for (size_t o = 0; o < scene.object_count(); ++o) {
     const Material& m = scene.material(scene.object(uint32_t(o)).material);
     // A rough plastic's coating tables join the stage's list the first time a surface uses them.
@@ -476,13 +475,8 @@ SurfaceStage::SurfaceStage(const Scene& scene, StageModel model)
     params_of_[o] = int32_t(params_.size());
     textured_of_[o] = m.varies();  // (a normal map makes a material vary)
     params_.push_back(q);
-    // The albedo table's rows this stage's lookups read: a textured roughness may take any value.
-    rough_lo = textured_of_[o] ? 0.f : std::min(rough_lo, q.roughness);
-    rough_hi = textured_of_[o] ? 1.f : std::max(rough_hi, q.roughness);
   }
-  // (Rows are built on first use, and only those asked for here.)
-  if (model == StageModel::kMetallicRoughness && !params_.empty())
-    albedo_table_ = ggx_albedo_table(rough_lo, rough_hi);
+  if (model == StageModel::kMetallicRoughness) albedo_table_ = ggx_albedo_table();
 }
 
 void SurfaceStage::start(size_t paths) {
