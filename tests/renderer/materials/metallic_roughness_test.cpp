@@ -5,9 +5,8 @@
 // brute-force quadrature over the outgoing hemisphere instead of visible-normal tables).
 #include <gtest/gtest.h>
 
-#include <string>
-
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include "renderer/materials/material.h"
