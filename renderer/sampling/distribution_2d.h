@@ -3,6 +3,13 @@
 // (pbrt-v4 §A.4-A.5, PiecewiseConstant1D / PiecewiseConstant2D). Used to sample an environment map
 // in proportion to its luminance; reusable for anything tabulated on a grid.
 //
+// The inversion starts from a guide table (the cutpoint method of Chen & Asau 1974; Devroye 1986
+// §III.2.4): for each of K equal intervals of u, the cell its lower end falls in. A search then
+// only spans the cells between two neighbouring entries -- on average n / K of them, however
+// peaked the weights -- instead of a binary search over all n cells, whose data-dependent
+// branches and scattered loads made it the environment map's largest cost. The cell found is the
+// same as the full search's (the last cell whose CDF is <= u), so images do not change.
+//
 // Robustness: negative or non-finite weights count as 0. A distribution whose weights are all
 // zero still samples (uniformly) but reports pdf 0 for every point, so a caller that divides by
 // the pdf must reject pdf == 0; nothing here divides by zero.
@@ -27,12 +34,21 @@ class Distribution1D {
   float sample(float u, float* pdf, int* cell = nullptr) const;
   // Density at x in [0, 1] (x == 1 counts as the last cell).
   float pdf(float x) const;
+  // The CDF at the cells' edges: n + 1 values from 0 to 1.
+  std::span<const float> cdf() const { return cdf_; }
   // Density of cell i (constant over it).
   float cell_pdf(int i) const { return integral_ > 0.0 ? float(func_[size_t(i)] / integral_) : 0.f; }
 
  private:
+  // The last cell i with cdf_[i] <= u (0 for u < cdf_[1]; n - 1 for u >= 1 or NaN).
+  int find_cell(float u) const;
+
   std::vector<float> func_;
   std::vector<float> cdf_;  // size n + 1, cdf_[0] = 0, cdf_[n] = 1
+  // guide_[k] = find_cell(k / K) for k = 0..K, K = guide_.size() - 1 a power of two, so that
+  // k / K and u * K are exact in float and u in [k / K, (k + 1) / K) lies in cells
+  // guide_[k]..guide_[k + 1].
+  std::vector<int> guide_;
   double integral_ = 0.0;
 };
 
