@@ -11,6 +11,12 @@ class EnvironmentLight : public Light {
   virtual Spectrum radiance(const vec3& dir) const = 0;
   // Solid-angle density with which sample() picks dir.
   virtual float pdf(const vec3& dir) const = 0;
+  // Both at once, as an escaped ray needs them: a map finds the direction's texel once. No pdf
+  // is computed where `pdf` is null.
+  virtual Spectrum radiance_and_pdf(const vec3& dir, float* pdf) const {
+    if (pdf) *pdf = this->pdf(dir);
+    return radiance(dir);
+  }
 };
 
 // The same radiance from every direction, sampled uniformly over the sphere.

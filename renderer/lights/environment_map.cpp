@@ -134,7 +134,17 @@ float EnvironmentMap::pdf(const vec3& dir) const {
   if (is_black()) return 0.f;
   if (uniform_sampling_) return uniform_sphere_pdf();
   const vec3 d = to_local_ * dir;
+  return pdf_local(d, direction_to_uv(d));
+}
+
+Spectrum EnvironmentMap::radiance_and_pdf(const vec3& dir, float* pdf) const {
+  const vec3 d = to_local_ * dir;
   const vec2 uv = direction_to_uv(d);
+  if (pdf) *pdf = is_black() ? 0.f : uniform_sampling_ ? uniform_sphere_pdf() : pdf_local(d, uv);
+  return lookup(uv);
+}
+
+float EnvironmentMap::pdf_local(const vec3& d, const vec2& uv) const {
   float s = uv.x - half_texel_;
   if (s < 0.f) s += 1.f;
   const float sin_theta = std::sqrt(d.x * d.x + d.z * d.z);

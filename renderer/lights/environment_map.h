@@ -29,6 +29,7 @@ class EnvironmentMap final : public EnvironmentLight {
   float power(float scene_radius) const override;
   Spectrum radiance(const vec3& dir) const override;
   float pdf(const vec3& dir) const override;
+  Spectrum radiance_and_pdf(const vec3& dir, float* pdf) const override;
 
   // Integral of the (scaled) luminance over the sphere of directions; 4 pi L for a constant map.
   double luminance_integral() const { return integral_; }
@@ -42,6 +43,8 @@ class EnvironmentMap final : public EnvironmentLight {
  private:
   // Bilinear lookup at (u, v), as Mitsuba's EnvironmentMapEmitter::eval_spectrum.
   Spectrum lookup(const vec2& uv) const;
+  // pdf() of the map-space direction d whose lat-long coordinates are uv.
+  float pdf_local(const vec3& d, const vec2& uv) const;
   const Spectrum& texel(int x, int y) const { return texels_[size_t(y) * size_t(width_) + size_t(x)]; }
 
   int width_ = 1, height_ = 2;      // height >= 2: rows are samples from pole to pole

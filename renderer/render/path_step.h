@@ -166,11 +166,11 @@ inline void path_escaped(const Scene& scene, PathState& s, FirstHit* first) {
   if constexpr ((kFeatures & kFeatureEnvironment) != 0) {
     if (!environment) return;
     const LightSampler& lights = next_event_lights<kDistributed>(scene);
+    float pdf = 0.f;
+    const Spectrum radiance = environment->radiance_and_pdf(s.ray.direction, s.prev_delta ? nullptr : &pdf);
     const float w =
-        s.prev_delta ? 1.f
-                     : power_heuristic(s.prev_pdf, lights.pmf(scene.environment_light()) *
-                                                     environment->pdf(s.ray.direction));
-    s.radiance += s.beta * environment->radiance(s.ray.direction) * w;
+        s.prev_delta ? 1.f : power_heuristic(s.prev_pdf, lights.pmf(scene.environment_light()) * pdf);
+    s.radiance += s.beta * radiance * w;
   }
 }
 

@@ -34,15 +34,15 @@ class Distribution1D {
   float sample(float u, float* pdf, int* cell = nullptr) const;
   // Density at x in [0, 1] (x == 1 counts as the last cell).
   float pdf(float x) const;
+  // The cell sample(u) lands in: the last cell i with cdf_[i] <= u (0 for u < 0, n - 1 for
+  // u >= 1 or NaN).
+  int find_cell(float u) const;
   // The CDF at the cells' edges: n + 1 values from 0 to 1.
   std::span<const float> cdf() const { return cdf_; }
   // Density of cell i (constant over it).
   float cell_pdf(int i) const { return integral_ > 0.0 ? float(func_[size_t(i)] / integral_) : 0.f; }
 
  private:
-  // The last cell i with cdf_[i] <= u (0 for u < cdf_[1]; n - 1 for u >= 1 or NaN).
-  int find_cell(float u) const;
-
   std::vector<float> func_;
   std::vector<float> cdf_;  // size n + 1, cdf_[0] = 0, cdf_[n] = 1
   // guide_[k] = find_cell(k / K) for k = 0..K, K = guide_.size() - 1 a power of two, so that

@@ -7,6 +7,7 @@
 
 #include "renderer/lights/environment_light.h"
 #include "renderer/lights/environment_map.h"
+#include "renderer/sampling/sampling.h"
 #include "tests/renderer/sampling/chi2_util.h"
 
 namespace penumbra::test {
@@ -159,6 +160,31 @@ TEST(EnvironmentMap, SampleAgreesWithPdfAndRadiance) {
     ASSERT_NEAR(ls.value.x, l.x, 2e-3f * l.x + 1e-5f);
   }
   EXPECT_GT(accepted, 19990);
+}
+
+// An escaped ray asks for both at once; they must be radiance() and pdf() to the bit (images
+// depend on it), for sampled and uniform maps and a black one, and no pdf where none is asked.
+TEST(EnvironmentMap, RadianceAndPdfAreRadianceAndPdfToTheBit) {
+  auto sky = sky_with_sun(32, 17);
+  sky.to_world = rotation(70.f, glm::normalize(vec3(0.3f, 1, -0.2f)));
+  auto uniform = sky;
+  uniform.uniform_sampling = true;
+  EnvironmentMapDesc black = make_map(8, 4, [](int, int) { return 0.f; });
+  Rng rng(9);
+  for (const EnvironmentMapDesc* desc : {&sky, &uniform, &black}) {
+    const EnvironmentMap map(*desc);
+    const EnvironmentLight& light = map;
+    for (int i = 0; i < 5000; ++i) {
+      const vec3 dir = square_to_uniform_sphere(rng.next2());
+      float pdf = -1.f;
+      const Spectrum l = light.radiance_and_pdf(dir, &pdf);
+      const Spectrum expected = map.radiance(dir);
+      for (int c = 0; c < 3; ++c) ASSERT_EQ(l[c], expected[c]);
+      ASSERT_EQ(pdf, map.pdf(dir));
+      const Spectrum alone = light.radiance_and_pdf(dir, nullptr);
+      for (int c = 0; c < 3; ++c) ASSERT_EQ(alone[c], expected[c]);
+    }
+  }
 }
 
 // For a constant map the ideal density is uniform over the sphere, 1 / (4 pi). Without the
