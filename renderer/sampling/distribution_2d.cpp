@@ -20,17 +20,19 @@ int cell_of(float x, size_t n) {
 
 Distribution1D::Distribution1D(std::span<const float> weights) {
   const size_t n = std::max<size_t>(weights.size(), 1);
-  func_.assign(n, 0.f);
-  for (size_t i = 0; i < weights.size(); ++i) func_[i] = clean(weights[i]);
+  std::vector<float> func(n, 0.f);
+  for (size_t i = 0; i < weights.size(); ++i) func[i] = clean(weights[i]);
   // Sums in double: a 16k-cell row of float sums would lose the small cells' share.
   std::vector<double> acc(n + 1, 0.0);
-  for (size_t i = 0; i < n; ++i) acc[i + 1] = acc[i] + double(func_[i]);
+  for (size_t i = 0; i < n; ++i) acc[i + 1] = acc[i] + double(func[i]);
   const double total = acc[n];
   integral_ = total / double(n);
   cdf_.resize(n + 1);
   for (size_t i = 0; i <= n; ++i)
     cdf_[i] = total > 0.0 ? float(acc[i] / total) : float(double(i) / double(n));
   cdf_[n] = 1.f;
+  pdf_.resize(n);
+  for (size_t i = 0; i < n; ++i) pdf_[i] = integral_ > 0.0 ? float(double(func[i]) / integral_) : 0.f;
   // About one guide entry per four cells: a search spans ~4 cells on average (two comparisons),
   // for a quarter more memory than the CDF alone.
   const size_t buckets = std::max<size_t>(std::bit_ceil(n) / 4, 1);
@@ -44,7 +46,7 @@ Distribution1D::Distribution1D(std::span<const float> weights) {
 }
 
 int Distribution1D::find_cell(float u) const {
-  const size_t n = func_.size();
+  const size_t n = pdf_.size();
   if (guide_.empty()) return 0;  // default-constructed: no cells
   const size_t buckets = guide_.size() - 1;
   if (!(u >= 0.f && u < 1.f)) {
@@ -62,7 +64,7 @@ int Distribution1D::find_cell(float u) const {
 }
 
 float Distribution1D::sample(float u, float* pdf, int* cell) const {
-  const size_t n = func_.size();
+  const size_t n = pdf_.size();
   // The last cell i with cdf_[i] <= u: cells of zero width (zero weight) are never chosen.
   const int i = find_cell(u);
   const float width = cdf_[size_t(i) + 1] - cdf_[size_t(i)];
@@ -76,7 +78,7 @@ float Distribution1D::sample(float u, float* pdf, int* cell) const {
   return x;
 }
 
-float Distribution1D::pdf(float x) const { return cell_pdf(cell_of(x, func_.size())); }
+float Distribution1D::pdf(float x) const { return cell_pdf(cell_of(x, pdf_.size())); }
 
 Distribution2D::Distribution2D(std::span<const float> weights, int nu, int nv)
     : nu_(std::max(nu, 1)), nv_(std::max(nv, 1)) {
