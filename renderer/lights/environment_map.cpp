@@ -15,6 +15,23 @@ constexpr float kMinSinTheta = 1e-9f;
 
 float clean(float v) { return std::isfinite(v) && v > 0.f ? v : 0.f; }
 
+// A sample of [0, 1] with density proportional to (1 - x) a + x b, 0 <= a, b <= 4 (pbrt-v4
+// SampleLinear): the root of the CDF's quadratic in the form that stays accurate for a << b.
+float sample_linear(float u, float a, float b) {
+  if (!(a + b > 0.f)) return u;  // both zero: no shape to follow (its density is 0 anyway)
+  if (u == 0.f && a == 0.f) return 0.f;
+  const float x = u * (a + b) / (a + std::sqrt((1.f - u) * a * a + u * b * b));
+  return std::min(x, kOneMinusEpsilon);
+}
+
+// Density on the unit square, proportional to the bilinear interpolant of the four corners.
+float bilinear_pdf(float x, float y, float w00, float w10, float w01, float w11) {
+  const float sum = w00 + w10 + w01 + w11;
+  if (!(sum > 0.f)) return 0.f;
+  const float v = (1.f - x) * (1.f - y) * w00 + x * (1.f - y) * w10 + (1.f - x) * y * w01 + x * y * w11;
+  return 4.f * v / sum;
+}
+
 }  // namespace
 
 vec2 EnvironmentMap::direction_to_uv(const vec3& d) {
@@ -60,7 +77,16 @@ EnvironmentMap::EnvironmentMap(const EnvironmentMapDesc& desc)
   // samples out of proportion to their solid angle (pbrt-v3 §14.2.4; Mitsuba's envmap weights its
   // grid by sin(theta) too). A cell is zero only if all four texels are, i.e. only where the
   // radiance is zero.
+  // The sampling density within a cell is the bilinear interpolant of its corners' luminance x
+  // sin(theta) (the density a cell's integral is divided by), so the cell's weight is their mean.
+  // A pole row's sin(theta) would be 0, and a map lit only there (or a one-row map, whose two
+  // rows are both poles) would then have no samples at all: the poles count as sin(theta) a
+  // quarter row in, which only shapes the density within their cells. `sum` is the luminance
+  // integral.
   const int nu = width_, nv = height_ - 1;
+  row_sin_.resize(size_t(height_));
+  const double pole_sin = std::sin(M_PI / (4.0 * nv));
+  for (int y = 0; y < height_; ++y) row_sin_[size_t(y)] = float(std::max(std::sin(M_PI * y / nv), pole_sin));
   std::vector<float> weights(size_t(nu) * size_t(nv));
   double sum = 0.0;
   for (int y = 0; y < nv; ++y) {
@@ -69,13 +95,22 @@ EnvironmentMap::EnvironmentMap(const EnvironmentMapDesc& desc)
       const int x1 = (x + 1) % nu;
       const double mean = 0.25 * (double(luminance(texel(x, y))) + luminance(texel(x1, y)) +
                                   luminance(texel(x, y + 1)) + luminance(texel(x1, y + 1)));
-      weights[size_t(y) * size_t(nu) + size_t(x)] = float(mean * band);
+      const Corners c = corners(x, y);
+      weights[size_t(y) * size_t(nu) + size_t(x)] =
+          float(0.25 * (double(c.w00) + double(c.w10) + double(c.w01) + double(c.w11)));
       sum += mean * band;
     }
   }
   distribution_ = Distribution2D(weights, nu, nv);
   // Each cell spans 2 pi / width in azimuth.
   integral_ = sum * (2.0 * M_PI / nu);
+}
+
+EnvironmentMap::Corners EnvironmentMap::corners(int x, int y) const {
+  const int x1 = x + 1 == width_ ? 0 : x + 1;
+  const float s0 = row_sin_[size_t(y)], s1 = row_sin_[size_t(y) + 1];
+  return {luminance(texel(x, y)) * s0, luminance(texel(x1, y)) * s0, luminance(texel(x, y + 1)) * s1,
+          luminance(texel(x1, y + 1)) * s1};
 }
 
 Spectrum EnvironmentMap::lookup(const vec2& uv) const {
@@ -113,14 +148,31 @@ bool EnvironmentMap::sample(const vec3&, float, const vec2& u, LightSample* out)
     out->pdf = uniform_sphere_pdf();
     out->value = radiance(out->wi);
   } else {
+    // The cell, and where in it the sample fell: a uniform point of the cell (its row and column
+    // were drawn independently), which the bilinear warp then reshapes.
     float pdf_cell = 0.f;
     const vec2 st = distribution_.sample(u, &pdf_cell);
-    vec2 uv(st.x + half_texel_, st.y);
+    if (!(pdf_cell > 0.f)) return false;
+    const int nu = width_, nv = height_ - 1;
+    const float sx = st.x * float(nu), sy = st.y * float(nv);
+    const int cx = std::min(int(sx), nu - 1), cy = std::min(int(sy), nv - 1);
+    // The warp depends only on the corners' ratios: scaled to at most 1, their squares cannot
+    // overflow (texels up to 1e30 are allowed).
+    Corners c = corners(cx, cy);
+    const float top = std::max(std::max(c.w00, c.w10), std::max(c.w01, c.w11));
+    if (!(top > 0.f)) return false;
+    const float inv = 1.f / top;
+    c = {c.w00 * inv, c.w10 * inv, c.w01 * inv, c.w11 * inv};
+    const float fy = sample_linear(std::clamp(sy - float(cy), 0.f, 1.f), c.w00 + c.w10, c.w01 + c.w11);
+    const float fx = sample_linear(std::clamp(sx - float(cx), 0.f, 1.f), (1.f - fy) * c.w00 + fy * c.w01,
+                                   (1.f - fy) * c.w10 + fy * c.w11);
+    const float pdf_uv = pdf_cell * bilinear_pdf(fx, fy, c.w00, c.w10, c.w01, c.w11);
+    vec2 uv((float(cx) + fx) / float(nu) + half_texel_, std::min((float(cy) + fy) / float(nv), 1.f));
     if (uv.x >= 1.f) uv.x -= 1.f;
     const float sin_theta = std::sin(uv.y * kPi);
-    if (!(pdf_cell > 0.f) || !(sin_theta > kMinSinTheta)) return false;
+    if (!(pdf_uv > 0.f) || !(sin_theta > kMinSinTheta)) return false;
     out->wi = to_world_ * uv_to_direction(uv);
-    out->pdf = pdf_cell * kInv2PiSquared / sin_theta;
+    out->pdf = pdf_uv * kInv2PiSquared / sin_theta;
     out->value = lookup(uv);
   }
   if (!(out->pdf > 0.f) || !std::isfinite(out->pdf)) return false;
@@ -149,7 +201,15 @@ float EnvironmentMap::pdf_local(const vec3& d, const vec2& uv) const {
   if (s < 0.f) s += 1.f;
   const float sin_theta = std::sqrt(d.x * d.x + d.z * d.z);
   if (!(sin_theta > kMinSinTheta)) return 0.f;
-  const float p = distribution_.pdf(vec2(s, uv.y)) * kInv2PiSquared / sin_theta;
+  const float pdf_cell = distribution_.pdf(vec2(s, uv.y));
+  if (!(pdf_cell > 0.f)) return 0.f;
+  // The cell distribution_.pdf found, and the point's place in it.
+  const int nu = width_, nv = height_ - 1;
+  const float sx = s * float(nu), sy = uv.y * float(nv);
+  const int cx = std::clamp(int(sx), 0, nu - 1), cy = std::clamp(int(sy), 0, nv - 1);
+  const Corners c = corners(cx, cy);
+  const float fx = std::clamp(sx - float(cx), 0.f, 1.f), fy = std::clamp(sy - float(cy), 0.f, 1.f);
+  const float p = pdf_cell * bilinear_pdf(fx, fy, c.w00, c.w10, c.w01, c.w11) * kInv2PiSquared / sin_theta;
   return std::isfinite(p) ? p : 0.f;
 }
 

@@ -5,11 +5,12 @@
 //  - lookup: bilinear between texels, with texel x's centre at u = (x + 0.5) / width (wrapping
 //    around the seam) and row y at v = y / (height - 1): the first and last rows sit on the poles;
 //  - sampling: by importance, in proportion to luminance times sin(theta) (the Jacobian of the
-//    lat-long map), combined with BSDF sampling by MIS in the integrator.
-// Mitsuba samples a piecewise-bilinear density over the texel grid; here the grid's cells (between
-// four texels) get a piecewise-constant density (pbrt-v4 §A.5; pbrt-v3 §14.2.4 for the lat-long
-// map), which is positive wherever the bilinear radiance is: the expected image is the same,
-// only its noise differs.
+//    lat-long map), combined with BSDF sampling by MIS in the integrator. The density is
+//    piecewise bilinear over the texel grid, as Mitsuba's: a cell (between four texels) is chosen
+//    from a piecewise-constant distribution of the cells' integrals (pbrt-v4 §A.5), then a point
+//    within it from the bilinear interpolant of its corners' luminance x sin(theta) (pbrt-v4
+//    SampleBilinear, §A.3.2) -- the shape of the bilinear radiance itself, so a cell half lit by
+//    the sun's edge gets its samples where the light is.
 #include <vector>
 
 #include "renderer/lights/environment_light.h"
@@ -45,6 +46,11 @@ class EnvironmentMap final : public EnvironmentLight {
   Spectrum lookup(const vec2& uv) const;
   // pdf() of the map-space direction d whose lat-long coordinates are uv.
   float pdf_local(const vec3& d, const vec2& uv) const;
+  // Cell (x, y)'s corners: luminance x sin(theta) of texels x, x + 1 in rows y, y + 1.
+  struct Corners {
+    float w00, w10, w01, w11;
+  };
+  Corners corners(int x, int y) const;
   const Spectrum& texel(int x, int y) const { return texels_[size_t(y) * size_t(width_) + size_t(x)]; }
 
   int width_ = 1, height_ = 2;      // height >= 2: rows are samples from pole to pole
@@ -53,6 +59,7 @@ class EnvironmentMap final : public EnvironmentLight {
   // Cell (x, y) of the distribution spans texels x, x + 1 and rows y, y + 1; in u it starts at
   // texel x's centre, half a texel right of the cell's own coordinate.
   Distribution2D distribution_;
+  std::vector<float> row_sin_;  // sin(theta) of each texel row (poles: see the constructor)
   float half_texel_ = 0.f;
   double integral_ = 0.0;
   bool uniform_sampling_ = false;
