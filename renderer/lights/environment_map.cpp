@@ -15,7 +15,7 @@ constexpr float kMinSinTheta = 1e-9f;
 
 float clean(float v) { return std::isfinite(v) && v > 0.f ? v : 0.f; }
 
-// A sample of [0, 1] with density proportional to (1 - x) a + x b, 0 <= a, b <= 4 (pbrt-v4
+// A sample of [0, 1] with density proportional to (1 - x) a + x b, 0 <= a, b <= 2 (pbrt-v4
 // SampleLinear): the root of the CDF's quadratic in the form that stays accurate for a << b.
 float sample_linear(float u, float a, float b) {
   if (!(a + b > 0.f)) return u;  // both zero: no shape to follow (its density is 0 anyway)
@@ -70,19 +70,16 @@ EnvironmentMap::EnvironmentMap(const EnvironmentMapDesc& desc)
   half_texel_ = 0.5f / float(width_);
 
   // Cell (x, y) lies between rows y and y + 1, at polar angles theta0..theta1, and between the
-  // centres of texels x and x + 1. Its weight approximates the integral of luminance over its
-  // solid angle: the mean of its four texels (the integral of the bilinear interpolant over the
-  // cell) times the band's cos(theta0) - cos(theta1), the integral of sin(theta) dtheta. The
-  // sin(theta) factor keeps the poles, which the map stretches across a whole row, from drawing
-  // samples out of proportion to their solid angle (pbrt-v3 §14.2.4; Mitsuba's envmap weights its
-  // grid by sin(theta) too). A cell is zero only if all four texels are, i.e. only where the
-  // radiance is zero.
-  // The sampling density within a cell is the bilinear interpolant of its corners' luminance x
-  // sin(theta) (the density a cell's integral is divided by), so the cell's weight is their mean.
-  // A pole row's sin(theta) would be 0, and a map lit only there (or a one-row map, whose two
-  // rows are both poles) would then have no samples at all: the poles count as sin(theta) a
-  // quarter row in, which only shapes the density within their cells. `sum` is the luminance
-  // integral.
+  // centres of texels x and x + 1. Sampling density: each corner (texel) carries its luminance x
+  // its row's sin(theta); within a cell the density is their bilinear interpolant, so a cell's
+  // weight is their mean. The sin(theta) factor keeps the poles, which the map stretches across
+  // a whole row, from drawing samples out of proportion to their solid angle (pbrt-v3 §14.2.4;
+  // Mitsuba's envmap weights its grid by sin(theta) too). A pole row's sin(theta) would be 0, and
+  // a map lit only there (or a one-row map, whose two rows are both poles) would then have no
+  // samples at all: the poles count as sin(theta) a quarter row in, which only shapes the density
+  // within their cells. So a cell is zero only if its four texels are, i.e. only where the
+  // radiance is zero. `sum` is the luminance integral itself (for the light's power): each cell's
+  // mean luminance times its band's cos(theta0) - cos(theta1), the integral of sin(theta) dtheta.
   const int nu = width_, nv = height_ - 1;
   row_sin_.resize(size_t(height_));
   const double pole_sin = std::sin(M_PI / (4.0 * nv));
