@@ -150,21 +150,19 @@ bool EnvironmentMap::sample(const vec3&, float, const vec2& u, LightSample* out)
     float pdf_cell = 0.f;
     const vec2 st = distribution_.sample(u, &pdf_cell);
     if (!(pdf_cell > 0.f)) return false;
-    const int nu = width_, nv = height_ - 1;
-    const float sx = st.x * float(nu), sy = st.y * float(nv);
-    const int cx = std::min(int(sx), nu - 1), cy = std::min(int(sy), nv - 1);
+    const CellPoint q = cell_point(st);
     // The warp depends only on the corners' ratios: scaled to at most 1, their squares cannot
     // overflow (texels up to 1e30 are allowed).
-    Corners c = corners(cx, cy);
+    Corners c = corners(q.x, q.y);
     const float top = std::max(std::max(c.w00, c.w10), std::max(c.w01, c.w11));
     if (!(top > 0.f)) return false;
     const float inv = 1.f / top;
     c = {c.w00 * inv, c.w10 * inv, c.w01 * inv, c.w11 * inv};
-    const float fy = sample_linear(std::clamp(sy - float(cy), 0.f, 1.f), c.w00 + c.w10, c.w01 + c.w11);
-    const float fx = sample_linear(std::clamp(sx - float(cx), 0.f, 1.f), (1.f - fy) * c.w00 + fy * c.w01,
-                                   (1.f - fy) * c.w10 + fy * c.w11);
+    const float fy = sample_linear(q.fy, c.w00 + c.w10, c.w01 + c.w11);
+    const float fx = sample_linear(q.fx, (1.f - fy) * c.w00 + fy * c.w01, (1.f - fy) * c.w10 + fy * c.w11);
     const float pdf_uv = pdf_cell * bilinear_pdf(fx, fy, c.w00, c.w10, c.w01, c.w11);
-    vec2 uv((float(cx) + fx) / float(nu) + half_texel_, std::min((float(cy) + fy) / float(nv), 1.f));
+    vec2 uv((float(q.x) + fx) / float(width_) + half_texel_,
+            std::min((float(q.y) + fy) / float(height_ - 1), 1.f));
     if (uv.x >= 1.f) uv.x -= 1.f;
     const float sin_theta = std::sin(uv.y * kPi);
     if (!(pdf_uv > 0.f) || !(sin_theta > kMinSinTheta)) return false;
@@ -179,6 +177,13 @@ bool EnvironmentMap::sample(const vec3&, float, const vec2& u, LightSample* out)
   return true;
 }
 
+EnvironmentMap::CellPoint EnvironmentMap::cell_point(const vec2& st) const {
+  const int nu = width_, nv = height_ - 1;
+  const float sx = st.x * float(nu), sy = st.y * float(nv);
+  const int cx = std::clamp(int(sx), 0, nu - 1), cy = std::clamp(int(sy), 0, nv - 1);
+  return {cx, cy, std::clamp(sx - float(cx), 0.f, 1.f), std::clamp(sy - float(cy), 0.f, 1.f)};
+}
+
 float EnvironmentMap::pdf(const vec3& dir) const {
   if (is_black()) return 0.f;
   if (uniform_sampling_) return uniform_sphere_pdf();
@@ -189,11 +194,13 @@ float EnvironmentMap::pdf(const vec3& dir) const {
 Spectrum EnvironmentMap::radiance_and_pdf(const vec3& dir, float* pdf) const {
   const vec3 d = to_local_ * dir;
   const vec2 uv = direction_to_uv(d);
-  if (pdf) *pdf = is_black() ? 0.f : uniform_sampling_ ? uniform_sphere_pdf() : pdf_local(d, uv);
+  if (pdf) *pdf = pdf_local(d, uv);
   return lookup(uv);
 }
 
 float EnvironmentMap::pdf_local(const vec3& d, const vec2& uv) const {
+  if (is_black()) return 0.f;
+  if (uniform_sampling_) return uniform_sphere_pdf();
   float s = uv.x - half_texel_;
   if (s < 0.f) s += 1.f;
   const float sin_theta = std::sqrt(d.x * d.x + d.z * d.z);
@@ -201,12 +208,9 @@ float EnvironmentMap::pdf_local(const vec3& d, const vec2& uv) const {
   const float pdf_cell = distribution_.pdf(vec2(s, uv.y));
   if (!(pdf_cell > 0.f)) return 0.f;
   // The cell distribution_.pdf found, and the point's place in it.
-  const int nu = width_, nv = height_ - 1;
-  const float sx = s * float(nu), sy = uv.y * float(nv);
-  const int cx = std::clamp(int(sx), 0, nu - 1), cy = std::clamp(int(sy), 0, nv - 1);
-  const Corners c = corners(cx, cy);
-  const float fx = std::clamp(sx - float(cx), 0.f, 1.f), fy = std::clamp(sy - float(cy), 0.f, 1.f);
-  const float p = pdf_cell * bilinear_pdf(fx, fy, c.w00, c.w10, c.w01, c.w11) * kInv2PiSquared / sin_theta;
+  const CellPoint q = cell_point(vec2(s, uv.y));
+  const Corners c = corners(q.x, q.y);
+  const float p = pdf_cell * bilinear_pdf(q.fx, q.fy, c.w00, c.w10, c.w01, c.w11) * kInv2PiSquared / sin_theta;
   return std::isfinite(p) ? p : 0.f;
 }
 

@@ -46,6 +46,13 @@ class EnvironmentMap final : public EnvironmentLight {
   Spectrum lookup(const vec2& uv) const;
   // pdf() of the map-space direction d whose lat-long coordinates are uv.
   float pdf_local(const vec3& d, const vec2& uv) const;
+  // The distribution's cell holding st (cell coordinates, u from texel x's centre) and st's place
+  // within it, each in [0, 1]: where the bilinear warp starts and where its density is read.
+  struct CellPoint {
+    int x, y;
+    float fx, fy;
+  };
+  CellPoint cell_point(const vec2& st) const;
   // Cell (x, y)'s corners: luminance x sin(theta) of texels x, x + 1 in rows y, y + 1.
   struct Corners {
     float w00, w10, w01, w11;

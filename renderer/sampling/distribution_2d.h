@@ -34,15 +34,16 @@ class Distribution1D {
   float sample(float u, float* pdf, int* cell = nullptr) const;
   // Density at x in [0, 1] (x == 1 counts as the last cell).
   float pdf(float x) const;
-  // The cell sample(u) lands in: the last cell i with cdf_[i] <= u (0 for u < 0, n - 1 for
-  // u >= 1 or NaN).
-  int find_cell(float u) const;
   // The CDF at the cells' edges: n + 1 values from 0 to 1.
   std::span<const float> cdf() const { return cdf_; }
   // Density of cell i (constant over it).
   float cell_pdf(int i) const { return pdf_[size_t(i)]; }
 
  private:
+  // The cell sample(u) lands in: the last cell i with cdf_[i] <= u (0 for u < 0, n - 1 for
+  // u >= 1 or NaN).
+  int find_cell(float u) const;
+
   // Each cell's density, weight / integral (0 for all cells when the integral is 0): divided
   // once here, not per lookup (a double division was half of a map's pdf() time).
   std::vector<float> pdf_;
