@@ -21,21 +21,58 @@ ShapeContext triangles_context(ShapeContext ctx) {
   return ctx;
 }
 
+// The point o + s u + t v and its error bound: three products and two sums per coordinate,
+// rounded once each (pbrt-v4 section 6.8.1).
+void parallelogram_point(const vec3& o, const vec3& u, const vec3& v, float s, float t, vec3* p,
+                         vec3* error) {
+  const vec3 su = s * u, tv = t * v;
+  *p = o + su + tv;
+  *error = gamma_bound(6) * (abs_components(o) + abs_components(su) + abs_components(tv));
+}
+
 }  // namespace
 
 Quad::Quad(const QuadDesc& desc, const ShapeContext& ctx)
     : TriangleMesh(two_triangles(moved(desc, ctx.offset)), triangles_context(ctx)),
       quad_(moved(desc, ctx.offset)),
-      normal_(glm::normalize(glm::cross(quad_.u, quad_.v))) {
+      normal_(glm::normalize(glm::cross(quad_.u, quad_.v))),
+      test_(quad_),
+      parallelogram_(!moving() && !has_cutout()) {
   set_area(glm::length(glm::cross(desc.u, desc.v)));
 }
 
+EmbreeGeometry Quad::make_geometry(RTCDevice device) const {
+  if (!parallelogram_) return TriangleMesh::make_geometry(device);
+  EmbreeGeometry geom(rtcNewGeometry(device, RTC_GEOMETRY_TYPE_USER));
+  if (!geom) return geom;
+  rtcSetGeometryUserPrimitiveCount(geom.get(), 1);
+  rtcSetGeometryBoundsFunction(geom.get(), parallelogram_bounds_fn, nullptr);
+  rtcSetGeometryIntersectFunction(geom.get(), parallelogram_intersect_fn);
+  rtcSetGeometryOccludedFunction(geom.get(), parallelogram_occluded_fn);
+  rtcSetGeometryUserData(geom.get(), const_cast<Parallelogram*>(&test_));
+  rtcCommitGeometry(geom.get());
+  return geom;
+}
+
+void Quad::hit_geometry(const Ray& ray, float t, uint32_t prim, const vec2& uv,
+                        SurfaceHit* hit) const {
+  if (!parallelogram_) return TriangleMesh::hit_geometry(ray, t, prim, uv, hit);
+  // Embree's (u, v) are the parallelogram's (s, t) (shapes/parallelogram.cpp).
+  parallelogram_point(quad_.origin, quad_.u, quad_.v, uv.x, uv.y, &hit->p, &hit->p_error);
+  hit->uv = uv;
+  hit->ng = normal_;
+  hit->ns = normal_;
+}
+
+void Quad::surface_derivatives(float time, SurfaceHit* hit) const {
+  if (!parallelogram_) return TriangleMesh::surface_derivatives(time, hit);
+  hit->dpdu = quad_.u;  // of o + s u + t v with uv = (s, t), as the triangles' solve gives
+  hit->dpdv = quad_.v;
+}
+
 bool Quad::sample(const vec3& ref, float time, const vec2& u, ShapeSample* out) const {
-  const vec3 su = u.x * quad_.u, sv = u.y * quad_.v;
   const vec3 o = moving() ? quad_.origin + displacement_at(time) : quad_.origin;
-  out->p = o + su + sv;
-  // Three products and two sums per coordinate, rounded once each (pbrt-v4 section 6.8.1).
-  out->p_error = gamma_bound(6) * (abs_components(o) + abs_components(su) + abs_components(sv));
+  parallelogram_point(o, quad_.u, quad_.v, u.x, u.y, &out->p, &out->p_error);
   out->n = normal_;
   out->uv = u;
   out->pdf = area_to_solid_angle(ref, out->p, out->n, area());

@@ -134,6 +134,21 @@ inline ObjectDesc box(const vec3& lo, const vec3& hi, uint32_t material) {
   return o;
 }
 
+// A box of six quads, faces outward, its corners turned by `rotation` about `lo` (each face's
+// corner and edges rotated and rounded on their own, so neighbouring faces share their edges only
+// to float rounding, as a user's hand-made box does).
+inline std::vector<ObjectDesc> quad_box(const vec3& lo, const vec3& hi, uint32_t material,
+                                        const glm::mat3& rotation = glm::mat3(1.f)) {
+  const vec3 e = hi - lo;
+  const vec3 x(e.x, 0.f, 0.f), y(0.f, e.y, 0.f), z(0.f, 0.f, e.z);
+  const vec3 faces[6][3] = {{vec3(0.f), z, y}, {x, y, z}, {vec3(0.f), x, z},
+                            {y, z, x},         {vec3(0.f), y, x}, {z, x, y}};
+  std::vector<ObjectDesc> out;
+  for (const auto& f : faces)
+    out.push_back(quad(lo + rotation * f[0], rotation * f[1], rotation * f[2], material));
+  return out;
+}
+
 // Unit-radius UV sphere as a triangle mesh (counter-clockwise from outside), optional smooth
 // normals.
 inline MeshDesc uv_sphere_mesh(const vec3& center, float radius, int rings, int segments, bool normals) {
