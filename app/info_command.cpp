@@ -24,6 +24,14 @@ namespace penumbra::app {
 
 namespace {
 
+// The environment line's kind: an image map (its size), a constant radiance, or black.
+std::string environment_kind(const SceneInput& scene) {
+  if (scene.environment_map)
+    return "map " + std::to_string(scene.environment_map->width) + " x " +
+           std::to_string(scene.environment_map->height);
+  return is_black(scene.environment) ? "black" : "constant";
+}
+
 namespace fs = std::filesystem;
 
 void print_help(std::FILE* out) {
@@ -143,7 +151,7 @@ int print_scene(const std::string& file) {
               list_counts({{"point light", "point lights", points},
                            {"directional light", "directional lights", directionals}})
                   .c_str(),
-              is_black(scene.environment) ? "black" : "constant");
+              environment_kind(scene).c_str());
   std::printf("  materials   %zu\n", scene.materials.size());
   std::printf("  files       %zu\n", request.assets.size());
   for (const api::AssetUse& asset : request.assets)

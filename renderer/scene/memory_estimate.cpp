@@ -1,8 +1,11 @@
 #include "renderer/scene/memory_estimate.h"
 
 #include <algorithm>
+#include <bit>
 #include <variant>
 #include <vector>
+
+#include "renderer/sampling/distribution_2d.h"
 
 namespace penumbra {
 namespace {
@@ -39,6 +42,21 @@ void add_mesh(const MeshDesc& mesh, bool emissive, bool moving, MemoryEstimate& 
   e.embree_build_peak += triangles * kBvhBuildExtraPerTriangle;
 }
 
+// An environment map: its texels in the input, and in the light (lights/environment_map.h) the
+// scaled texels and the sampling distribution (sampling/distribution_2d.h): per texel a density
+// and a CDF entry, per four texels a guide entry (a row of w texels has bit_ceil(w) / 4 + 1),
+// per row sin(theta) and the marginal's entries.
+void add_environment_map(const EnvironmentMapDesc& map, MemoryEstimate& e) {
+  const int64_t w = std::max(map.width, 0), h = std::max(map.height, 0);
+  const int64_t texels = w * h, texel_bytes = int64_t(sizeof(Spectrum));
+  e.scene_input += texels * texel_bytes;
+  const int64_t guide_per_row =
+      (int64_t(std::bit_ceil(uint64_t(std::max<int64_t>(w, 1)))) / 4 + 1) * 4;
+  // The row's Distribution1D, its extra CDF entry, guide, sin(theta), the marginal's entries.
+  const int64_t row_bytes = int64_t(sizeof(Distribution1D)) + 4 + guide_per_row + 4 + 9;
+  e.shapes += texels * (texel_bytes + 4 + 4) + h * row_bytes;
+}
+
 }  // namespace
 
 MemoryEstimate estimate_mesh_memory(const MeshDesc& mesh) {
@@ -65,6 +83,7 @@ MemoryEstimate estimate_memory(const SceneInput& scene, const RenderSettings& se
       e.embree_build_peak = std::max(e.embree_build_peak, triangles * kBvhBuildExtraPerTriangle);
     }
   }
+  if (scene.environment_map) add_environment_map(*scene.environment_map, e);
   e.film = int64_t(settings.width) * settings.height * kFilmBytesPerPixel;
   return e;
 }

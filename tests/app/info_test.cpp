@@ -2,6 +2,7 @@
 // estimate; unreadable or invalid files fail with the loader's messages.
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <fstream>
 
 #include "tests/app/app_test_util.h"
@@ -43,6 +44,23 @@ TEST(Info, SceneWithAMeshFile) {
       << r.output;
   EXPECT_TRUE(contains(r.output, "  memory      about ")) << r.output;
   EXPECT_TRUE(contains(r.output, "film 390.6 KiB")) << r.output;  // 5000 pixels x 80 bytes
+}
+
+// An environment map: the line says so (not "black"), and the estimate counts its texels in
+// the input and, with the sampling tables, in the light (512 x 256: 1.5 MiB and 2.6 MiB).
+TEST(Info, SceneWithAnEnvironmentMap) {
+  SceneFolder folder;
+  std::filesystem::copy_file(std::string(PENUMBRA_SOURCE_DIR) + "/scenes/sky_sun.hdr",
+                             folder.file("sky.hdr"));
+  write_file(folder, "sky.json", R"({"version": 1,
+      "camera": {"position": [0, 0, 5], "look_at": [0, 0, 0]},
+      "environment": {"map": "sky.hdr"},
+      "materials": {"white": {"type": "diffuse"}},
+      "objects": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "white"}]})");
+  const CommandResult r = run_penumbra(folder, "info sky.json");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "  lights      none; environment map 512 x 256\n")) << r.output;
+  EXPECT_TRUE(contains(r.output, "scene input 1.5 MiB, renderer copies 2.6 MiB")) << r.output;
 }
 
 TEST(Info, SceneWithInstances) {

@@ -87,5 +87,26 @@ TEST(MemoryEstimate, InstancesAddPerCopyAndOneBvhPerMesh) {
   EXPECT_LE(bvh, 1000 * 80);
 }
 
+// An environment map's texels count in the input and, with its sampling tables (density, CDF
+// and a guide entry per four texels), in the light: about 12 + 21 bytes per texel.
+TEST(MemoryEstimate, EnvironmentMapTexelsAndSamplingTables) {
+  SceneInput scene;
+  RenderSettings settings;
+  settings.width = 0;
+  settings.height = 0;
+  const MemoryEstimate none = estimate_memory(scene, settings);
+  EnvironmentMapDesc map;
+  map.width = 1024;
+  map.height = 512;
+  map.rgb.assign(size_t(1024 * 512 * 3), 1.f);
+  scene.environment_map = map;
+  const MemoryEstimate e = estimate_memory(scene, settings);
+  const int64_t texels = 1024 * 512;
+  EXPECT_EQ(e.scene_input - none.scene_input, texels * 12);
+  EXPECT_GE(e.shapes - none.shapes, texels * 21);
+  EXPECT_LE(e.shapes - none.shapes, texels * 22);
+  EXPECT_EQ(e.embree, none.embree);
+}
+
 }  // namespace
 }  // namespace penumbra::test
