@@ -2,6 +2,11 @@
 // under construction or by an RAII handle, so a step that throws leaks nothing.
 #include <embree3/rtcore.h>
 
+#include <bit>
+#include <map>
+#include <utility>
+#include <vector>
+
 #include "renderer/embree/device.h"
 #include "renderer/embree/handles.h"
 #include "renderer/lights/area_light.h"
@@ -10,6 +15,7 @@
 #include "renderer/materials/coating_tables.h"
 #include "renderer/scene/scene.h"
 #include "renderer/shapes/make_shape.h"
+#include "renderer/shapes/quad.h"
 #include "renderer/shapes/triangle_mesh.h"
 #include "renderer/textures/image_texture.h"
 #include "renderer/textures/texture_image_cache.h"
@@ -211,8 +217,26 @@ class SceneBuilder {
     s_.exact_t_ = ExactTCheck(std::move(plain));
   }
 
+  // Quads in one axis plane (a duplicate, a panel flush with a wall, a tiled floor) can tie
+  // exactly, and Embree would skip the flat box of the second: their boxes get a thickness
+  // (shapes/parallelogram.h, Parallelogram::thicken). Other quads keep their flat boxes.
+  void thicken_coplanar_quads() {
+    std::map<std::pair<int, uint32_t>, std::vector<Quad*>> planes;
+    for (auto& shape : s_.shapes_) {
+      auto* quad = dynamic_cast<Quad*>(shape.get());
+      if (!quad || !quad->parallelogram()) continue;
+      const int k = quad->test().flat_axis();
+      if (k >= 0)
+        planes[{k, std::bit_cast<uint32_t>(quad->test().origin[k] + 0.f)}].push_back(quad);
+    }
+    for (auto& [plane, quads] : planes)
+      if (quads.size() > 1)
+        for (Quad* quad : quads) quad->thicken_box();
+  }
+
   void embree_scene() {
     exact_t_check();
+    thicken_coplanar_quads();
     RTCDevice device = embree_device();
     EmbreeErrorScope errors;
     EmbreeScene scene(rtcNewScene(device));

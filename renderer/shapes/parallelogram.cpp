@@ -21,14 +21,14 @@ ParallelogramLanes lanes_of(const Parallelogram& q) {
                             q.dv.y,       q.dv.z};
 }
 
-// The test on one ray: its t if it meets the parallelogram in (tnear, tfar), else a value that
-// fails `t > tnear`; (s, t) in *s, *t. Every lane computes every value and selects at the end,
+// The test on one ray: its t if it meets the parallelogram in (tnear, tfar), or at tfar itself
+// when `wins_tie` (see tie_wins), else a value that fails `t > tnear`; (s, t) in *s, *t. Every lane computes every value and selects at the end,
 // so a single ray and a packet's lane give the same bits (this file is compiled without FMA
 // contraction, renderer/CMakeLists.txt).
 [[gnu::always_inline]] inline float lane_test(const ParallelogramLanes& q, float ox, float oy,
                                               float oz, float dx, float dy, float dz,
-                                              float tnear, float tfar, float* s_out,
-                                              float* t_out) {
+                                              float tnear, float tfar, Mask wins_tie,
+                                              float* s_out, float* t_out) {
   // Sign of t in double: products of floats are exact there, so a ray leaving the plane (its
   // origin beyond the hit point's error bound) is never ahead of it.
   const double wx = double(q.qx) - double(ox), wy = double(q.qy) - double(oy),
@@ -43,10 +43,21 @@ ParallelogramLanes lanes_of(const Parallelogram& q) {
   constexpr float lo = -Parallelogram::kEdgeTolerance, hi = 1.f + Parallelogram::kEdgeTolerance;
   const Mask inside = mask(s >= lo) & mask(s <= hi) & mask(r >= lo) & mask(r <= hi);
   // Not `t > tnear` alone: a NaN t (a ray in the plane) fails both this and the caller's test.
-  const Mask hit = ahead & inside & mask(t > tnear) & mask(t < tfar);
+  const Mask nearer = mask(t < tfar) | (mask(t == tfar) & wins_tie);
+  const Mask hit = ahead & inside & mask(t > tnear) & nearer;
   *s_out = s;
   *t_out = r;
   return when(hit, t, -kInfinity);
+}
+
+// Whether a hit at the same t as the ray's current hit replaces it: when it comes first in
+// (instance, geometry) order. Coincident quads (a duplicated object) tie exactly, and Embree
+// visits them in a different order for a packet than for a single ray; so the lowest ids win
+// whatever the order (tests/stress/wavefront_driver_test.cpp, coincident quads).
+[[gnu::always_inline]] inline Mask tie_wins(unsigned inst, unsigned geom, unsigned hit_inst,
+                                            unsigned hit_geom) {
+  return mask(hit_geom != RTC_INVALID_GEOMETRY_ID) &
+         (mask(inst < hit_inst) | (mask(inst == hit_inst) & mask(geom < hit_geom)));
 }
 
 template <unsigned kN>
@@ -57,10 +68,12 @@ inline void intersect_one(const RTCIntersectFunctionNArguments* args, unsigned i
   RTCRayN* ray = RTCRayHitN_RayN(args->rayhit, n);
   RTCHitN* hit = RTCRayHitN_HitN(args->rayhit, n);
   float s, r;
+  const Mask tie = tie_wins(args->context->instID[0], args->geomID, RTCHitN_instID(hit, n, i, 0),
+                            RTCHitN_geomID(hit, n, i));
   const float t = lane_test(q, RTCRayN_org_x(ray, n, i), RTCRayN_org_y(ray, n, i),
                             RTCRayN_org_z(ray, n, i), RTCRayN_dir_x(ray, n, i),
                             RTCRayN_dir_y(ray, n, i), RTCRayN_dir_z(ray, n, i),
-                            RTCRayN_tnear(ray, n, i), RTCRayN_tfar(ray, n, i), &s, &r);
+                            RTCRayN_tnear(ray, n, i), RTCRayN_tfar(ray, n, i), tie, &s, &r);
   if (!(t > RTCRayN_tnear(ray, n, i))) return;
   RTCRayN_tfar(ray, n, i) = t;
   RTCHitN_Ng_x(hit, n, i) = float(q.nx);
@@ -83,7 +96,7 @@ inline void occluded_one(const RTCOccludedFunctionNArguments* args, unsigned i) 
   const float t = lane_test(q, RTCRayN_org_x(ray, n, i), RTCRayN_org_y(ray, n, i),
                             RTCRayN_org_z(ray, n, i), RTCRayN_dir_x(ray, n, i),
                             RTCRayN_dir_y(ray, n, i), RTCRayN_dir_z(ray, n, i),
-                            RTCRayN_tnear(ray, n, i), RTCRayN_tfar(ray, n, i), &s, &r);
+                            RTCRayN_tnear(ray, n, i), RTCRayN_tfar(ray, n, i), 0, &s, &r);
   if (t > RTCRayN_tnear(ray, n, i)) RTCRayN_tfar(ray, n, i) = -kInfinity;
 }
 
@@ -102,8 +115,9 @@ template <class RayHitK>
   const float nx = float(q.nx), ny = float(q.ny), nz = float(q.nz);
   for (int i = 0; i < kN; ++i) {
     float s, r;
+    const Mask tie = tie_wins(ids.inst, ids.geom, hit.instID[0][i], hit.geomID[i]);
     const float t = lane_test(q, ray.org_x[i], ray.org_y[i], ray.org_z[i], ray.dir_x[i],
-                              ray.dir_y[i], ray.dir_z[i], ray.tnear[i], ray.tfar[i], &s, &r);
+                              ray.dir_y[i], ray.dir_z[i], ray.tnear[i], ray.tfar[i], tie, &s, &r);
     const Mask m = mask(valid[i] != 0) & mask(t > ray.tnear[i]);
     ray.tfar[i] = when(m, t, ray.tfar[i]);
     hit.Ng_x[i] = when(m, nx, hit.Ng_x[i]);
@@ -125,7 +139,8 @@ template <class RayK>
   for (int i = 0; i < kN; ++i) {
     float s, r;
     const float t = lane_test(q, ray->org_x[i], ray->org_y[i], ray->org_z[i], ray->dir_x[i],
-                              ray->dir_y[i], ray->dir_z[i], ray->tnear[i], ray->tfar[i], &s, &r);
+                              ray->dir_y[i], ray->dir_z[i], ray->tnear[i], ray->tfar[i], 0, &s,
+                              &r);
     const Mask m = mask(valid[i] != 0) & mask(t > ray->tnear[i]);
     ray->tfar[i] = when(m, -kInfinity, ray->tfar[i]);
   }
@@ -174,11 +189,24 @@ Parallelogram::Parallelogram(const QuadDesc& q)
   const vec3 corners[4] = {origin, origin + u, origin + v, origin + u + v};
   for (const vec3& c : corners) bounds.extend(c);
   // The tolerance's overhang plus the rounding of the corners' sums.
-  const vec3 pad =
-      kEdgeTolerance * (abs_components(u) + abs_components(v)) +
-      gamma_bound(4) * (abs_components(origin) + abs_components(u) + abs_components(v));
+  const vec3 pad = kEdgeTolerance * (abs_components(u) + abs_components(v)) +
+                   gamma_bound(4) * (abs_components(origin) + abs_components(u) + abs_components(v));
   bounds.lo -= pad;
   bounds.hi += pad;
+}
+
+int Parallelogram::flat_axis() const {
+  for (int k = 0; k < 3; ++k)
+    if (u[k] == 0.f && v[k] == 0.f) return k;
+  return -1;
+}
+
+void Parallelogram::thicken() {
+  // As thick in every axis as the rounding of a distance across the quad, so that a ray's entry
+  // into the box comes before its hit on the quad whatever Embree's slab test rounds.
+  const float pad = gamma_bound(4) * (glm::length(origin) + glm::length(u) + glm::length(v));
+  bounds.lo -= vec3(pad);
+  bounds.hi += vec3(pad);
 }
 
 void parallelogram_bounds_fn(const RTCBoundsFunctionArguments* args) {

@@ -23,6 +23,10 @@ class Quad final : public TriangleMesh {
 
   // Whether it is traced by its own test: static and without a cutout.
   bool parallelogram() const { return parallelogram_; }
+  // That test (meaningful only if parallelogram()), and its box made thick enough for ties
+  // (Parallelogram::thicken; before make_geometry).
+  const Parallelogram& test() const { return test_; }
+  void thicken_box() { test_.thicken(); }
 
   // What sample() reads, for the wavefront driver's light kernels (render/light_kernels.h).
   const QuadDesc& desc() const { return quad_; }

@@ -15,6 +15,7 @@
 #include "api/scene_loader.h"
 #include "renderer/render/render.h"
 #include "renderer/scene/scene.h"
+#include "tests/stress/stress_util.h"
 
 namespace penumbra::test {
 namespace {
@@ -93,6 +94,34 @@ TEST(WavefrontDriver, SameImagesAcrossBatchesAdaptiveSamplingAndWindows) {
   s.window = PixelWindow{5, 3, 21, 17};
   s.tile_size = 7;
   expect_same_render(*scene, s, "adaptive in a window");
+}
+
+// Coincident quads (each traced by its own parallelogram test, shapes/parallelogram.h): a
+// duplicated floor of two colours, and two identical boxes of glass quads. Their hits tie in t,
+// and which one a ray gets must not depend on the order of Embree's traversal, which differs
+// between packets and single rays.
+TEST(WavefrontDriver, SameImagesWithCoincidentQuads) {
+  SceneInput in;
+  in.camera = camera_looking({0.3f, 1.5f, 4.f}, {0.f, 0.3f, 0.f}, 40.f);
+  in.environment = Spectrum(0.6f);
+  in.materials = {DiffuseParams{Spectrum(0.8f, 0.2f, 0.2f)}, DiffuseParams{Spectrum(0.2f, 0.2f, 0.8f)},
+                  DielectricParams{}};
+  in.objects = {quad_object({-3, 0, 3}, {6, 0, 0}, {0, 0, -6}, 0),
+                quad_object({-3, 0, 3}, {6, 0, 0}, {0, 0, -6}, 1)};
+  for (int copy = 0; copy < 2; ++copy)
+    for (const ObjectDesc& face : quad_box(vec3(-0.5f, 0.2f, -0.5f), vec3(0.5f, 1.2f, 0.5f), 2))
+      in.objects.push_back(face);
+  in.lights = {PointLightDesc{vec3(1.f, 3.f, 1.f), Spectrum(20.f)}};
+  const auto scene = Scene::build(in);
+  RenderSettings s;
+  s.width = 32;
+  s.height = 32;
+  s.spp = 8;
+  s.max_depth = 8;
+  for (IntegratorKind kind : {IntegratorKind::kPath, IntegratorKind::kDistributed}) {
+    s.integrator = kind;
+    expect_same_render(*scene, s, kind == IntegratorKind::kPath ? "path" : "distributed");
+  }
 }
 
 }  // namespace
