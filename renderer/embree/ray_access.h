@@ -3,6 +3,7 @@
 // accessors) read back as our vector types.
 #include <embree3/rtcore.h>
 
+#include "renderer/core/lane.h"
 #include "renderer/core/math.h"
 #include "renderer/core/ray.h"
 
@@ -38,6 +39,17 @@ template <class Fn>
     return;
   }
   for (unsigned i = 0; i < args->N; ++i) fn(args->N, i);
+}
+
+// Whether a user geometry's hit at exactly the t of the ray's current hit replaces it: when it
+// comes first in (instance, geometry) order. Coincident surfaces (a duplicated object) tie to the
+// bit, and Embree visits them in a different order for a packet than for a single ray; with this
+// rule the lowest ids win whatever the order, so both drivers see the same hit
+// (tests/stress/wavefront_driver_test.cpp, coincident surfaces). No current hit: no tie.
+[[gnu::always_inline]] inline Mask tie_wins(unsigned inst, unsigned geom, unsigned hit_inst,
+                                            unsigned hit_geom) {
+  return mask(hit_geom != RTC_INVALID_GEOMETRY_ID) &
+         (mask(inst < hit_inst) | (mask(inst == hit_inst) & mask(geom < hit_geom)));
 }
 
 inline vec3 embree_ray_origin(RTCRayN* ray, unsigned n, unsigned i) {

@@ -22,9 +22,10 @@ ParallelogramLanes lanes_of(const Parallelogram& q) {
 }
 
 // The test on one ray: its t if it meets the parallelogram in (tnear, tfar), or at tfar itself
-// when `wins_tie` (see tie_wins), else a value that fails `t > tnear`; (s, t) in *s, *t. Every lane computes every value and selects at the end,
-// so a single ray and a packet's lane give the same bits (this file is compiled without FMA
-// contraction, renderer/CMakeLists.txt).
+// when `wins_tie` (embree/ray_access.h, tie_wins), else -infinity, which fails `t > tnear`;
+// (s, t) in *s_out, *t_out. Every lane computes every value and selects at the end, so a single
+// ray and a packet's lane give the same bits (this file is compiled without FMA contraction,
+// renderer/CMakeLists.txt).
 [[gnu::always_inline]] inline float lane_test(const ParallelogramLanes& q, float ox, float oy,
                                               float oz, float dx, float dy, float dz,
                                               float tnear, float tfar, Mask wins_tie,
@@ -42,22 +43,12 @@ ParallelogramLanes lanes_of(const Parallelogram& q) {
   const float r = (px * q.dvx + py * q.dvy) + pz * q.dvz;
   constexpr float lo = -Parallelogram::kEdgeTolerance, hi = 1.f + Parallelogram::kEdgeTolerance;
   const Mask inside = mask(s >= lo) & mask(s <= hi) & mask(r >= lo) & mask(r <= hi);
-  // Not `t > tnear` alone: a NaN t (a ray in the plane) fails both this and the caller's test.
+  // A ray in the plane (num = den = 0) has a NaN t, which every comparison here rejects.
   const Mask nearer = mask(t < tfar) | (mask(t == tfar) & wins_tie);
   const Mask hit = ahead & inside & mask(t > tnear) & nearer;
   *s_out = s;
   *t_out = r;
   return when(hit, t, -kInfinity);
-}
-
-// Whether a hit at the same t as the ray's current hit replaces it: when it comes first in
-// (instance, geometry) order. Coincident quads (a duplicated object) tie exactly, and Embree
-// visits them in a different order for a packet than for a single ray; so the lowest ids win
-// whatever the order (tests/stress/wavefront_driver_test.cpp, coincident quads).
-[[gnu::always_inline]] inline Mask tie_wins(unsigned inst, unsigned geom, unsigned hit_inst,
-                                            unsigned hit_geom) {
-  return mask(hit_geom != RTC_INVALID_GEOMETRY_ID) &
-         (mask(inst < hit_inst) | (mask(inst == hit_inst) & mask(geom < hit_geom)));
 }
 
 template <unsigned kN>

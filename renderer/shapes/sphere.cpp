@@ -35,7 +35,9 @@ inline void sphere_intersect_one(const RTCIntersectFunctionNArguments* args, uns
   const vec3 o = embree_ray_origin(ray, n, i), d = embree_ray_direction(ray, n, i);
   float& t_far = RTCRayN_tfar(ray, n, i);
   const vec3 c = sphere.center_at(RTCRayN_time(ray, n, i));
-  const float t = intersect_sphere(c, sphere.radius(), o, d, t_far);
+  const bool tie = tie_wins(args->context->instID[0], args->geomID, RTCHitN_instID(hit, n, i, 0),
+                            RTCHitN_geomID(hit, n, i)) != 0;
+  const float t = intersect_sphere(c, sphere.radius(), o, d, t_far, tie);
   if (t <= RTCRayN_tnear(ray, n, i)) return;
   t_far = t;
   const vec3 ng = o + t * d - c;
@@ -121,7 +123,7 @@ template <bool kMoving>
 [[gnu::always_inline]] inline float lane_intersect_sphere(float cx, float cy, float cz,
                                                           float radius, float ox, float oy,
                                                           float oz, float dx, float dy, float dz,
-                                                          float t_max) {
+                                                          float t_max, Mask take_equal) {
   const float fx = ox - cx, fy = oy - cy, fz = oz - cz;
   const float b = -((fx * dx + fy * dy) + fz * dz);
   const float lx = fx + b * dx, ly = fy + b * dy, lz = fz + b * dz;
@@ -133,8 +135,8 @@ template <bool kMoving>
   const float t1 = q;
   const Mask swap = mask(t0 > t1);
   const float lo = when(swap, t1, t0), hi = when(swap, t0, t1);
-  const Mask lo_in = mask(lo > 0.f) & mask(lo < t_max);
-  const Mask hi_in = mask(hi > 0.f) & mask(hi < t_max);
+  const Mask lo_in = mask(lo > 0.f) & (mask(lo < t_max) | (take_equal & mask(lo == t_max)));
+  const Mask hi_in = mask(hi > 0.f) & (mask(hi < t_max) | (take_equal & mask(hi == t_max)));
   return when(mask(disc < 0.f), -1.f, when(lo_in, lo, when(hi_in, hi, -1.f)));
 }
 
@@ -154,8 +156,9 @@ template <class RayHitK, bool kMoving>
     lane_center<kMoving>(s, ray.time[i], &cx, &cy, &cz);
     const float ox = ray.org_x[i], oy = ray.org_y[i], oz = ray.org_z[i];
     const float dx = ray.dir_x[i], dy = ray.dir_y[i], dz = ray.dir_z[i];
+    const Mask tie = tie_wins(ids.inst, ids.geom, hit.instID[0][i], hit.geomID[i]);
     const float t =
-        lane_intersect_sphere(cx, cy, cz, s.radius, ox, oy, oz, dx, dy, dz, ray.tfar[i]);
+        lane_intersect_sphere(cx, cy, cz, s.radius, ox, oy, oz, dx, dy, dz, ray.tfar[i], tie);
     // The scalar rejection `t <= tnear`, negated (not t > tnear: they differ for a NaN tnear).
     const Mask m = mask(valid[i] != 0) & ~mask(t <= ray.tnear[i]);
     ray.tfar[i] = when(m, t, ray.tfar[i]);
@@ -180,7 +183,7 @@ template <class RayK, bool kMoving>
     lane_center<kMoving>(s, ray->time[i], &cx, &cy, &cz);
     const float t = lane_intersect_sphere(cx, cy, cz, s.radius, ray->org_x[i], ray->org_y[i],
                                           ray->org_z[i], ray->dir_x[i], ray->dir_y[i],
-                                          ray->dir_z[i], ray->tfar[i]);
+                                          ray->dir_z[i], ray->tfar[i], 0);
     const Mask m = mask(valid[i] != 0) & mask(t > ray->tnear[i]);
     ray->tfar[i] = when(m, -kInfinity, ray->tfar[i]);
   }
@@ -330,7 +333,7 @@ float Sphere::pdf(const vec3& ref, const vec3& p, const vec3& n, float time) con
 }
 
 float intersect_sphere(const vec3& center, float radius, const vec3& origin, const vec3& dir,
-                       float t_max) {
+                       float t_max, bool take_equal) {
   const vec3 f = origin - center;
   const float b = -glm::dot(f, dir);
   const vec3 l = f + b * dir;  // closest approach of the line to the centre
@@ -342,8 +345,8 @@ float intersect_sphere(const vec3& center, float radius, const vec3& origin, con
   float t0 = q != 0.f ? c / q : 0.f;
   float t1 = q;
   if (t0 > t1) std::swap(t0, t1);
-  if (t0 > 0.f && t0 < t_max) return t0;
-  if (t1 > 0.f && t1 < t_max) return t1;
+  if (t0 > 0.f && (t0 < t_max || (take_equal && t0 == t_max))) return t0;
+  if (t1 > 0.f && (t1 < t_max || (take_equal && t1 == t_max))) return t1;
   return -1.f;
 }
 

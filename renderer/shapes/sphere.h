@@ -44,8 +44,10 @@ class Sphere final : public Shape {
 // Uses the closest-approach form of the discriminant (Haines et al., "Precision Improvements for
 // Ray/Sphere Intersection", Ray Tracing Gems, 2019, ch. 7), which stays accurate for spheres that
 // are small or far away compared with the ray origin.
+// With `take_equal`, a root exactly at t_max counts too (a tie with the ray's current hit that
+// this sphere wins: see sphere.cpp).
 float intersect_sphere(const vec3& center, float radius, const vec3& origin, const vec3& dir,
-                       float t_max);
+                       float t_max, bool take_equal = false);
 
 // The Embree callbacks of a sphere's user geometry (user data: the Sphere); declared for tests,
 // which compare packets of 4, 8 and 16 rays with single rays.

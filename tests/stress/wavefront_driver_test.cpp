@@ -97,10 +97,11 @@ TEST(WavefrontDriver, SameImagesAcrossBatchesAdaptiveSamplingAndWindows) {
 }
 
 // Coincident quads (each traced by its own parallelogram test, shapes/parallelogram.h): a
-// duplicated floor of two colours, and two identical boxes of glass quads. Their hits tie in t,
+// duplicated floor of two colours, and two identical boxes of glass quads; and a duplicated
+// sphere of two colours (user geometry too). Their hits tie in t,
 // and which one a ray gets must not depend on the order of Embree's traversal, which differs
 // between packets and single rays.
-TEST(WavefrontDriver, SameImagesWithCoincidentQuads) {
+TEST(WavefrontDriver, SameImagesWithCoincidentSurfaces) {
   SceneInput in;
   in.camera = camera_looking({0.3f, 1.5f, 4.f}, {0.f, 0.3f, 0.f}, 40.f);
   in.environment = Spectrum(0.6f);
@@ -111,6 +112,9 @@ TEST(WavefrontDriver, SameImagesWithCoincidentQuads) {
   for (int copy = 0; copy < 2; ++copy)
     for (const ObjectDesc& face : quad_box(vec3(-0.5f, 0.2f, -0.5f), vec3(0.5f, 1.2f, 0.5f), 2))
       in.objects.push_back(face);
+  // And a duplicated sphere of two colours (the sphere's test ties alike).
+  in.objects.push_back(sphere(vec3(1.1f, 0.4f, 0.6f), 0.4f, 0));
+  in.objects.push_back(sphere(vec3(1.1f, 0.4f, 0.6f), 0.4f, 1));
   in.lights = {PointLightDesc{vec3(1.f, 3.f, 1.f), Spectrum(20.f)}};
   const auto scene = Scene::build(in);
   RenderSettings s;
