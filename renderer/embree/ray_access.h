@@ -3,6 +3,7 @@
 // accessors) read back as our vector types.
 #include <embree3/rtcore.h>
 
+#include "renderer/core/bounds.h"
 #include "renderer/core/lane.h"
 #include "renderer/core/math.h"
 #include "renderer/core/ray.h"
@@ -50,6 +51,32 @@ template <class Fn>
                                             unsigned hit_geom) {
   return mask(hit_geom != RTC_INVALID_GEOMETRY_ID) &
          (mask(inst < hit_inst) | (mask(inst == hit_inst) & mask(geom < hit_geom)));
+}
+
+// A user geometry's box as its bounds callback reports it.
+inline void write_embree_bounds(const Bounds3& b, RTCBounds* out) {
+  out->lower_x = b.lo.x;
+  out->lower_y = b.lo.y;
+  out->lower_z = b.lo.z;
+  out->upper_x = b.hi.x;
+  out->upper_y = b.hi.y;
+  out->upper_z = b.hi.z;
+}
+
+// A user geometry's hit on lane i of an intersect call over n rays (n = 1: rtcIntersect1): the
+// ray's new tfar, the hit's geometric normal, (u, v) and the primitive, geometry and instance ids.
+inline void record_user_hit(const RTCIntersectFunctionNArguments* args, unsigned n, unsigned i,
+                            float t, const vec3& ng, float u, float v) {
+  RTCRayN_tfar(RTCRayHitN_RayN(args->rayhit, n), n, i) = t;
+  RTCHitN* hit = RTCRayHitN_HitN(args->rayhit, n);
+  RTCHitN_Ng_x(hit, n, i) = ng.x;
+  RTCHitN_Ng_y(hit, n, i) = ng.y;
+  RTCHitN_Ng_z(hit, n, i) = ng.z;
+  RTCHitN_u(hit, n, i) = u;
+  RTCHitN_v(hit, n, i) = v;
+  RTCHitN_primID(hit, n, i) = args->primID;
+  RTCHitN_geomID(hit, n, i) = args->geomID;
+  RTCHitN_instID(hit, n, i, 0) = args->context->instID[0];
 }
 
 inline vec3 embree_ray_origin(RTCRayN* ray, unsigned n, unsigned i) {

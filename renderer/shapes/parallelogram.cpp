@@ -66,15 +66,7 @@ inline void intersect_one(const RTCIntersectFunctionNArguments* args, unsigned i
                             RTCRayN_dir_y(ray, n, i), RTCRayN_dir_z(ray, n, i),
                             RTCRayN_tnear(ray, n, i), RTCRayN_tfar(ray, n, i), tie, &s, &r);
   if (!(t > RTCRayN_tnear(ray, n, i))) return;
-  RTCRayN_tfar(ray, n, i) = t;
-  RTCHitN_Ng_x(hit, n, i) = float(q.nx);
-  RTCHitN_Ng_y(hit, n, i) = float(q.ny);
-  RTCHitN_Ng_z(hit, n, i) = float(q.nz);
-  RTCHitN_u(hit, n, i) = s;
-  RTCHitN_v(hit, n, i) = r;
-  RTCHitN_primID(hit, n, i) = args->primID;
-  RTCHitN_geomID(hit, n, i) = args->geomID;
-  RTCHitN_instID(hit, n, i, 0) = args->context->instID[0];
+  record_user_hit(args, n, i, t, vec3(float(q.nx), float(q.ny), float(q.nz)), s, r);
 }
 
 template <unsigned kN>
@@ -201,14 +193,8 @@ void Parallelogram::thicken() {
 }
 
 void parallelogram_bounds_fn(const RTCBoundsFunctionArguments* args) {
-  const Bounds3& b = static_cast<const Parallelogram*>(args->geometryUserPtr)->bounds;
-  RTCBounds* out = args->bounds_o;
-  out->lower_x = b.lo.x;
-  out->lower_y = b.lo.y;
-  out->lower_z = b.lo.z;
-  out->upper_x = b.hi.x;
-  out->upper_y = b.hi.y;
-  out->upper_z = b.hi.z;
+  write_embree_bounds(static_cast<const Parallelogram*>(args->geometryUserPtr)->bounds,
+                      args->bounds_o);
 }
 
 void parallelogram_intersect_fn(const RTCIntersectFunctionNArguments* args) {

@@ -13,14 +13,7 @@ namespace {
 
 void sphere_bounds_fn(const RTCBoundsFunctionArguments* args) {
   const auto& sphere = *static_cast<const Sphere*>(args->geometryUserPtr);
-  const Bounds3 b = sphere.embree_bounds();
-  RTCBounds* out = args->bounds_o;
-  out->lower_x = b.lo.x;
-  out->lower_y = b.lo.y;
-  out->lower_z = b.lo.z;
-  out->upper_x = b.hi.x;
-  out->upper_y = b.hi.y;
-  out->upper_z = b.hi.z;
+  write_embree_bounds(sphere.embree_bounds(), args->bounds_o);
 }
 
 // One ray of a packet of kN (0: the packet's run-time width). rtcIntersect1/rtcOccluded1 call
@@ -33,22 +26,13 @@ inline void sphere_intersect_one(const RTCIntersectFunctionNArguments* args, uns
   RTCRayN* ray = RTCRayHitN_RayN(args->rayhit, n);
   RTCHitN* hit = RTCRayHitN_HitN(args->rayhit, n);
   const vec3 o = embree_ray_origin(ray, n, i), d = embree_ray_direction(ray, n, i);
-  float& t_far = RTCRayN_tfar(ray, n, i);
+  const float t_far = RTCRayN_tfar(ray, n, i);
   const vec3 c = sphere.center_at(RTCRayN_time(ray, n, i));
   const bool tie = tie_wins(args->context->instID[0], args->geomID, RTCHitN_instID(hit, n, i, 0),
                             RTCHitN_geomID(hit, n, i)) != 0;
   const float t = intersect_sphere(c, sphere.radius(), o, d, t_far, tie);
   if (t <= RTCRayN_tnear(ray, n, i)) return;
-  t_far = t;
-  const vec3 ng = o + t * d - c;
-  RTCHitN_Ng_x(hit, n, i) = ng.x;
-  RTCHitN_Ng_y(hit, n, i) = ng.y;
-  RTCHitN_Ng_z(hit, n, i) = ng.z;
-  RTCHitN_u(hit, n, i) = 0.f;
-  RTCHitN_v(hit, n, i) = 0.f;
-  RTCHitN_primID(hit, n, i) = args->primID;
-  RTCHitN_geomID(hit, n, i) = args->geomID;
-  RTCHitN_instID(hit, n, i, 0) = args->context->instID[0];
+  record_user_hit(args, n, i, t, o + t * d - c, 0.f, 0.f);
 }
 
 template <unsigned kN>

@@ -14,6 +14,7 @@
 #include "renderer/embree/ray_access.h"
 #include "renderer/shapes/parallelogram.h"
 #include "renderer/shapes/quad.h"
+#include "tests/renderer/shapes/packet_test_util.h"
 
 namespace penumbra::test {
 namespace {
@@ -206,22 +207,6 @@ TEST(Parallelogram, SharedEdgesLeaveNoCrack) {
 
 // ---- packets against single rays ----
 
-constexpr int kRayFields = 12;
-constexpr int kHitFields = 7 + RTC_MAX_INSTANCE_LEVEL_COUNT;
-static_assert(sizeof(RTCRayHit) == (kRayFields + kHitFields) * 4);
-enum Field { kOrgX, kOrgY, kOrgZ, kTnear, kDirX, kDirY, kDirZ, kTime, kTfar, kMask };
-
-uint32_t bits(float f) {
-  uint32_t b;
-  std::memcpy(&b, &f, sizeof b);
-  return b;
-}
-
-struct Lane {
-  uint32_t f[kRayFields + kHitFields];
-  bool valid;
-};
-
 // Rays at, past, along and from a parallelogram, with tnear and tfar around the hit, invalid
 // lanes and garbage (NaNs, infinities) in every field a lane does not set.
 Lane random_lane(std::mt19937& rng, const QuadDesc& q) {
@@ -288,61 +273,14 @@ void expect_packets_match(const Parallelogram& q, const QuadDesc& desc, int pack
                           uint32_t seed) {
   constexpr int kN = sizeof(RayK{}.tfar) / 4;
   std::mt19937 rng(seed);
-  RTCIntersectContext ctx;
-  rtcInitIntersectContext(&ctx);
-  ctx.instID[0] = kInst;
+  void* user = const_cast<Parallelogram*>(&q);
   for (int p = 0; p < packets; ++p) {
     std::vector<Lane> lanes;
     for (int i = 0; i < kN; ++i) lanes.push_back(random_lane(rng, desc));
-    uint32_t packet[(kRayFields + kHitFields) * kN];
-    int valid[kN];
-    for (int i = 0; i < kN; ++i) {
-      for (int k = 0; k < kRayFields + kHitFields; ++k) packet[k * kN + i] = lanes[i].f[k];
-      valid[i] = lanes[i].valid ? -1 : 0;
-    }
-    RayHitK rh;
-    std::memcpy(&rh, packet, sizeof rh);
-    const RTCIntersectFunctionNArguments args{valid, const_cast<Parallelogram*>(&q), kPrim, &ctx,
-                                              reinterpret_cast<RTCRayHitN*>(&rh), kN, kGeom};
-    parallelogram_intersect_fn(&args);
-    uint32_t hits[(kRayFields + kHitFields) * kN];
-    std::memcpy(hits, &rh, sizeof rh);
-    RayK ray;
-    std::memcpy(&ray, packet, sizeof ray);
-    const RTCOccludedFunctionNArguments oargs{valid, const_cast<Parallelogram*>(&q), kPrim, &ctx,
-                                              reinterpret_cast<RTCRayN*>(&ray), kN, kGeom};
-    parallelogram_occluded_fn(&oargs);
-    uint32_t occluded[kRayFields * kN];
-    std::memcpy(occluded, &ray, sizeof ray);
-    for (int i = 0; i < kN; ++i) {
-      RTCRayHit one;
-      std::memcpy(&one, lanes[i].f, sizeof one);
-      RTCRay one_ray;
-      std::memcpy(&one_ray, lanes[i].f, sizeof one_ray);
-      int one_valid = -1;
-      if (lanes[i].valid) {
-        const RTCIntersectFunctionNArguments a1{&one_valid, const_cast<Parallelogram*>(&q),
-                                                kPrim,      &ctx,
-                                                reinterpret_cast<RTCRayHitN*>(&one),
-                                                1,          kGeom};
-        parallelogram_intersect_fn(&a1);
-        const RTCOccludedFunctionNArguments o1{&one_valid, const_cast<Parallelogram*>(&q),
-                                               kPrim,      &ctx,
-                                               reinterpret_cast<RTCRayN*>(&one_ray),
-                                               1,          kGeom};
-        parallelogram_occluded_fn(&o1);
-      }
-      uint32_t want[kRayFields + kHitFields], want_ray[kRayFields];
-      std::memcpy(want, &one, sizeof want);
-      std::memcpy(want_ray, &one_ray, sizeof want_ray);
-      for (int k = 0; k < kRayFields + kHitFields; ++k)
-        ASSERT_EQ(hits[k * kN + i], want[k])
-            << "intersect, width " << kN << ", lane " << i << ", field " << k
-            << (lanes[i].valid ? "" : " (invalid)");
-      for (int k = 0; k < kRayFields; ++k)
-        ASSERT_EQ(occluded[k * kN + i], want_ray[k]) << "occluded, width " << kN << ", lane " << i
-                                                     << ", field " << k;
-    }
+    expect_intersect_lanes_match<RayHitK>(parallelogram_intersect_fn, user, lanes, kPrim, kGeom,
+                                          kInst);
+    expect_occluded_lanes_match<RayK>(parallelogram_occluded_fn, user, lanes, kPrim, kGeom);
+    if (testing::Test::HasFatalFailure()) return;
   }
 }
 

@@ -12,29 +12,10 @@
 #include <vector>
 
 #include "renderer/shapes/sphere.h"
+#include "tests/renderer/shapes/packet_test_util.h"
 
 namespace penumbra::test {
 namespace {
-
-// An RTCRayHitK is 12 ray fields then 7 + instance-level hit fields, each K 32-bit lanes; one
-// ray (RTCRayHit) is the same with K = 1. The tests move lanes as raw bits.
-constexpr int kRayFields = 12;
-constexpr int kHitFields = 7 + RTC_MAX_INSTANCE_LEVEL_COUNT;
-static_assert(sizeof(RTCRayHit) == (kRayFields + kHitFields) * 4);
-static_assert(sizeof(RTCRayHit16) == (kRayFields + kHitFields) * 4 * 16);
-enum Field { kOrgX, kOrgY, kOrgZ, kTnear, kDirX, kDirY, kDirZ, kTime, kTfar, kMask };
-
-uint32_t bits(float f) {
-  uint32_t b;
-  std::memcpy(&b, &f, sizeof b);
-  return b;
-}
-
-// One ray's fields (and garbage in its hit fields), and whether its lane is valid.
-struct Lane {
-  uint32_t f[kRayFields + kHitFields];
-  bool valid;
-};
 
 constexpr unsigned kPrim = 7, kGeom = 5, kInst = 3;
 
@@ -115,79 +96,6 @@ class Rays {
   std::mt19937 rng_;
 };
 
-// A packet of K lanes through the packet callback, each lane through the N = 1 callback, and
-// their fields compared bit for bit.
-template <class RayHitK>
-void expect_intersect_lanes_match(const Sphere& sphere, const std::vector<Lane>& lanes) {
-  constexpr int kN = sizeof(std::declval<RayHitK>().ray.tfar) / 4;
-  ASSERT_EQ(lanes.size(), static_cast<size_t>(kN));
-  RTCIntersectContext ctx;
-  rtcInitIntersectContext(&ctx);
-  ctx.instID[0] = kInst;
-  uint32_t packet[(kRayFields + kHitFields) * kN];
-  int valid[kN];
-  for (int i = 0; i < kN; ++i) {
-    for (int k = 0; k < kRayFields + kHitFields; ++k) packet[k * kN + i] = lanes[i].f[k];
-    valid[i] = lanes[i].valid ? -1 : 0;
-  }
-  RayHitK rh;
-  std::memcpy(&rh, packet, sizeof rh);
-  const RTCIntersectFunctionNArguments args{valid, const_cast<Sphere*>(&sphere), kPrim, &ctx,
-                                            reinterpret_cast<RTCRayHitN*>(&rh), kN, kGeom};
-  sphere_intersect_fn(&args);
-  std::memcpy(packet, &rh, sizeof rh);
-  for (int i = 0; i < kN; ++i) {
-    RTCRayHit one;
-    std::memcpy(&one, lanes[i].f, sizeof one);
-    int one_valid = -1;
-    if (lanes[i].valid) {
-      const RTCIntersectFunctionNArguments a1{&one_valid, const_cast<Sphere*>(&sphere), kPrim,
-                                              &ctx, reinterpret_cast<RTCRayHitN*>(&one), 1, kGeom};
-      sphere_intersect_fn(&a1);
-    }
-    uint32_t want[kRayFields + kHitFields];
-    std::memcpy(want, &one, sizeof want);
-    for (int k = 0; k < kRayFields + kHitFields; ++k)
-      ASSERT_EQ(packet[k * kN + i], want[k]) << "width " << kN << ", lane " << i << ", field " << k
-                                             << (lanes[i].valid ? "" : " (invalid lane)");
-  }
-}
-
-template <class RayK>
-void expect_occluded_lanes_match(const Sphere& sphere, const std::vector<Lane>& lanes) {
-  constexpr int kN = sizeof(std::declval<RayK>().tfar) / 4;
-  ASSERT_EQ(lanes.size(), static_cast<size_t>(kN));
-  RTCIntersectContext ctx;
-  rtcInitIntersectContext(&ctx);
-  uint32_t packet[kRayFields * kN];
-  int valid[kN];
-  for (int i = 0; i < kN; ++i) {
-    for (int k = 0; k < kRayFields; ++k) packet[k * kN + i] = lanes[i].f[k];
-    valid[i] = lanes[i].valid ? -1 : 0;
-  }
-  RayK ray;
-  std::memcpy(&ray, packet, sizeof ray);
-  const RTCOccludedFunctionNArguments args{valid, const_cast<Sphere*>(&sphere), kPrim, &ctx,
-                                           reinterpret_cast<RTCRayN*>(&ray), kN, kGeom};
-  sphere_occluded_fn(&args);
-  std::memcpy(packet, &ray, sizeof ray);
-  for (int i = 0; i < kN; ++i) {
-    RTCRay one;
-    std::memcpy(&one, lanes[i].f, sizeof one);
-    int one_valid = -1;
-    if (lanes[i].valid) {
-      const RTCOccludedFunctionNArguments a1{&one_valid, const_cast<Sphere*>(&sphere), kPrim, &ctx,
-                                             reinterpret_cast<RTCRayN*>(&one), 1, kGeom};
-      sphere_occluded_fn(&a1);
-    }
-    uint32_t want[kRayFields];
-    std::memcpy(want, &one, sizeof want);
-    for (int k = 0; k < kRayFields; ++k)
-      ASSERT_EQ(packet[k * kN + i], want[k]) << "width " << kN << ", lane " << i << ", field " << k
-                                             << (lanes[i].valid ? "" : " (invalid lane)");
-  }
-}
-
 template <class RayHitK, class RayK>
 void expect_packets_match(const Sphere& sphere, int packets, uint32_t seed) {
   constexpr int kN = sizeof(std::declval<RayK>().tfar) / 4;
@@ -198,8 +106,9 @@ void expect_packets_match(const Sphere& sphere, int packets, uint32_t seed) {
       const float time = rays.uniform(0.f, 1.f);
       lanes.push_back(rays.lane(sphere.center_at(time), sphere.radius(), time));
     }
-    expect_intersect_lanes_match<RayHitK>(sphere, lanes);
-    expect_occluded_lanes_match<RayK>(sphere, lanes);
+    void* user = const_cast<Sphere*>(&sphere);
+    expect_intersect_lanes_match<RayHitK>(sphere_intersect_fn, user, lanes, kPrim, kGeom, kInst);
+    expect_occluded_lanes_match<RayK>(sphere_occluded_fn, user, lanes, kPrim, kGeom);
     if (testing::Test::HasFatalFailure()) return;
   }
 }
