@@ -42,6 +42,15 @@ template <class Fn>
   for (unsigned i = 0; i < args->N; ++i) fn(args->N, i);
 }
 
+// The ids a user geometry's packet callback writes into the lanes it hits (the primitive and
+// geometry of the call, the instance of its context), taken once per call.
+struct UserHitIds {
+  unsigned prim, geom, inst;
+};
+inline UserHitIds user_hit_ids(const RTCIntersectFunctionNArguments* args) {
+  return UserHitIds{args->primID, args->geomID, args->context->instID[0]};
+}
+
 // Whether a user geometry's hit at exactly the t of the ray's current hit replaces it: when it
 // comes first in (instance, geometry) order. Coincident surfaces (a duplicated object) tie to the
 // bit, and Embree visits them in a different order for a packet than for a single ray; with this

@@ -83,15 +83,11 @@ inline void occluded_one(const RTCOccludedFunctionNArguments* args, unsigned i) 
   if (t > RTCRayN_tnear(ray, n, i)) RTCRayN_tfar(ray, n, i) = -kInfinity;
 }
 
-struct HitIds {
-  unsigned prim, geom, inst;
-};
-
 // Packets of 4, 8 and 16 rays in SIMD lanes; a lane that does not hit keeps its old values.
 template <class RayHitK>
 [[gnu::always_inline]] inline void intersect_packet(const ParallelogramLanes& q,
                                                     const int* __restrict valid,
-                                                    RayHitK* __restrict rh, HitIds ids) {
+                                                    RayHitK* __restrict rh, UserHitIds ids) {
   constexpr int kN = sizeof(rh->ray.tfar) / sizeof(float);
   auto& ray = rh->ray;
   auto& hit = rh->hit;
@@ -131,17 +127,17 @@ template <class RayK>
 
 PENUMBRA_SIMD_CLONES
 void packet_intersect16(const ParallelogramLanes& q, const int* __restrict valid,
-                 RTCRayHit16* __restrict rh, HitIds ids) {
+                 RTCRayHit16* __restrict rh, UserHitIds ids) {
   intersect_packet(q, valid, rh, ids);
 }
 PENUMBRA_SIMD_CLONES
 void packet_intersect8(const ParallelogramLanes& q, const int* __restrict valid,
-                RTCRayHit8* __restrict rh, HitIds ids) {
+                RTCRayHit8* __restrict rh, UserHitIds ids) {
   intersect_packet(q, valid, rh, ids);
 }
 PENUMBRA_SIMD_CLONES
 void packet_intersect4(const ParallelogramLanes& q, const int* __restrict valid,
-                RTCRayHit4* __restrict rh, HitIds ids) {
+                RTCRayHit4* __restrict rh, UserHitIds ids) {
   intersect_packet(q, valid, rh, ids);
 }
 PENUMBRA_SIMD_CLONES
@@ -200,7 +196,7 @@ void parallelogram_bounds_fn(const RTCBoundsFunctionArguments* args) {
 void parallelogram_intersect_fn(const RTCIntersectFunctionNArguments* args) {
   if (args->N == 1) return intersect_one<1>(args, 0);
   const ParallelogramLanes q = lanes_of(*static_cast<const Parallelogram*>(args->geometryUserPtr));
-  const HitIds ids{args->primID, args->geomID, args->context->instID[0]};
+  const UserHitIds ids = user_hit_ids(args);
   // An RTCRayHitN of a width known here is that width's RTCRayHitK (embree3/rtcore_ray.h).
   switch (args->N) {
     case 16:

@@ -124,14 +124,10 @@ template <bool kMoving>
   return when(mask(disc < 0.f), -1.f, when(lo_in, lo, when(hi_in, hi, -1.f)));
 }
 
-struct HitIds {
-  unsigned prim, geom, inst;
-};
-
 template <class RayHitK, bool kMoving>
 [[gnu::always_inline]] inline void intersect_lanes(const SphereLanes& s,
                                                    const int* __restrict valid,
-                                                   RayHitK* __restrict rh, HitIds ids) {
+                                                   RayHitK* __restrict rh, UserHitIds ids) {
   constexpr int kN = sizeof(rh->ray.tfar) / sizeof(float);
   auto& ray = rh->ray;
   auto& hit = rh->hit;
@@ -176,7 +172,7 @@ template <class RayK, bool kMoving>
 // One function per width for the target clones; the motion test is made once, outside the loop.
 template <class RayHitK>
 [[gnu::always_inline]] inline void intersect_packet(const SphereLanes& s, const int* valid,
-                                                    RayHitK* rh, HitIds ids) {
+                                                    RayHitK* rh, UserHitIds ids) {
   if (s.moving)
     intersect_lanes<RayHitK, true>(s, valid, rh, ids);
   else
@@ -192,17 +188,17 @@ template <class RayK>
 }
 PENUMBRA_SIMD_CLONES
 void intersect16(const SphereLanes& s, const int* __restrict valid, RTCRayHit16* __restrict rh,
-                 HitIds ids) {
+                 UserHitIds ids) {
   intersect_packet(s, valid, rh, ids);
 }
 PENUMBRA_SIMD_CLONES
 void intersect8(const SphereLanes& s, const int* __restrict valid, RTCRayHit8* __restrict rh,
-                HitIds ids) {
+                UserHitIds ids) {
   intersect_packet(s, valid, rh, ids);
 }
 PENUMBRA_SIMD_CLONES
 void intersect4(const SphereLanes& s, const int* __restrict valid, RTCRayHit4* __restrict rh,
-                HitIds ids) {
+                UserHitIds ids) {
   intersect_packet(s, valid, rh, ids);
 }
 PENUMBRA_SIMD_CLONES
@@ -223,7 +219,7 @@ void occluded4(const SphereLanes& s, const int* __restrict valid, RTCRay4* __res
 void sphere_intersect_fn(const RTCIntersectFunctionNArguments* args) {
   if (args->N == 1) return sphere_intersect_one<1>(args, 0);
   const auto& sphere = *static_cast<const Sphere*>(args->geometryUserPtr);
-  const HitIds ids{args->primID, args->geomID, args->context->instID[0]};
+  const UserHitIds ids = user_hit_ids(args);
   // An RTCRayHitN of a width known here is that width's RTCRayHitK (embree3/rtcore_ray.h).
   switch (args->N) {
     case 16:

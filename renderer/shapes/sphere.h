@@ -45,7 +45,7 @@ class Sphere final : public Shape {
 // Ray/Sphere Intersection", Ray Tracing Gems, 2019, ch. 7), which stays accurate for spheres that
 // are small or far away compared with the ray origin.
 // With `take_equal`, a root exactly at t_max counts too (a tie with the ray's current hit that
-// this sphere wins: see sphere.cpp).
+// this sphere wins: embree/ray_access.h, tie_wins).
 float intersect_sphere(const vec3& center, float radius, const vec3& origin, const vec3& dir,
                        float t_max, bool take_equal = false);
 
