@@ -205,10 +205,10 @@ float EnvironmentMap::pdf_local(const vec3& d, const vec2& uv) const {
   if (s < 0.f) s += 1.f;
   const float sin_theta = std::sqrt(d.x * d.x + d.z * d.z);
   if (!(sin_theta > kMinSinTheta)) return 0.f;
-  const float pdf_cell = distribution_.pdf(vec2(s, uv.y));
-  if (!(pdf_cell > 0.f)) return 0.f;
-  // The cell distribution_.pdf found, and the point's place in it.
+  // The point's cell (the one distribution_.pdf would find) and its place in it.
   const CellPoint q = cell_point(vec2(s, uv.y));
+  const float pdf_cell = distribution_.cell_pdf(q.x, q.y);
+  if (!(pdf_cell > 0.f)) return 0.f;
   const Corners c = corners(q.x, q.y);
   const float p = pdf_cell * bilinear_pdf(q.fx, q.fy, c.w00, c.w10, c.w01, c.w11) * kInv2PiSquared / sin_theta;
   return std::isfinite(p) ? p : 0.f;

@@ -45,34 +45,37 @@ Distribution1D::Distribution1D(std::span<const float> weights) {
   }
 }
 
-int Distribution1D::find_cell(float u) const {
-  const size_t n = pdf_.size();
-  if (guide_.empty()) return 0;  // default-constructed: no cells
-  const size_t buckets = guide_.size() - 1;
+int CdfSearch::find_cell(float u) const {
+  if (buckets == 0) return 0;  // default-constructed: no cells
   if (!(u >= 0.f && u < 1.f)) {
     // Outside [0, 1) (and NaN): the binary search over all cells decides, clamped to a cell.
-    const auto it = std::upper_bound(cdf_.begin(), cdf_.end(), u);
-    return int(std::clamp<std::ptrdiff_t>(it - cdf_.begin() - 1, 0, std::ptrdiff_t(n) - 1));
+    const float* it = std::upper_bound(cdf, cdf + n + 1, u);
+    return int(std::clamp<std::ptrdiff_t>(it - cdf - 1, 0, std::ptrdiff_t(n) - 1));
   }
   // u * buckets is exact (a power of two), so k / buckets <= u < (k + 1) / buckets.
   const size_t k = std::min(size_t(u * float(buckets)), buckets - 1);
-  const size_t lo = size_t(guide_[k]), hi = size_t(guide_[k + 1]);
-  // The last i in [lo, hi] with cdf_[i] <= u: cdf_[lo] <= k / buckets <= u, and no cell past hi
-  // can qualify since cdf_[hi + 1] > (k + 1) / buckets > u (or hi = n - 1).
-  const auto first = cdf_.begin() + std::ptrdiff_t(lo) + 1, last = cdf_.begin() + std::ptrdiff_t(hi) + 1;
-  return int(std::upper_bound(first, last, u) - cdf_.begin()) - 1;
+  const size_t lo = size_t(guide[k]), hi = size_t(guide[k + 1]);
+  // The last i in [lo, hi] with cdf[i] <= u: cdf[lo] <= k / buckets <= u, and no cell past hi
+  // can qualify since cdf[hi + 1] > (k + 1) / buckets > u (or hi = n - 1).
+  return int(std::upper_bound(cdf + lo + 1, cdf + hi + 1, u) - cdf) - 1;
 }
 
-float Distribution1D::sample(float u, float* pdf, int* cell) const {
-  const size_t n = pdf_.size();
-  // The last cell i with cdf_[i] <= u: cells of zero width (zero weight) are never chosen.
+float CdfSearch::sample(float u, int* cell) const {
+  // The last cell i with cdf[i] <= u: cells of zero width (zero weight) are never chosen.
   const int i = find_cell(u);
-  const float width = cdf_[size_t(i) + 1] - cdf_[size_t(i)];
-  float du = width > 0.f ? (u - cdf_[size_t(i)]) / width : 0.f;
+  const float width = cdf[size_t(i) + 1] - cdf[size_t(i)];
+  float du = width > 0.f ? (u - cdf[size_t(i)]) / width : 0.f;
   du = std::clamp(du, 0.f, kOneMinusEpsilon);
   float x = std::min((float(i) + du) / float(n), kOneMinusEpsilon);
   // Rounding may carry x onto the next cell's edge; pdf(x) must find the cell sampled here.
   while (x > 0.f && cell_of(x, n) > i) x = std::nextafter(x, 0.f);
+  *cell = i;
+  return x;
+}
+
+float Distribution1D::sample(float u, float* pdf, int* cell) const {
+  int i = 0;
+  const float x = search().sample(u, &i);
   if (pdf) *pdf = cell_pdf(i);
   if (cell) *cell = i;
   return x;
@@ -82,30 +85,44 @@ float Distribution1D::pdf(float x) const { return cell_pdf(cell_of(x, pdf_.size(
 
 Distribution2D::Distribution2D(std::span<const float> weights, int nu, int nv)
     : nu_(std::max(nu, 1)), nv_(std::max(nv, 1)) {
-  conditional_.reserve(size_t(nv_));
   std::vector<float> row_integrals(static_cast<size_t>(nv_));
+  std::vector<float> row_pdfs(size_t(nu_) * size_t(nv_));
+  const std::vector<float> missing(size_t(nu_), 0.f);  // a row past the end of `weights` weighs 0
   for (int j = 0; j < nv_; ++j) {
     const size_t begin = size_t(j) * size_t(nu_);
     const std::span<const float> row =
-        begin + size_t(nu_) <= weights.size() ? weights.subspan(begin, size_t(nu_)) : std::span<const float>();
-    conditional_.emplace_back(row);
-    row_integrals[size_t(j)] = float(conditional_.back().integral());
+        begin + size_t(nu_) <= weights.size() ? weights.subspan(begin, size_t(nu_)) : std::span<const float>(missing);
+    // Each row built as a Distribution1D of its own, then copied into the flat arrays: the same
+    // numbers, so the same samples, as one object per row.
+    const Distribution1D d(row);
+    cdf_.insert(cdf_.end(), d.cdf().begin(), d.cdf().end());
+    guide_.insert(guide_.end(), d.guide().begin(), d.guide().end());
+    buckets_ = d.guide().size() - 1;  // the same for every row: it depends on nu alone
+    for (int i = 0; i < nu_; ++i) row_pdfs[begin + size_t(i)] = d.cell_pdf(i);
+    row_integrals[size_t(j)] = float(d.integral());
   }
   marginal_ = Distribution1D(row_integrals);
+  pdf_.resize(row_pdfs.size());
+  for (int j = 0; j < nv_; ++j)
+    for (int i = 0; i < nu_; ++i) {
+      const size_t c = size_t(j) * size_t(nu_) + size_t(i);
+      pdf_[c] = marginal_.cell_pdf(j) * row_pdfs[c];
+    }
 }
 
-vec2 Distribution2D::sample(const vec2& u, float* pdf) const {
-  float pdf_v = 0.f, pdf_u = 0.f;
-  int row = 0;
-  const float v = marginal_.sample(u.y, &pdf_v, &row);
-  const float x = conditional_[size_t(row)].sample(u.x, &pdf_u);
-  if (pdf) *pdf = pdf_v * pdf_u;
+vec2 Distribution2D::sample(const vec2& u, float* pdf, glm::ivec2* cell) const {
+  int row = 0, col = 0;
+  const float v = marginal_.sample(u.y, nullptr, &row);
+  const CdfSearch conditional{cdf_.data() + size_t(row) * size_t(nu_ + 1),
+                              guide_.data() + size_t(row) * (buckets_ + 1), size_t(nu_), buckets_};
+  const float x = conditional.sample(u.x, &col);
+  if (pdf) *pdf = cell_pdf(col, row);
+  if (cell) *cell = glm::ivec2(col, row);
   return vec2(x, v);
 }
 
 float Distribution2D::pdf(const vec2& p) const {
-  const int row = cell_of(p.y, size_t(nv_));
-  return marginal_.cell_pdf(row) * conditional_[size_t(row)].pdf(p.x);
+  return cell_pdf(cell_of(p.x, size_t(nu_)), cell_of(p.y, size_t(nv_)));
 }
 
 }  // namespace penumbra

@@ -21,6 +21,19 @@
 
 namespace penumbra {
 
+// The inversion of a piecewise-constant CDF through its guide table, wherever the table is kept:
+// Distribution1D's own arrays, or one row of Distribution2D's flat ones.
+struct CdfSearch {
+  const float* cdf = nullptr;  // n + 1 values from 0 to 1
+  const int* guide = nullptr;  // buckets + 1 entries (see Distribution1D::guide_)
+  size_t n = 0, buckets = 0;
+
+  // The last cell i with cdf[i] <= u (0 for u < 0, n - 1 for u >= 1 or NaN).
+  int find_cell(float u) const;
+  // x in [0, 1) in the cell find_cell(u) picks, placed linearly by u within it; *cell gets it.
+  float sample(float u, int* cell) const;
+};
+
 class Distribution1D {
  public:
   Distribution1D() = default;
@@ -38,11 +51,13 @@ class Distribution1D {
   std::span<const float> cdf() const { return cdf_; }
   // Density of cell i (constant over it).
   float cell_pdf(int i) const { return pdf_[size_t(i)]; }
+  // The guide table, one entry per bucket plus the end (see guide_).
+  std::span<const int> guide() const { return guide_; }
 
  private:
-  // The cell sample(u) lands in: the last cell i with cdf_[i] <= u (0 for u < 0, n - 1 for
-  // u >= 1 or NaN).
-  int find_cell(float u) const;
+  CdfSearch search() const {
+    return {cdf_.data(), guide_.data(), pdf_.size(), guide_.empty() ? 0 : guide_.size() - 1};
+  }
 
   // Each cell's density, weight / integral (0 for all cells when the integral is 0): divided
   // once here, not per lookup (a double division was half of a map's pdf() time).
@@ -67,15 +82,27 @@ class Distribution2D {
   int nv() const { return nv_; }
   // Integral of the weights over [0, 1)^2: their mean.
   double integral() const { return marginal_.integral(); }
-  // A point of [0, 1)^2 with density *pdf (0 when the distribution is all zero).
-  vec2 sample(const vec2& u, float* pdf) const;
+  // A point of [0, 1)^2 with density *pdf (0 when the distribution is all zero); *cell (if
+  // given) receives the cell it lies in, as (column, row).
+  vec2 sample(const vec2& u, float* pdf, glm::ivec2* cell = nullptr) const;
   // Density at p in [0, 1]^2.
   float pdf(const vec2& p) const;
+  // Density of cell (i, j), constant over it.
+  float cell_pdf(int i, int j) const { return pdf_[size_t(j) * size_t(nu_) + size_t(i)]; }
 
  private:
   int nu_ = 0, nv_ = 0;
-  std::vector<Distribution1D> conditional_;  // one per row
-  Distribution1D marginal_;                  // over rows, weighted by each row's integral
+  // The rows' conditional distributions, flat: row j's CDF is cdf_[j * (nu + 1) ...], its guide
+  // guide_[j * (buckets + 1) ...]. One array per kind instead of a Distribution1D per row
+  // saves a sample the load of the row's own pointers before the search can start (the map's
+  // sampling is a chain of dependent loads).
+  std::vector<float> cdf_;
+  std::vector<int> guide_;
+  size_t buckets_ = 0;
+  // The joint density of every cell, marginal x conditional (the product sample and pdf return),
+  // so a pdf is one load.
+  std::vector<float> pdf_;
+  Distribution1D marginal_;  // over rows, weighted by each row's integral
 };
 
 }  // namespace penumbra

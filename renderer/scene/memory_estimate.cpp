@@ -5,7 +5,6 @@
 #include <variant>
 #include <vector>
 
-#include "renderer/sampling/distribution_2d.h"
 
 namespace penumbra {
 namespace {
@@ -52,8 +51,8 @@ void add_environment_map(const EnvironmentMapDesc& map, MemoryEstimate& e) {
   e.scene_input += texels * texel_bytes;
   const int64_t guide_per_row =
       (int64_t(std::bit_ceil(uint64_t(std::max<int64_t>(w, 1)))) / 4 + 1) * 4;
-  // The row's Distribution1D, its extra CDF entry, guide, sin(theta), the marginal's entries.
-  const int64_t row_bytes = int64_t(sizeof(Distribution1D)) + 4 + guide_per_row + 4 + 9;
+  // The row's extra CDF entry, guide, sin(theta), the marginal's entries.
+  const int64_t row_bytes = 4 + guide_per_row + 4 + 9;
   e.shapes += texels * (texel_bytes + 4 + 4) + h * row_bytes;
 }
 

@@ -155,10 +155,15 @@ TEST(Distribution2D, SamplesFollowTheWeights) {
   Rng rng(11);
   for (int s = 0; s < kSamples; ++s) {
     float pdf = -1.f;
-    const vec2 p = d.sample(rng.next2(), &pdf);
+    glm::ivec2 cell(-1);
+    const vec2 p = d.sample(rng.next2(), &pdf, &cell);
     ASSERT_TRUE(p.x >= 0.f && p.x < 1.f && p.y >= 0.f && p.y < 1.f);
     ASSERT_EQ(pdf, d.pdf(p));
     ASSERT_GT(pdf, 0.f);
+    // The cell reported is the point's, and its density the point's.
+    ASSERT_EQ(cell.x, int(p.x * nu));
+    ASSERT_EQ(cell.y, int(p.y * nv));
+    ASSERT_EQ(d.cell_pdf(cell.x, cell.y), pdf);
     observed[size_t(std::min(int(p.y * bv), bv - 1) * bu + std::min(int(p.x * bu), bu - 1))] += 1.0;
   }
   const auto fit = chi2_goodness_of_fit(observed, expected);
@@ -195,6 +200,11 @@ TEST(Distribution2D, OneHotCellAndAllZeroAreHarmless) {
   EXPECT_TRUE(std::isfinite(p.x) && std::isfinite(p.y));
   EXPECT_EQ(pdf, 0.f);
   EXPECT_EQ(zero.pdf(vec2(0.3f, 0.7f)), 0.f);
+  // Rows the weights do not reach weigh nothing: the two given rows share all the density.
+  const Distribution2D short_rows(std::vector<float>(size_t(2 * nu), 1.f), nu, nv);
+  EXPECT_FLOAT_EQ(short_rows.pdf(vec2(0.5f, 0.5f / nv)), float(nv) / 2.f);
+  EXPECT_EQ(short_rows.pdf(vec2(0.5f, 0.5f)), 0.f);
+  for (int s = 0; s < 100; ++s) EXPECT_LT(short_rows.sample(rng.next2(), &pdf).y, 2.f / nv);
   // A single cell is the uniform distribution.
   const Distribution2D one(std::vector<float>{2.f}, 1, 1);
   EXPECT_EQ(one.pdf(vec2(0.1f, 0.9f)), 1.f);
