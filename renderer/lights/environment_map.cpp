@@ -32,6 +32,15 @@ float bilinear_pdf(float x, float y, float w00, float w10, float w01, float w11)
   return 4.f * v / sum;
 }
 
+// The end of every sample: a usable density, and the fields of a direction from infinity.
+bool finish_sample(LightSample* out) {
+  if (!(out->pdf > 0.f) || !std::isfinite(out->pdf)) return false;
+  out->distance = kInfinity;
+  out->is_delta = false;
+  out->p = out->p_error = out->n = vec3(0.f);
+  return true;
+}
+
 }  // namespace
 
 vec2 EnvironmentMap::direction_to_uv(const vec3& d) {
@@ -144,37 +153,55 @@ bool EnvironmentMap::sample(const vec3&, float, const vec2& u, LightSample* out)
     out->wi = square_to_uniform_sphere(u);
     out->pdf = uniform_sphere_pdf();
     out->value = radiance(out->wi);
-  } else {
-    // The cell, and where in it the sample fell: a uniform point of the cell (its row and column
-    // were drawn independently), which the bilinear warp then reshapes.
-    float pdf_cell = 0.f;
-    const vec2 st = distribution_.sample(u, &pdf_cell);
-    if (!(pdf_cell > 0.f)) return false;
-    const CellPoint q = cell_point(st);
-    // The warp depends only on the corners' ratios: scaled to at most 1, their squares cannot
-    // overflow (texels up to 1e30 are allowed).
-    Corners c = corners(q.x, q.y);
-    const float top = std::max(std::max(c.w00, c.w10), std::max(c.w01, c.w11));
-    if (!(top > 0.f)) return false;
-    const float inv = 1.f / top;
-    c = {c.w00 * inv, c.w10 * inv, c.w01 * inv, c.w11 * inv};
-    const float fy = sample_linear(q.fy, c.w00 + c.w10, c.w01 + c.w11);
-    const float fx = sample_linear(q.fx, (1.f - fy) * c.w00 + fy * c.w01, (1.f - fy) * c.w10 + fy * c.w11);
-    const float pdf_uv = pdf_cell * bilinear_pdf(fx, fy, c.w00, c.w10, c.w01, c.w11);
-    vec2 uv((float(q.x) + fx) / float(width_) + half_texel_,
-            std::min((float(q.y) + fy) / float(height_ - 1), 1.f));
-    if (uv.x >= 1.f) uv.x -= 1.f;
-    const float sin_theta = std::sin(uv.y * kPi);
-    if (!(pdf_uv > 0.f) || !(sin_theta > kMinSinTheta)) return false;
-    out->wi = to_world_ * uv_to_direction(uv);
-    out->pdf = pdf_uv * kInv2PiSquared / sin_theta;
-    out->value = lookup(uv);
+    return finish_sample(out);
   }
-  if (!(out->pdf > 0.f) || !std::isfinite(out->pdf)) return false;
-  out->distance = kInfinity;
-  out->is_delta = false;
-  out->p = out->p_error = out->n = vec3(0.f);
-  return true;
+  float pdf_cell = 0.f;
+  const vec2 st = distribution_.sample(u, &pdf_cell);
+  return sample_in_cell(st, pdf_cell, out);
+}
+
+void EnvironmentMap::sample_many(size_t n, const vec3* refs, const float* times, const vec2* u,
+                                 LightSample* out, bool* ok) const {
+  if (is_black() || uniform_sampling_) return Light::sample_many(n, refs, times, u, out, ok);
+  // The chain of one sample (marginal search, the row's search, the cell's texels) is a series
+  // of dependent loads; each stage's loads are independent across samples, so the processor
+  // overlaps them. Chunks keep the stages' state on the stack.
+  constexpr size_t kChunk = 64;
+  for (size_t k0 = 0; k0 < n; k0 += kChunk) {
+    const size_t m = std::min(kChunk, n - k0);
+    int row[kChunk], column[kChunk];
+    float v[kChunk], x[kChunk];
+    for (size_t k = 0; k < m; ++k) v[k] = distribution_.sample_row(u[k0 + k].y, &row[k]);
+    for (size_t k = 0; k < m; ++k) x[k] = distribution_.sample_column(row[k], u[k0 + k].x, &column[k]);
+    for (size_t k = 0; k < m; ++k)
+      ok[k0 + k] = sample_in_cell(vec2(x[k], v[k]), distribution_.cell_pdf(column[k], row[k]), &out[k0 + k]);
+  }
+}
+
+bool EnvironmentMap::sample_in_cell(const vec2& st, float pdf_cell, LightSample* out) const {
+  // The cell, and where in it the sample fell: a uniform point of the cell (its row and column
+  // were drawn independently), which the bilinear warp then reshapes.
+  if (!(pdf_cell > 0.f)) return false;
+  const CellPoint q = cell_point(st);
+  // The warp depends only on the corners' ratios: scaled to at most 1, their squares cannot
+  // overflow (texels up to 1e30 are allowed).
+  Corners c = corners(q.x, q.y);
+  const float top = std::max(std::max(c.w00, c.w10), std::max(c.w01, c.w11));
+  if (!(top > 0.f)) return false;
+  const float inv = 1.f / top;
+  c = {c.w00 * inv, c.w10 * inv, c.w01 * inv, c.w11 * inv};
+  const float fy = sample_linear(q.fy, c.w00 + c.w10, c.w01 + c.w11);
+  const float fx = sample_linear(q.fx, (1.f - fy) * c.w00 + fy * c.w01, (1.f - fy) * c.w10 + fy * c.w11);
+  const float pdf_uv = pdf_cell * bilinear_pdf(fx, fy, c.w00, c.w10, c.w01, c.w11);
+  vec2 uv((float(q.x) + fx) / float(width_) + half_texel_,
+          std::min((float(q.y) + fy) / float(height_ - 1), 1.f));
+  if (uv.x >= 1.f) uv.x -= 1.f;
+  const float sin_theta = std::sin(uv.y * kPi);
+  if (!(pdf_uv > 0.f) || !(sin_theta > kMinSinTheta)) return false;
+  out->wi = to_world_ * uv_to_direction(uv);
+  out->pdf = pdf_uv * kInv2PiSquared / sin_theta;
+  out->value = lookup(uv);
+  return finish_sample(out);
 }
 
 EnvironmentMap::CellPoint EnvironmentMap::cell_point(const vec2& st) const {

@@ -25,6 +25,9 @@ class EnvironmentMap final : public EnvironmentLight {
   explicit EnvironmentMap(const EnvironmentMapDesc& desc);
 
   bool sample(const vec3& ref, float time, const vec2& u, LightSample* out) const override;
+  // In three stages over all n: every sample's row, then every column, then the rest.
+  void sample_many(size_t n, const vec3* refs, const float* times, const vec2* u, LightSample* out,
+                   bool* ok) const override;
   // Like ConstantEnvironment: the radiance integral over the sphere onto the scene's bounding
   // disc, (integral of L over directions) * pi r^2.
   float power(float scene_radius) const override;
@@ -44,6 +47,9 @@ class EnvironmentMap final : public EnvironmentLight {
  private:
   // Bilinear lookup at (u, v), as Mitsuba's EnvironmentMapEmitter::eval_spectrum.
   Spectrum lookup(const vec2& uv) const;
+  // sample() from the point st of the distribution's cell (density pdf_cell) on: the bilinear
+  // warp within the cell, the direction, its radiance and density.
+  bool sample_in_cell(const vec2& st, float pdf_cell, LightSample* out) const;
   // pdf() of the map-space direction d whose lat-long coordinates are uv.
   float pdf_local(const vec3& d, const vec2& uv) const;
   // The distribution's cell holding st (cell coordinates, u from texel x's centre) and st's place

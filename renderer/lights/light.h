@@ -23,6 +23,13 @@ class Light {
 
   // Samples light arriving at `ref` at normalised shutter time `time`; false if none arrives.
   virtual bool sample(const vec3& ref, float time, const vec2& u, LightSample* out) const = 0;
+  // sample() for n references at once (out[k], its result in ok[k]): the same samples to the bit.
+  // A light whose sampling is a chain of dependent table loads runs the chain in stages over all
+  // n instead, so that the loads of different samples overlap.
+  virtual void sample_many(size_t n, const vec3* refs, const float* times, const vec2* u,
+                           LightSample* out, bool* ok) const {
+    for (size_t k = 0; k < n; ++k) ok[k] = sample(refs[k], times[k], u[k], &out[k]);
+  }
   // An estimate of the emitted power (luminance), from which the light sampler chooses.
   virtual float power(float scene_radius) const = 0;
   // Whether an integrator that weighs light sampling against BSDF sampling by MIS on every

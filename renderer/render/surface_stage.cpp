@@ -723,11 +723,8 @@ void SurfaceStage::sample_own_code_lights() {
   // path_scatter's call with the same point, time and sampler values: the same sample to the
   // bit, which the kernel then takes as it takes a quad's (a zero normal marks a point in free
   // space, an infinite distance a direction).
-  for (const uint32_t i : own_code_lanes_) {
-    const vec3 ref(p_[0][i], p_[1][i], p_[2][i]);
-    LightSample ls;
-    const vec2 u(u_point_[0][i], u_point_[1][i]);
-    light_ok_[i] = scene_.light(light_[i]).sample(ref, time_[i], u, &ls);
+  const auto store = [&](uint32_t i, bool ok, const LightSample& ls) {
+    light_ok_[i] = ok;
     l_delta_[i] = ls.is_delta;
     l_distance_[i] = ls.distance;
     l_pdf_[i] = ls.pdf;
@@ -738,7 +735,37 @@ void SurfaceStage::sample_own_code_lights() {
       l_n_[c][i] = ls.n[c];
       l_value_[c][i] = ls.value[c];
     }
+  };
+  // The environment's lanes go together to its sample_many (an environment map's sampling is a
+  // chain of table loads, which it then overlaps across lanes); other lights one lane at a time.
+  const int environment = scene_.environment_light();
+  environment_lanes_.clear();
+  many_refs_.clear();
+  many_times_.clear();
+  many_u_.clear();
+  for (const uint32_t i : own_code_lanes_) {
+    const vec3 ref(p_[0][i], p_[1][i], p_[2][i]);
+    const vec2 u(u_point_[0][i], u_point_[1][i]);
+    if (light_[i] == environment) {
+      environment_lanes_.push_back(i);
+      many_refs_.push_back(ref);
+      many_times_.push_back(time_[i]);
+      many_u_.push_back(u);
+      continue;
+    }
+    LightSample ls;
+    const bool ok = scene_.light(light_[i]).sample(ref, time_[i], u, &ls);
+    store(i, ok, ls);
   }
+  const size_t n = environment_lanes_.size();
+  if (n == 0) return;
+  if (many_out_.size() < n) {  // (many_ok_ holds as many as many_out_)
+    many_out_.resize(n);
+    many_ok_ = std::make_unique<bool[]>(n);
+  }
+  scene_.light(environment).sample_many(n, many_refs_.data(), many_times_.data(), many_u_.data(),
+                                        many_out_.data(), many_ok_.get());
+  for (size_t k = 0; k < n; ++k) store(environment_lanes_[k], many_ok_[k], many_out_[k]);
 }
 
 void SurfaceStage::shadow(size_t i, ShadowQuery* q) const {

@@ -19,6 +19,7 @@
 // is sampled lane by lane by its own Light::sample, the rest of the step in the lanes.
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "renderer/render/light_kernels.h"
@@ -131,6 +132,14 @@ class SurfaceStage {
   std::vector<int32_t> light_, light_ok_, l_delta_;
   std::vector<float> l_wi_[3], l_distance_, l_pdf_, l_p_[3], l_error_[3], l_n_[3], l_value_[3], l_pmf_;
   std::vector<uint32_t> own_code_lanes_;  // lanes whose light is StagedLights::kOwnCode
+  // Those of them whose light is the environment, and their requests and samples for its
+  // Light::sample_many.
+  std::vector<uint32_t> environment_lanes_;
+  std::vector<vec3> many_refs_;
+  std::vector<float> many_times_;
+  std::vector<vec2> many_u_;
+  std::vector<LightSample> many_out_;
+  std::unique_ptr<bool[]> many_ok_;
   // The lanes whose looked-up parameters leave the model (a textured hit's may), and the
   // normal-mapped lanes: their mask (set in compute, only when there are any: the kernels'
   // mapped case then costs the other batches nothing), tangent frames' s and t, mapped normals.

@@ -110,12 +110,16 @@ Distribution2D::Distribution2D(std::span<const float> weights, int nu, int nv)
     }
 }
 
-vec2 Distribution2D::sample(const vec2& u, float* pdf, glm::ivec2* cell) const {
-  int row = 0, col = 0;
-  const float v = marginal_.sample(u.y, nullptr, &row);
+float Distribution2D::sample_column(int row, float u, int* column) const {
   const CdfSearch conditional{cdf_.data() + size_t(row) * size_t(nu_ + 1),
                               guide_.data() + size_t(row) * (buckets_ + 1), size_t(nu_), buckets_};
-  const float x = conditional.sample(u.x, &col);
+  return conditional.sample(u, column);
+}
+
+vec2 Distribution2D::sample(const vec2& u, float* pdf, glm::ivec2* cell) const {
+  int row = 0, col = 0;
+  const float v = sample_row(u.y, &row);
+  const float x = sample_column(row, u.x, &col);
   if (pdf) *pdf = cell_pdf(col, row);
   if (cell) *cell = glm::ivec2(col, row);
   return vec2(x, v);

@@ -85,6 +85,10 @@ class Distribution2D {
   // A point of [0, 1)^2 with density *pdf (0 when the distribution is all zero); *cell (if
   // given) receives the cell it lies in, as (column, row).
   vec2 sample(const vec2& u, float* pdf, glm::ivec2* cell = nullptr) const;
+  // sample() in its two steps: v (with its row) from u.y, then x (with its column) within that
+  // row from u.x; the point (x, v) lies in cell (column, row).
+  float sample_row(float u, int* row) const { return marginal_.sample(u, nullptr, row); }
+  float sample_column(int row, float u, int* column) const;
   // Density at p in [0, 1]^2.
   float pdf(const vec2& p) const;
   // Density of cell (i, j), constant over it.

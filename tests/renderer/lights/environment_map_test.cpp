@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <glm/gtc/matrix_transform.hpp>
+#include <memory>
+#include <vector>
 
 #include "renderer/lights/environment_light.h"
 #include "renderer/lights/environment_map.h"
@@ -186,6 +188,50 @@ TEST(EnvironmentMap, RadianceAndPdfAreRadianceAndPdfToTheBit) {
       ASSERT_EQ(pdf, map.pdf(dir));
       const Spectrum alone = light.radiance_and_pdf(dir, nullptr);
       for (int c = 0; c < 3; ++c) ASSERT_EQ(alone[c], expected[c]);
+    }
+  }
+}
+
+// sample_many runs sample()'s chain in stages over many requests: each result must be the one
+// sample() gives for that request, to the bit, failures included (a map with black regions), for
+// any count (chunk boundaries), with uniform sampling and for a black map.
+TEST(EnvironmentMap, SampleManyIsSampleToTheBit) {
+  auto sky = sky_with_sun(32, 17);
+  sky.to_world = rotation(70.f, glm::normalize(vec3(0.3f, 1, -0.2f)));
+  auto patchy = make_map(24, 9, [](int x, int y) { return (x / 4 + y) % 3 == 0 ? 0.f : 1.f + x; });
+  auto uniform = sky;
+  uniform.uniform_sampling = true;
+  EnvironmentMapDesc black = make_map(8, 4, [](int, int) { return 0.f; });
+  Rng rng(17);
+  for (const EnvironmentMapDesc* desc : {&sky, &patchy, &uniform, &black}) {
+    const EnvironmentMap map(*desc);
+    for (const size_t n : {size_t(1), size_t(63), size_t(64), size_t(65), size_t(300)}) {
+      std::vector<vec3> refs(n, vec3(0.5f, -1.f, 2.f));
+      std::vector<float> times(n, 0.25f);
+      std::vector<vec2> u(n);
+      for (vec2& x : u) x = rng.next2();
+      u[0] = vec2(0.f);  // the distributions' ends
+      if (n > 1) u[n - 1] = vec2(kOneMinusEpsilon);
+      std::vector<LightSample> out(n);
+      std::unique_ptr<bool[]> ok = std::make_unique<bool[]>(n);
+      map.sample_many(n, refs.data(), times.data(), u.data(), out.data(), ok.get());
+      int failures = 0;
+      for (size_t k = 0; k < n; ++k) {
+        LightSample one;
+        const bool expected = map.sample(refs[k], times[k], u[k], &one);
+        ASSERT_EQ(ok[k], expected) << k;
+        if (!expected) {
+          ++failures;
+          continue;
+        }
+        ASSERT_EQ(out[k].pdf, one.pdf);
+        ASSERT_EQ(out[k].distance, one.distance);
+        for (int c = 0; c < 3; ++c) {
+          ASSERT_EQ(out[k].wi[c], one.wi[c]);
+          ASSERT_EQ(out[k].value[c], one.value[c]);
+        }
+      }
+      if (desc == &black) EXPECT_EQ(failures, int(n));
     }
   }
 }
