@@ -1,6 +1,9 @@
 #pragma once
 // Light arriving from infinitely far away in every direction: what a ray that leaves the scene
 // sees. Rays that escape ask radiance(); next-event estimation samples it.
+#include <cstddef>
+#include <cstdint>
+
 #include "renderer/lights/light.h"
 
 namespace penumbra {
@@ -16,6 +19,17 @@ class EnvironmentLight : public Light {
   virtual Spectrum radiance_and_pdf(const vec3& dir, float* pdf) const {
     if (pdf) *pdf = this->pdf(dir);
     return radiance(dir);
+  }
+  // radiance_and_pdf for n directions at once: radiance[k] always, pdf[k] where want_pdf[k] (else
+  // left alone); the same values to the bit. A map splits it in stages over all n, so the
+  // texel loads of different directions overlap.
+  // Whether radiance_and_pdf_many beats one call per direction: a driver that would have to
+  // queue the directions first asks for many only then (a constant environment answers in a few
+  // instructions, less than the queueing costs).
+  virtual bool prefers_many() const { return false; }
+  virtual void radiance_and_pdf_many(size_t n, const vec3* dirs, const uint8_t* want_pdf,
+                                     Spectrum* radiance, float* pdf) const {
+    for (size_t k = 0; k < n; ++k) radiance[k] = radiance_and_pdf(dirs[k], want_pdf[k] ? &pdf[k] : nullptr);
   }
 };
 

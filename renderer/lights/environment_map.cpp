@@ -225,6 +225,24 @@ Spectrum EnvironmentMap::radiance_and_pdf(const vec3& dir, float* pdf) const {
   return lookup(uv);
 }
 
+void EnvironmentMap::radiance_and_pdf_many(size_t n, const vec3* dirs, const uint8_t* want_pdf,
+                                           Spectrum* radiance, float* pdf) const {
+  constexpr size_t kChunk = 64;
+  for (size_t k0 = 0; k0 < n; k0 += kChunk) {
+    const size_t m = std::min(kChunk, n - k0);
+    vec3 d[kChunk];
+    vec2 uv[kChunk];
+    for (size_t k = 0; k < m; ++k) {
+      d[k] = to_local_ * dirs[k0 + k];
+      uv[k] = direction_to_uv(d[k]);
+    }
+    for (size_t k = 0; k < m; ++k) {
+      if (want_pdf[k0 + k]) pdf[k0 + k] = pdf_local(d[k], uv[k]);
+      radiance[k0 + k] = lookup(uv[k]);
+    }
+  }
+}
+
 float EnvironmentMap::pdf_local(const vec3& d, const vec2& uv) const {
   if (is_black()) return 0.f;
   if (uniform_sampling_) return uniform_sphere_pdf();

@@ -34,6 +34,10 @@ class EnvironmentMap final : public EnvironmentLight {
   Spectrum radiance(const vec3& dir) const override;
   float pdf(const vec3& dir) const override;
   Spectrum radiance_and_pdf(const vec3& dir, float* pdf) const override;
+  bool prefers_many() const override { return true; }
+  // In two stages: every direction's lat-long coordinates, then every texel lookup and density.
+  void radiance_and_pdf_many(size_t n, const vec3* dirs, const uint8_t* want_pdf, Spectrum* radiance,
+                             float* pdf) const override;
 
   // Integral of the (scaled) luminance over the sphere of directions; 4 pi L for a constant map.
   double luminance_integral() const { return integral_; }

@@ -156,6 +156,17 @@ template <bool kDistributed>
   else return scene.mis_light_sampler();
 }
 
+// What an escaped path gathers from the environment's answer for its ray: `radiance`, and
+// `pdf` (asked for only when the last bounce was not a delta) for the MIS weight.
+template <bool kDistributed>
+[[gnu::always_inline]] inline void path_gather_environment(const Scene& scene, PathState& s,
+                                                           const Spectrum& radiance, float pdf) {
+  const LightSampler& lights = next_event_lights<kDistributed>(scene);
+  const float w =
+      s.prev_delta ? 1.f : power_heuristic(s.prev_pdf, lights.pmf(scene.environment_light()) * pdf);
+  s.radiance += s.beta * radiance * w;
+}
+
 // The path's ray escaped the scene: the environment's radiance, weighted by MIS against light
 // sampling (weight 1 where the integrator leaves the environment to BSDF sampling: its pmf is
 // 0). The path ends.
@@ -165,12 +176,9 @@ inline void path_escaped(const Scene& scene, PathState& s, FirstHit* first) {
   if (first && s.depth == 1) path_step_detail::record_miss(environment, s.ray, first);
   if constexpr ((kFeatures & kFeatureEnvironment) != 0) {
     if (!environment) return;
-    const LightSampler& lights = next_event_lights<kDistributed>(scene);
     float pdf = 0.f;
     const Spectrum radiance = environment->radiance_and_pdf(s.ray.direction, s.prev_delta ? nullptr : &pdf);
-    const float w =
-        s.prev_delta ? 1.f : power_heuristic(s.prev_pdf, lights.pmf(scene.environment_light()) * pdf);
-    s.radiance += s.beta * radiance * w;
+    path_gather_environment<kDistributed>(scene, s, radiance, pdf);
   }
 }
 

@@ -90,12 +90,21 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
     std::vector<uint32_t>& hit_of = b.hit_of_;
     hit_of.resize(live.size());
     size_t hit_index = 0;
+    const EnvironmentLight* environment = scene.environment();
+    const bool escapes_together = environment && environment->prefers_many();
+    b.escaped_.clear();
     for (size_t k = 0; k < live.size(); ++k) {
       const uint32_t p = live[k];
       PathState& s = b.states_[p];
       FirstHit* first = b.record_first_hits_ ? &b.firsts_[p] : nullptr;
       if (!b.found_[k]) {
-        path_escaped<kDistributed, kFeatures>(scene, s, first);
+        if ((kFeatures & kFeatureEnvironment) != 0 && escapes_together) {
+          // path_escaped for all of them at once below, where the environment answers together.
+          if (first && s.depth == 1) path_step_detail::record_miss(environment, s.ray, first);
+          b.escaped_.push_back(p);
+        } else {
+          path_escaped<kDistributed, kFeatures>(scene, s, first);
+        }
         continue;
       }
       const size_t j = hit_index++;
@@ -114,6 +123,22 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
                                                      first, &b.shadows_[k], &shadow);
       has_shadow[k] = shadow;
       b.cursors_[p] = sampler.cursor();
+    }
+    if (const size_t n = b.escaped_.size()) {
+      b.escaped_dirs_.resize(n);
+      b.escaped_want_pdf_.resize(n);
+      b.escaped_radiance_.resize(n);
+      b.escaped_pdf_.assign(n, 0.f);
+      for (size_t e = 0; e < n; ++e) {
+        const PathState& s = b.states_[b.escaped_[e]];
+        b.escaped_dirs_[e] = s.ray.direction;
+        b.escaped_want_pdf_[e] = !s.prev_delta;
+      }
+      environment->radiance_and_pdf_many(n, b.escaped_dirs_.data(), b.escaped_want_pdf_.data(),
+                                         b.escaped_radiance_.data(), b.escaped_pdf_.data());
+      for (size_t e = 0; e < n; ++e)
+        path_gather_environment<kDistributed>(scene, b.states_[b.escaped_[e]], b.escaped_radiance_[e],
+                                              b.escaped_pdf_[e]);
     }
     for (auto& stage : b.stages_) {
       if (!kStages) break;

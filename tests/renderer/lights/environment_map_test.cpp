@@ -189,6 +189,23 @@ TEST(EnvironmentMap, RadianceAndPdfAreRadianceAndPdfToTheBit) {
       const Spectrum alone = light.radiance_and_pdf(dir, nullptr);
       for (int c = 0; c < 3; ++c) ASSERT_EQ(alone[c], expected[c]);
     }
+    // Many at once (across chunk boundaries), the pdf asked for by some: the same values, and
+    // no pdf written where none was asked for.
+    constexpr size_t n = 333;
+    std::vector<vec3> dirs(n);
+    std::vector<uint8_t> want(n);
+    for (size_t k = 0; k < n; ++k) {
+      dirs[k] = square_to_uniform_sphere(rng.next2());
+      want[k] = uint8_t(k % 3 != 1);
+    }
+    std::vector<Spectrum> radiance(n);
+    std::vector<float> pdf(n, -7.f);
+    light.radiance_and_pdf_many(n, dirs.data(), want.data(), radiance.data(), pdf.data());
+    for (size_t k = 0; k < n; ++k) {
+      const Spectrum expected = map.radiance(dirs[k]);
+      for (int c = 0; c < 3; ++c) ASSERT_EQ(radiance[k][c], expected[c]) << k;
+      ASSERT_EQ(pdf[k], want[k] ? map.pdf(dirs[k]) : -7.f) << k;
+    }
   }
 }
 
