@@ -228,11 +228,18 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
             auto flush = [&] {
               camera_stage.generate(batch);
               integrate_batch(scene, isettings, batch, counters);
-              for (size_t i = 0; i < batch.size(); ++i) {
+              // Each run of one pixel's samples at once (the batch holds them consecutively).
+              for (size_t i = 0; i < batch.size();) {
                 const uint32_t pi = batch_pixels[i];
+                size_t end = i + 1;
+                while (end < batch.size() && batch_pixels[end] == pi) ++end;
                 const int fx = int(pi % uint32_t(width)), fy = int(pi / uint32_t(width));
-                if (!film.add_sample(fx, fy, batch.radiance(i))) ++item_nonfinite;
-                if (first) layer_film->add_sample(fx, fy, batch.first_hit(i));
+                item_nonfinite += film.add_samples(fx, fy, end - i, [&](size_t k) -> const Spectrum& {
+                  return batch.radiance(i + k);
+                });
+                if (first)
+                  for (size_t k = i; k < end; ++k) layer_film->add_sample(fx, fy, batch.first_hit(k));
+                i = end;
               }
               item_samples += batch.size();
               batch.clear();
