@@ -171,10 +171,17 @@ void EnvironmentMap::sample_many(size_t n, const vec3* refs, const float* times,
     const size_t m = std::min(kChunk, n - k0);
     int row[kChunk], column[kChunk];
     float v[kChunk], x[kChunk];
+    CellPoint q[kChunk];
+    Corners c[kChunk];
+    float pdf_cell[kChunk];
     for (size_t k = 0; k < m; ++k) v[k] = distribution_.sample_row(u[k0 + k].y, &row[k]);
     for (size_t k = 0; k < m; ++k) x[k] = distribution_.sample_column(row[k], u[k0 + k].x, &column[k]);
-    for (size_t k = 0; k < m; ++k)
-      ok[k0 + k] = sample_in_cell(vec2(x[k], v[k]), distribution_.cell_pdf(column[k], row[k]), &out[k0 + k]);
+    for (size_t k = 0; k < m; ++k) {
+      pdf_cell[k] = distribution_.cell_pdf(column[k], row[k]);
+      q[k] = cell_point(vec2(x[k], v[k]));
+      c[k] = corners(q[k].x, q[k].y);
+    }
+    for (size_t k = 0; k < m; ++k) ok[k0 + k] = sample_in_cell(q[k], c[k], pdf_cell[k], &out[k0 + k]);
   }
 }
 
@@ -183,9 +190,14 @@ bool EnvironmentMap::sample_in_cell(const vec2& st, float pdf_cell, LightSample*
   // were drawn independently), which the bilinear warp then reshapes.
   if (!(pdf_cell > 0.f)) return false;
   const CellPoint q = cell_point(st);
+  return sample_in_cell(q, corners(q.x, q.y), pdf_cell, out);
+}
+
+bool EnvironmentMap::sample_in_cell(const CellPoint& q, Corners c, float pdf_cell,
+                                    LightSample* out) const {
+  if (!(pdf_cell > 0.f)) return false;
   // The warp depends only on the corners' ratios: scaled to at most 1, their squares cannot
   // overflow (texels up to 1e30 are allowed).
-  Corners c = corners(q.x, q.y);
   const float top = std::max(std::max(c.w00, c.w10), std::max(c.w01, c.w11));
   if (!(top > 0.f)) return false;
   const float inv = 1.f / top;

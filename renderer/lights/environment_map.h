@@ -54,6 +54,10 @@ class EnvironmentMap final : public EnvironmentLight {
   // sample() from the point st of the distribution's cell (density pdf_cell) on: the bilinear
   // warp within the cell, the direction, its radiance and density.
   bool sample_in_cell(const vec2& st, float pdf_cell, LightSample* out) const;
+  struct CellPoint;
+  struct Corners;
+  // The same from the point's place in its cell and the cell's corners.
+  bool sample_in_cell(const CellPoint& q, Corners c, float pdf_cell, LightSample* out) const;
   // pdf() of the map-space direction d whose lat-long coordinates are uv.
   float pdf_local(const vec3& d, const vec2& uv) const;
   // The distribution's cell holding st (cell coordinates, u from texel x's centre) and st's place
