@@ -20,13 +20,13 @@ class EnvironmentLight : public Light {
     if (pdf) *pdf = this->pdf(dir);
     return radiance(dir);
   }
-  // radiance_and_pdf for n directions at once: radiance[k] always, pdf[k] where want_pdf[k] (else
-  // left alone); the same values to the bit. A map splits it in stages over all n, so the
-  // texel loads of different directions overlap.
   // Whether radiance_and_pdf_many beats one call per direction: a driver that would have to
   // queue the directions first asks for many only then (a constant environment answers in a few
   // instructions, less than the queueing costs).
   virtual bool prefers_many() const { return false; }
+  // radiance_and_pdf for n directions at once: radiance[k] always, pdf[k] where want_pdf[k] (else
+  // left alone); the same values to the bit. A map splits it in stages over all n, so the
+  // texel loads of different directions overlap.
   virtual void radiance_and_pdf_many(size_t n, const vec3* dirs, const uint8_t* want_pdf,
                                      Spectrum* radiance, float* pdf) const {
     for (size_t k = 0; k < n; ++k) radiance[k] = radiance_and_pdf(dirs[k], want_pdf[k] ? &pdf[k] : nullptr);
