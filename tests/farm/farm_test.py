@@ -555,7 +555,10 @@ def tiles_by_worker(farm, job):
 def split_job(farm, kill_one=False):
     api = farm.start("api")
     workers = [farm.start("worker") for _ in range(3)]
-    s = big_scene()
+    # The kill needs a tile still rendering 0.3 s after it was seen running: at 2 spp a tile took
+    # ~0.4 s, so the kill could land after it had committed (no attempt expired; failed CI once
+    # the renderer got faster). At 32 spp a tile takes about two seconds.
+    s = big_scene(spp=32 if kill_one else 2)
     t0 = time.time()
     job = submit(api["base"], s)
     kinds = farm.psql("SELECT kind, count(*) FROM tasks WHERE job_id = '%s' GROUP BY kind" % job)
