@@ -68,18 +68,18 @@ class SurfaceStage {
   // deltas, as path_scatter decides; that also decides which sampler values are whose.)
 
   size_t size() const { return count_; }
+  // Hands the step's results, as path_scatter leaves them, to the driver's per-slot arrays:
+  // for lane i with slot k = slot(i) and path p = live[k], goes_on[k] and has_shadow[k], the
+  // shadow query in shadows[k] (written whether or not there is one: the slot is the lane's
+  // own), and, for a path that goes on, states[p] and cursors[p] (its ray, throughput, MIS
+  // record, eta, depth, and the sampler dimensions it took). Lanes whose looked-up parameters
+  // leave the model (a textured hit's may) get none of this: they are listed in *unstaged for
+  // the caller to take their step with path_scatter. Returns how many next-event rays the
+  // step counted.
+  uint64_t deliver(const uint32_t* live, PathState* states, Sampler::Cursor* cursors,
+                   uint8_t* goes_on, uint8_t* has_shadow, ShadowQuery* shadows,
+                   std::vector<uint32_t>* unstaged) const;
   uint32_t slot(size_t lane) const { return slot_[lane]; }
-  // False if the lane's looked-up parameters leave the model (a textured hit's may): the caller
-  // takes the step with path_scatter instead of the results below.
-  bool staged(size_t lane) const { return staged_[lane] != 0; }
-  // The step's results, as path_scatter leaves them: whether the path goes on (then `apply`
-  // updates its state and sampler cursor), whether it has a shadow query, and whether it
-  // counted a next-event ray.
-  bool alive(size_t lane) const { return alive_[lane] != 0; }
-  bool has_shadow(size_t lane) const { return has_shadow_[lane] != 0; }
-  bool counted_ray(size_t lane) const { return nee_ray_[lane] != 0; }
-  void shadow(size_t lane, ShadowQuery* out) const;
-  void apply(size_t lane, PathState& s, Sampler::Cursor& cursor) const;
 
  private:
   // Whether path_scatter estimates direct light at this model's surfaces (given lights): not

@@ -143,41 +143,36 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
     for (auto& stage : b.stages_) {
       if (!kStages) break;
       stage->compute(settings, next_event);
-      for (size_t lane = 0; lane < stage->size(); ++lane) {
+      std::vector<uint32_t>& unstaged = b.unstaged_;
+      unstaged.clear();
+      counters.rays += stage->deliver(live.data(), b.states_.data(), b.cursors_.data(),
+                                      goes_on.data(), has_shadow.data(), b.shadows_.data(),
+                                      &unstaged);
+      // Lanes whose parameters leave the model: the step one path at a time.
+      for (const uint32_t lane : unstaged) {
         const size_t k = stage->slot(lane);
         const uint32_t p = live[k];
-        PathState& s = b.states_[p];
-        if (!stage->staged(lane)) {  // its parameters leave the model: the step one path at a time
-          PrefetchedSampler sampler(*b.samplers_[p], b.cursors_[p], samples, hit_of[k]);
-          bool shadow;
-          goes_on[k] = path_scatter<kDistributed, kFeatures>(scene, settings, s, b.hits_[k],
-                                                             sampler, counters, &b.shadows_[k],
-                                                             &shadow);
-          has_shadow[k] = shadow;
-          b.cursors_[p] = sampler.cursor();
-          continue;
-        }
-        if (stage->counted_ray(lane)) ++counters.rays;
-        if (stage->has_shadow(lane)) {
-          has_shadow[k] = 1;
-          stage->shadow(lane, &b.shadows_[k]);
-        }
-        if (stage->alive(lane)) {
-          goes_on[k] = 1;
-          stage->apply(lane, s, b.cursors_[p]);
-        }
+        PrefetchedSampler sampler(*b.samplers_[p], b.cursors_[p], samples, hit_of[k]);
+        bool shadow;
+        goes_on[k] = path_scatter<kDistributed, kFeatures>(scene, settings, b.states_[p],
+                                                           b.hits_[k], sampler, counters,
+                                                           &b.shadows_[k], &shadow);
+        has_shadow[k] = shadow;
+        b.cursors_[p] = sampler.cursor();
       }
     }
     // The shadow queries stay in their slots (copying 44-byte queries into a compact array
-    // stalled on store forwarding); their slots and paths are listed in path order.
+    // stalled on store forwarding); their slots and paths are listed in path order. Written
+    // whatever the flags, the next entry's place advanced by them: the flags are random and
+    // branches on them mispredicted.
     size_t survivors = 0, shadows = 0;
     for (size_t k = 0; k < live.size(); ++k) {
       const uint32_t p = live[k];
-      if (has_shadow[k]) {
-        b.shadow_slots_[shadows] = uint32_t(k);
-        b.shadow_paths_[shadows++] = p;
-      }
-      if (goes_on[k]) live[survivors++] = p;  // survivors <= k: reads stay ahead of writes
+      b.shadow_slots_[shadows] = uint32_t(k);
+      b.shadow_paths_[shadows] = p;
+      shadows += has_shadow[k];
+      live[survivors] = p;  // survivors <= k: reads stay ahead of writes
+      survivors += goes_on[k];
     }
     live.resize(survivors);
 
