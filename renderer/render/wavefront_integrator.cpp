@@ -20,6 +20,8 @@ PathBatch::PathBatch(size_t capacity, bool record_first_hits)
   shadows_.resize(capacity_);
   shadow_paths_.resize(capacity_);
   shadow_slots_.resize(capacity_);
+  hit_slots_.resize(capacity_);
+  miss_slots_.resize(capacity_);
 }
 
 void PathBatch::clear() {
@@ -64,15 +66,29 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
       for (int i = 0; i < count; ++i) b.found_[k + i] = found[i];
     }
     counters.rays += live.size();
+    // The slots whose ray hit something, in order (hit j is slot hit_slots[j]), and those whose
+    // ray escaped: written whatever the flag, the place advanced by it (whether a ray hits is
+    // random, and branches on it mispredicted in every loop that tested it).
+    std::vector<uint32_t>& hit_slots = b.hit_slots_;
+    std::vector<uint32_t>& miss_slots = b.miss_slots_;
+    size_t hit_count = 0, miss_count = 0;
+    for (size_t k = 0; k < live.size(); ++k) {
+      hit_slots[hit_count] = uint32_t(k);
+      miss_slots[miss_count] = uint32_t(k);
+      hit_count += b.found_[k];
+      miss_count += 1 - b.found_[k];
+    }
 
     // The sampler values the paths that hit something will take, for all of them at once (no
     // light choice and light point where the integrator samples no light).
     const bool next_event =
         (kFeatures & kFeatureLights) != 0 && !next_event_lights<kDistributed>(scene).empty();
     BounceSamples& samples = b.samples_;
-    samples.start(live.size(), next_event ? BounceSamples::kBounce : BounceSamples::kBounceWithoutLight);
-    for (size_t k = 0; k < live.size(); ++k)
-      if (b.found_[k]) samples.add(*b.samplers_[live[k]], b.cursors_[live[k]]);
+    samples.start(hit_count, next_event ? BounceSamples::kBounce : BounceSamples::kBounceWithoutLight);
+    for (size_t j = 0; j < hit_count; ++j) {
+      const uint32_t p = live[hit_slots[j]];
+      samples.add(*b.samplers_[p], b.cursors_[p]);
+    }
     samples.compute();
 
     // Shade: every live path takes its step. Paths on plain Lambertian surfaces, rough
@@ -89,25 +105,26 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
     has_shadow.assign(live.size(), 0);
     std::vector<uint32_t>& hit_of = b.hit_of_;
     hit_of.resize(live.size());
-    size_t hit_index = 0;
     const EnvironmentLight* environment = scene.environment();
     const bool escapes_together = environment && environment->prefers_many();
     b.escaped_.clear();
-    for (size_t k = 0; k < live.size(); ++k) {
+    for (size_t m = 0; m < miss_count; ++m) {
+      const uint32_t p = live[miss_slots[m]];
+      PathState& s = b.states_[p];
+      FirstHit* first = b.record_first_hits_ ? &b.firsts_[p] : nullptr;
+      if ((kFeatures & kFeatureEnvironment) != 0 && escapes_together) {
+        // path_escaped for all of them at once below, where the environment answers together.
+        if (first && s.depth == 1) path_step_detail::record_miss(environment, s.ray, first);
+        b.escaped_.push_back(p);
+      } else {
+        path_escaped<kDistributed, kFeatures>(scene, s, first);
+      }
+    }
+    for (size_t j = 0; j < hit_count; ++j) {
+      const size_t k = hit_slots[j];
       const uint32_t p = live[k];
       PathState& s = b.states_[p];
       FirstHit* first = b.record_first_hits_ ? &b.firsts_[p] : nullptr;
-      if (!b.found_[k]) {
-        if ((kFeatures & kFeatureEnvironment) != 0 && escapes_together) {
-          // path_escaped for all of them at once below, where the environment answers together.
-          if (first && s.depth == 1) path_step_detail::record_miss(environment, s.ray, first);
-          b.escaped_.push_back(p);
-        } else {
-          path_escaped<kDistributed, kFeatures>(scene, s, first);
-        }
-        continue;
-      }
-      const size_t j = hit_index++;
       hit_of[k] = uint32_t(j);
       SurfaceHit& hit = b.hits_[k];
       const int stage = kStages ? b.stage_of_[hit.object] : -1;

@@ -62,6 +62,7 @@ class PathBatch {
   std::vector<int8_t> stage_of_;  // per object: its stage in stages_, or -1
   std::vector<uint8_t> goes_on_, has_shadow_;  // per live path of the bounce
   std::vector<uint32_t> hit_of_;               // per live path: its index among the hits
+  std::vector<uint32_t> hit_slots_, miss_slots_;  // the live paths' slots with a hit, without
   std::vector<uint32_t> unstaged_;  // a stage's lanes whose parameters leave its model
   // The bounce's escaped paths that ask the environment, their directions, whether each wants
   // the pdf, and the answers (EnvironmentLight::radiance_and_pdf_many).
