@@ -53,6 +53,7 @@ struct Material::Impl {
   std::unique_ptr<ImageFloatTexture> roughness;
   std::unique_ptr<ImageFloatTexture> metallic;
   std::unique_ptr<ImageSpectrumTexture> normal_map;  // linear RGB = (n + 1) / 2
+  float normal_scale = 1.f;
   std::unique_ptr<CoatingTableCache> own_coatings;
   std::unique_ptr<TextureImageCache> own_images;
 };
@@ -94,15 +95,36 @@ Material::Material(const MaterialParams& params, CoatingTableCache* coatings,
         }
       },
       params);
-  varies_ = m.color || m.roughness || m.metallic || m.normal_map;
+  parameters_vary_ = m.color || m.roughness || m.metallic;
+  varies_ = parameters_vary_ || m.normal_map;
+  // glTF's normalTexture.scale multiplies x and y before normalising (glTF 2.0 section 3.9.3);
+  // 1 for the other materials.
+  m.normal_scale = std::visit(
+      [](const auto& p) {
+        if constexpr (requires { p.normal_scale; }) return p.normal_scale;
+        else return 1.f;
+      },
+      params);
 }
 
 Material::~Material() = default;
 Material::Material(Material&&) noexcept = default;
 Material& Material::operator=(Material&&) noexcept = default;
 
+vec3 Material::mapped_normal_at(const TextureQuery& q) const {
+  const float s = impl_->normal_scale;
+  return (2.f * impl_->normal_map->eval(q) - vec3(1.f)) * vec3(s, s, 1.f);
+}
+
 SurfaceBsdf Material::bsdf_at(const TextureQuery& q) const {
   const Impl& m = *impl_;
+  if (!parameters_vary_) {
+    // The BSDF built once (every model's constructor from its params is the one below with the
+    // factors alone), with the map's normal.
+    SurfaceBsdf b = *m.bsdf;
+    if (m.normal_map) b.set_mapped_normal(mapped_normal_at(q));
+    return b;
+  }
   auto color = [&](const Spectrum& factor) {
     return m.color ? factor * clamp01(m.color->eval(q)) : factor;
   };
@@ -126,17 +148,7 @@ SurfaceBsdf Material::bsdf_at(const TextureQuery& q) const {
           return SurfaceBsdf(std::get<PlasticBsdf>(m.bsdf->model()).with_color(color(p.color)));
       },
       m.params);
-  if (m.normal_map) {
-    // glTF's normalTexture.scale multiplies x and y before normalising (glTF 2.0 section 3.9.3);
-    // 1 for the other materials.
-    const float s = std::visit(
-        [](const auto& p) {
-          if constexpr (requires { p.normal_scale; }) return p.normal_scale;
-          else return 1.f;
-        },
-        m.params);
-    b.set_mapped_normal((2.f * m.normal_map->eval(q) - vec3(1.f)) * vec3(s, s, 1.f));
-  }
+  if (m.normal_map) b.set_mapped_normal(mapped_normal_at(q));
   return b;
 }
 

@@ -40,6 +40,12 @@ class Material {
   bool normal_mapped() const { return normal_mapped_; }
   // The BSDF at a surface point, its textures looked up there.
   SurfaceBsdf bsdf_at(const TextureQuery& q) const;
+  // Only the normal map varies (no parameter is textured): bsdf_at(q) is bsdf() with
+  // mapped_normal_at(q) set, so a caller that holds bsdf()'s parameters needs only that normal.
+  bool only_normal_varies() const { return varies_ && !parameters_vary_; }
+  // The normal map's normal at q as bsdf_at sets it (SurfaceBsdf::mapped_normal): 2 rgb - 1,
+  // its x and y times glTF's normal scale. Only where normal_mapped().
+  vec3 mapped_normal_at(const TextureQuery& q) const;
 
   // bsdf()'s answers (tests and untextured materials).
   Spectrum eval(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;
@@ -64,6 +70,7 @@ class Material {
   std::unique_ptr<Impl> impl_;
   const SurfaceBsdf* bsdf_ = nullptr;  // inside impl_ (heap), so moves keep it valid
   bool varies_ = false;
+  bool parameters_vary_ = false;  // some parameter (not the normal) is textured
   bool normal_mapped_ = false;
   uint32_t lobes_ = 0;
 };

@@ -525,20 +525,29 @@ void SurfaceStage::write_params(size_t i, const SurfaceParams& q) {
 void SurfaceStage::add_textured(size_t i, const PathState& s, const SurfaceHit& hit) {
   // path_scatter's lookup, at the same point: the same parameters to the bit.
   const Material& m = scene_.material(scene_.object(hit.object).material);
-  SurfaceParams q = params_[size_t(params_of_[hit.object])];
-  const SurfaceBsdf b = m.bsdf_at(TextureQuery{hit.p, hit.uv, s.ray.time});
-  if (!fill_params(b, &q)) unfit_.push_back(uint32_t(i));
-  write_params(i, q);
-  if (b.normal_mapped()) {
-    // path_scatter's frame for a normal map, along dp/du (its n is the hit's ns).
-    SurfaceHit h = hit;
-    const Frame f = path_step_detail::tangent_frame(scene_, s.ray.time, &h);
-    mapped_lanes_.push_back(uint32_t(i));
-    for (int c = 0; c < 3; ++c) {
-      frame_s_[c][i] = f.s[c];
-      frame_t_[c][i] = f.t[c];
-      mapped_n_[c][i] = b.mapped_normal()[c];
-    }
+  const TextureQuery query{hit.p, hit.uv, s.ray.time};
+  vec3 mapped_normal;
+  if (m.only_normal_varies()) {
+    // bsdf_at is bsdf() with the map's normal: the object's parameters, and the normal alone
+    // looked up (no BSDF built and taken apart per hit).
+    write_params(i, params_[size_t(params_of_[hit.object])]);
+    mapped_normal = m.mapped_normal_at(query);
+  } else {
+    SurfaceParams q = params_[size_t(params_of_[hit.object])];
+    const SurfaceBsdf b = m.bsdf_at(query);
+    if (!fill_params(b, &q)) unfit_.push_back(uint32_t(i));
+    write_params(i, q);
+    if (!b.normal_mapped()) return;
+    mapped_normal = b.mapped_normal();
+  }
+  // path_scatter's frame for a normal map, along dp/du (its n is the hit's ns).
+  SurfaceHit h = hit;
+  const Frame f = path_step_detail::tangent_frame(scene_, s.ray.time, &h);
+  mapped_lanes_.push_back(uint32_t(i));
+  for (int c = 0; c < 3; ++c) {
+    frame_s_[c][i] = f.s[c];
+    frame_t_[c][i] = f.t[c];
+    mapped_n_[c][i] = mapped_normal[c];
   }
 }
 

@@ -126,6 +126,60 @@ TEST(TexturedMaterial, NormalMapFileGivesTheDecodedNormal) {
             m.bsdf().eval(BsdfContext{}, kWi, kWo));
 }
 
+// A material whose only texture is its normal map is its constant BSDF with the map's normal
+// (bsdf_at's shortcut, and the surface stages take only that normal): the same BSDF to the bit
+// as the general lookup gives once some parameter is textured by an image of ones.
+TEST(TexturedMaterial, NormalMapAloneIsTheConstantBsdfWithTheMapsNormal) {
+  TempFolder dir("textured_normal_only");
+  const vec3 n = glm::normalize(vec3(0.3f, -0.2f, 0.9f));
+  const ImageTextureDesc map = two_texels(dir, "n.exr", 0.5f * (n + vec3(1.f)), Spectrum(0.5f, 0.4f, 1.f));
+  const ImageTextureDesc ones = two_texels(dir, "one.exr", Spectrum(1.f), Spectrum(1.f));
+  DiffuseParams diffuse{Spectrum(0.8f, 0.6f, 0.4f)};
+  ConductorParams conductor{Spectrum(0.9f, 0.8f, 0.7f), 0.35f};
+  PlasticParams plastic{Spectrum(0.5f, 0.3f, 0.2f), 1.5f, 0.3f};
+  DielectricParams dielectric{1.5f, 0.4f};
+  MetallicRoughnessParams gltf{Spectrum(0.7f, 0.6f, 0.3f), 0.4f, 0.5f};
+  gltf.normal_scale = 0.6f;
+  std::vector<std::pair<MaterialParams, MaterialParams>> cases;  // normal map alone, and with ones
+  auto add = [&](auto p, auto with_ones) {
+    p.normal_map = map;
+    auto q = p;
+    with_ones(q);
+    cases.emplace_back(p, q);
+  };
+  add(diffuse, [&](auto& q) { q.color_texture = ones; });
+  add(conductor, [&](auto& q) { q.roughness_texture = ones; });
+  add(plastic, [&](auto& q) { q.color_texture = ones; });
+  add(dielectric, [&](auto& q) { q.roughness_texture = ones; });
+  add(gltf, [&](auto& q) { q.metallic_texture = ones; });
+  CoatingTableCache coatings;
+  for (const auto& [alone, general] : cases) {
+    const Material a(alone, &coatings), g(general, &coatings);
+    EXPECT_TRUE(a.only_normal_varies());
+    EXPECT_FALSE(g.only_normal_varies());
+    for (const float u : {0.25f, 0.75f}) {
+      const SurfaceBsdf x = a.bsdf_at(at(u, 0.5f)), y = g.bsdf_at(at(u, 0.5f));
+      EXPECT_EQ(x.mapped_normal(), y.mapped_normal());
+      EXPECT_EQ(x.mapped_normal(), a.mapped_normal_at(at(u, 0.5f)));
+      EXPECT_EQ(x.lobes(), y.lobes());
+      EXPECT_EQ(x.albedo(), y.albedo());
+      for (const vec3& wo : {kWo, vec3(kWo.x, kWo.y, -kWo.z)}) {
+        EXPECT_EQ(x.eval(BsdfContext{}, kWi, wo), y.eval(BsdfContext{}, kWi, wo));
+        EXPECT_EQ(x.pdf(BsdfContext{}, kWi, wo), y.pdf(BsdfContext{}, kWi, wo));
+      }
+      for (const float u_lobe : {0.1f, 0.6f, 0.95f}) {
+        const auto sx = x.sample(BsdfContext{}, kWi, u_lobe, vec2(0.3f, 0.7f));
+        const auto sy = y.sample(BsdfContext{}, kWi, u_lobe, vec2(0.3f, 0.7f));
+        ASSERT_EQ(sx.has_value(), sy.has_value());
+        if (!sx) continue;
+        EXPECT_EQ(sx->wo, sy->wo);
+        EXPECT_EQ(sx->weight, sy->weight);
+        EXPECT_EQ(sx->pdf, sy->pdf);
+      }
+    }
+  }
+}
+
 TEST(TexturedMaterial, MissingImageThrowsNamingTheFile) {
   DiffuseParams p;
   p.color_texture = ImageTextureDesc{"/nonexistent/albedo.png"};
