@@ -167,13 +167,19 @@ template <bool kDistributed>
   s.radiance += s.beta * radiance * w;
 }
 
+// The output layers' record of a camera ray that escaped: path_escaped's first part (a driver
+// that asks the environment for many paths at once takes it one path at a time).
+inline void path_escape_record(const Scene& scene, const PathState& s, FirstHit* first) {
+  if (first && s.depth == 1) path_step_detail::record_miss(scene.environment(), s.ray, first);
+}
+
 // The path's ray escaped the scene: the environment's radiance, weighted by MIS against light
 // sampling (weight 1 where the integrator leaves the environment to BSDF sampling: its pmf is
 // 0). The path ends.
 template <bool kDistributed, uint32_t kFeatures>
 inline void path_escaped(const Scene& scene, PathState& s, FirstHit* first) {
   const EnvironmentLight* environment = scene.environment();
-  if (first && s.depth == 1) path_step_detail::record_miss(environment, s.ray, first);
+  path_escape_record(scene, s, first);
   if constexpr ((kFeatures & kFeatureEnvironment) != 0) {
     if (!environment) return;
     float pdf = 0.f;

@@ -114,7 +114,7 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
       FirstHit* first = b.record_first_hits_ ? &b.firsts_[p] : nullptr;
       if ((kFeatures & kFeatureEnvironment) != 0 && escapes_together) {
         // path_escaped for all of them at once below, where the environment answers together.
-        if (first && s.depth == 1) path_step_detail::record_miss(environment, s.ray, first);
+        path_escape_record(scene, s, first);
         b.escaped_.push_back(p);
       } else {
         path_escaped<kDistributed, kFeatures>(scene, s, first);
