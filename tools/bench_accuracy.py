@@ -2,7 +2,8 @@
 """Run time against error: penumbra and Mitsuba 3 on the accuracy scenes.
 
     .venv-mitsuba/bin/python tools/bench_accuracy.py --penumbra build/app/penumbra \
-        [--spp 4,16,64,256] [--seeds 3] [--heavy-seeds 8] [--mitsuba llvm_ad_rgb,scalar_rgb] [--only cornell] \
+        [--spp 4,16,64,256] [--seeds 3] [--heavy-seeds 8] \
+        [--mitsuba llvm_ad_rgb,llvm_ad_rgb:ldsampler,llvm_ad_rgb:multijitter] [--only cornell] \
         [--adaptive 0.1,0.05,0.03] [--adaptive-cap 1024] \
         [--cycles /usr/bin/blender [--cycles-sphere-mesh 512] [--cycles-rough-glass] \
         [--cycles-reference-spp 4096]]
@@ -21,6 +22,13 @@ Mitsuba reference (and "penumbra adaptive": one point per render.noise_threshold
 A curve that has not reached penumbra's error by its last point is extended (spp doubled, or the
 adaptive threshold divided by sqrt 2; at most ``--extend`` points), so times are interpolated
 between measured points; a time that still had to be extrapolated is marked "~" in the table.
+
+The fastest Mitsuba is the fastest of its configurations: ``--mitsuba`` lists variants, each
+optionally with a sampler (``llvm_ad_rgb:multijitter``). Mitsuba's default ``independent``
+sampler is not its best: its stratified samplers (``multijitter``, ``ldsampler``) reach a given
+error 1.5-3x sooner on most scenes, as penumbra's Owen-scrambled Sobol sampler does, so a
+comparison against ``independent`` alone credits penumbra with its sampler (docs/accuracy.md,
+session 20).
 
 Seconds are comparable work on both sides: for penumbra the scene build plus the render as its
 summary line reports them (not process start or JSON parsing); for Mitsuba ``load_dict`` plus
@@ -161,19 +169,27 @@ def cycles_reference(blender: str, scene_path: str, spp: int, mi, sphere_mesh: i
 
 
 def run_mitsuba(variant: str, scene: dict, spp: int, seed: int, instants: int,
-                assets: str = ".") -> tuple[np.ndarray, float]:
-    """Render with Mitsuba in this process; returns the image and load + render seconds."""
+                assets: str = ".", sampler: str = "independent") -> tuple[np.ndarray, float]:
+    """Render with Mitsuba in this process (its ``sampler`` plugin); returns the image and
+    load + render seconds."""
     mi = p2m.import_mitsuba(variant)
     times = p2m.shutter_instants(scene, instants)
     per_instant = max(1, spp // len(times))
     total, seconds = None, 0.0
     for k, t in enumerate(times):
         start = time.perf_counter()
-        mscene = mi.load_dict(p2m.to_mitsuba(mi, scene, time=t, spp=per_instant, assets=assets))
+        mscene = mi.load_dict(p2m.to_mitsuba(mi, scene, time=t, spp=per_instant, assets=assets,
+                                                   sampler=sampler))
         img = np.asarray(mi.render(mscene, spp=per_instant, seed=seed * len(times) + k), dtype=np.float64)
         seconds += time.perf_counter() - start
         total = img if total is None else total + img
     return total / len(times), seconds
+
+
+def mitsuba_config(renderer: str) -> tuple[str, str]:
+    """(variant, sampler) of a renderer named 'mitsuba VARIANT [SAMPLER]'."""
+    parts = renderer.split()
+    return parts[1], parts[2] if len(parts) > 2 else "independent"
 
 
 def curve(rows: list[dict]) -> list[tuple[float, float]]:
@@ -296,8 +312,11 @@ def main(argv: list[str]) -> int:
     ap.add_argument("--heavy-seeds", type=int, default=8,
                     help="seeds for the firefly-dominated scenes (HEAVY_TAILED), whose mean relMSE "
                          "over a few seeds is decided by one render's outliers")
-    ap.add_argument("--mitsuba", default="llvm_ad_rgb,scalar_rgb",
-                    help="Mitsuba variants to measure, comma-separated ('' for none)")
+    ap.add_argument("--mitsuba", default="llvm_ad_rgb,llvm_ad_rgb:ldsampler,llvm_ad_rgb:multijitter",
+                    help="Mitsuba variants to measure, comma-separated ('' for none); VARIANT:SAMPLER "
+                         "renders with that Mitsuba sampler instead of 'independent' (e.g. "
+                         "llvm_ad_rgb:ldsampler, Mitsuba's low-discrepancy (0,2)-sequence), shown as "
+                         "'mitsuba VARIANT SAMPLER'")
     ap.add_argument("--instants", type=int, default=16, help="shutter instants for Mitsuba motion blur")
     ap.add_argument("--only", default="", help="comma-separated scene names (default: all)")
     ap.add_argument("--adaptive", default="0.1,0.05,0.03",
@@ -334,11 +353,11 @@ def main(argv: list[str]) -> int:
     scenes = [os.path.splitext(os.path.basename(p))[0] for p in sorted(glob.glob(os.path.join(ACCURACY, "scenes", "*.json")))]
     scenes = [s for s in scenes if not only or s in only]
     os.makedirs(args.out, exist_ok=True)
-    mi = p2m.import_mitsuba(variants[0] if variants else "scalar_rgb")
+    mi = p2m.import_mitsuba(variants[0].split(":")[0] if variants else "scalar_rgb")
 
     rows: list[dict] = []
     thresholds = [float(t) for t in args.adaptive.split(",") if t]
-    renderers = ["penumbra"] + (["penumbra adaptive"] if thresholds else []) + [f"mitsuba {v}" for v in variants]
+    renderers = ["penumbra"] + (["penumbra adaptive"] if thresholds else []) + [f"mitsuba {v.replace(':', ' ')}" for v in variants]
     if args.cycles:
         renderers.append("cycles")
     for scene_name in scenes:
@@ -386,17 +405,26 @@ def main(argv: list[str]) -> int:
             if renderer.startswith("penumbra"):
                 run_penumbra(args.penumbra, scene_path, ladder[0], 0, mi)
             else:
-                run_mitsuba(renderer.split()[1], scene, max(ladder[0], instants), 0, instants, assets)
+                variant, sampler = mitsuba_config(renderer)
+                run_mitsuba(variant, scene, max(ladder[0], instants), 0, instants, assets, sampler)
             def measure(spp: int, threshold: float) -> float:
                 """One point of the curve over all seeds; returns its mean relMSE."""
                 errs = []
+                if not renderer.startswith("penumbra") and mitsuba_config(renderer)[1] != "independent":
+                    # Mitsuba's other samplers compile the sample count into their kernels: a
+                    # discarded render per count keeps that compilation (0.3 s and more, paid
+                    # once per count thanks to Dr.Jit's kernel cache) out of the measured seeds.
+                    variant, sampler = mitsuba_config(renderer)
+                    run_mitsuba(variant, scene, max(spp, instants), 0, instants, assets, sampler)
                 for seed in range(seeds):
                     start = time.perf_counter()
                     if renderer.startswith("penumbra"):
                         image, seconds = run_penumbra(args.penumbra, scene_path, spp, seed, mi, threshold)
                         used_instants = 1
                     else:
-                        image, seconds = run_mitsuba(renderer.split()[1], scene, max(spp, instants), seed, instants, assets)
+                        variant, sampler = mitsuba_config(renderer)
+                        image, seconds = run_mitsuba(variant, scene, max(spp, instants), seed, instants, assets,
+                                                     sampler)
                         used_instants = instants
                     process = time.perf_counter() - start
                     used_spp = spp if renderer.startswith("penumbra") else max(spp, instants)

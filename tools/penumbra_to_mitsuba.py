@@ -581,8 +581,10 @@ def use_scene_folder(mi, scene_path: str) -> None:
     mi.file_resolver().prepend(os.path.dirname(os.path.abspath(scene_path)))
 
 
-def convert_sensor(mi, scene: dict, spp: int, width: int | None = None, height: int | None = None) -> dict:
-    """Camera, film (box filter, linear float RGB) and sampler."""
+def convert_sensor(mi, scene: dict, spp: int, width: int | None = None, height: int | None = None,
+                   sampler: str = "independent") -> dict:
+    """Camera, film (box filter, linear float RGB) and sampler (Mitsuba's ``independent`` by
+    default; the benchmark also measures its low-discrepancy ones, e.g. ``ldsampler``)."""
     cam = scene["camera"]
     render = scene.get("render", {})
     to_world = mi.ScalarTransform4f().look_at(
@@ -603,7 +605,7 @@ def convert_sensor(mi, scene: dict, spp: int, width: int | None = None, height: 
         "pixel_format": "rgb",
         "component_format": "float32",
     }
-    sensor["sampler"] = {"type": "independent", "sample_count": int(spp), "seed": int(render.get("seed", 0))}
+    sensor["sampler"] = {"type": sampler, "sample_count": int(spp), "seed": int(render.get("seed", 0))}
     return sensor
 
 
@@ -620,11 +622,12 @@ def convert_integrator(scene: dict) -> dict:
 
 
 def to_mitsuba(mi, scene: dict, time: float = 0.0, spp: int | None = None,
-               width: int | None = None, height: int | None = None, assets: str = ".") -> dict:
+               width: int | None = None, height: int | None = None, assets: str = ".",
+               sampler: str = "independent") -> dict:
     """The Mitsuba scene dictionary of a penumbra scene at instant ``time``.
 
     ``spp``, ``width`` and ``height`` override the scene's render settings; texture files are
-    relative to ``assets`` (the scene file's folder).
+    relative to ``assets`` (the scene file's folder); ``sampler`` is the Mitsuba sampler plugin.
     """
     if scene.get("version") != 1:
         raise ValueError("only penumbra scene format version 1 is supported")
@@ -632,7 +635,7 @@ def to_mitsuba(mi, scene: dict, time: float = 0.0, spp: int | None = None,
     out: dict[str, Any] = {
         "type": "scene",
         "integrator": convert_integrator(scene),
-        "sensor": convert_sensor(mi, scene, spp or render.get("spp", 64), width, height),
+        "sensor": convert_sensor(mi, scene, spp or render.get("spp", 64), width, height, sampler),
     }
     materials = scene.get("materials", {})
     textures = TextureBaker(mi, assets)
