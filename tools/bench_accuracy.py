@@ -170,20 +170,22 @@ def cycles_reference(blender: str, scene_path: str, spp: int, mi, sphere_mesh: i
 
 def run_mitsuba(variant: str, scene: dict, spp: int, seed: int, instants: int,
                 assets: str = ".", sampler: str = "independent") -> tuple[np.ndarray, float]:
-    """Render with Mitsuba in this process (its ``sampler`` plugin); returns the image and
-    load + render seconds."""
+    """Render with Mitsuba in this process (its ``sampler`` plugin); returns the image, load +
+    render seconds and the samples per pixel it took (its stratified samplers round the count:
+    ldsampler to a power of four, multijitter to a multiple of its grid)."""
     mi = p2m.import_mitsuba(variant)
     times = p2m.shutter_instants(scene, instants)
     per_instant = max(1, spp // len(times))
-    total, seconds = None, 0.0
+    total, seconds, taken = None, 0.0, 0
     for k, t in enumerate(times):
         start = time.perf_counter()
         mscene = mi.load_dict(p2m.to_mitsuba(mi, scene, time=t, spp=per_instant, assets=assets,
                                                    sampler=sampler))
         img = np.asarray(mi.render(mscene, spp=per_instant, seed=seed * len(times) + k), dtype=np.float64)
         seconds += time.perf_counter() - start
+        taken += int(mscene.sensors()[0].sampler().sample_count())
         total = img if total is None else total + img
-    return total / len(times), seconds
+    return total / len(times), seconds, taken
 
 
 def mitsuba_config(renderer: str) -> tuple[str, str]:
@@ -423,11 +425,12 @@ def main(argv: list[str]) -> int:
                         used_instants = 1
                     else:
                         variant, sampler = mitsuba_config(renderer)
-                        image, seconds = run_mitsuba(variant, scene, max(spp, instants), seed, instants, assets,
-                                                     sampler)
+                        image, seconds, used_spp = run_mitsuba(variant, scene, max(spp, instants), seed,
+                                                               instants, assets, sampler)
                         used_instants = instants
                     process = time.perf_counter() - start
-                    used_spp = spp if renderer.startswith("penumbra") else max(spp, instants)
+                    if renderer.startswith("penumbra"):
+                        used_spp = spp
                     row = {"scene": scene_name, "renderer": renderer, "spp": used_spp, "threshold": threshold,
                            "seed": seed, "seconds": seconds, "instants": used_instants, **errors(image, reference),
                            "process_seconds": process, "reference": "mitsuba"}
