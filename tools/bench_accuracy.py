@@ -26,7 +26,7 @@ between measured points; a time that still had to be extrapolated is marked "~" 
 The fastest Mitsuba is the fastest of its configurations: ``--mitsuba`` lists variants, each
 optionally with a sampler (``llvm_ad_rgb:multijitter``). Mitsuba's default ``independent``
 sampler is not its best: its stratified samplers (``multijitter``, ``ldsampler``) reach a given
-error 1.5-3x sooner on most scenes, as penumbra's Owen-scrambled Sobol sampler does, so a
+error 1.5-10x sooner than it, as penumbra's Owen-scrambled Sobol sampler does, so a
 comparison against ``independent`` alone credits penumbra with its sampler (docs/accuracy.md,
 session 20).
 
@@ -169,7 +169,7 @@ def cycles_reference(blender: str, scene_path: str, spp: int, mi, sphere_mesh: i
 
 
 def run_mitsuba(variant: str, scene: dict, spp: int, seed: int, instants: int,
-                assets: str = ".", sampler: str = "independent") -> tuple[np.ndarray, float]:
+                assets: str = ".", sampler: str = "independent") -> tuple[np.ndarray, float, int]:
     """Render with Mitsuba in this process (its ``sampler`` plugin); returns the image, load +
     render seconds and the samples per pixel it took (its stratified samplers round the count:
     ldsampler to a power of four, multijitter to a multiple of its grid)."""
