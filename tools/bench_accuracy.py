@@ -308,7 +308,7 @@ def write_report(rows: list[dict], scenes: list[str], renderers: list[str], out:
 
 def main(argv: list[str]) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--penumbra", required=True, help="the penumbra executable")
+    ap.add_argument("--penumbra", help="the penumbra executable (required unless --summarise)")
     ap.add_argument("--spp", default="4,16,64,256", help="sample-count ladder")
     ap.add_argument("--seeds", type=int, default=3)
     ap.add_argument("--heavy-seeds", type=int, default=8,
@@ -349,6 +349,8 @@ def main(argv: list[str]) -> int:
         write_report(rows, scenes, renderers, args.out)
         return 0
 
+    if not args.penumbra:
+        ap.error("--penumbra is required (unless --summarise)")
     ladder = [int(s) for s in args.spp.split(",")]
     variants = [v for v in args.mitsuba.split(",") if v]
     only = {s for s in args.only.split(",") if s}
