@@ -180,7 +180,7 @@ def run_mitsuba(variant: str, scene: dict, spp: int, seed: int, instants: int,
     for k, t in enumerate(times):
         start = time.perf_counter()
         mscene = mi.load_dict(p2m.to_mitsuba(mi, scene, time=t, spp=per_instant, assets=assets,
-                                                   sampler=sampler))
+                                             sampler=sampler))
         img = np.asarray(mi.render(mscene, spp=per_instant, seed=seed * len(times) + k), dtype=np.float64)
         seconds += time.perf_counter() - start
         taken += int(mscene.sensors()[0].sampler().sample_count())
@@ -406,33 +406,30 @@ def main(argv: list[str]) -> int:
             adaptive = renderer == "penumbra adaptive"
             # (spp, noise_threshold) of each point: the spp ladder, or the thresholds under a cap
             points = [(args.adaptive_cap, t) for t in thresholds] if adaptive else [(s, 0.0) for s in ladder]
-            if renderer.startswith("penumbra"):
+            is_penumbra = renderer.startswith("penumbra")
+            variant, sampler = ("", "") if is_penumbra else mitsuba_config(renderer)
+            if is_penumbra:
                 run_penumbra(args.penumbra, scene_path, ladder[0], 0, mi)
             else:
-                variant, sampler = mitsuba_config(renderer)
                 run_mitsuba(variant, scene, max(ladder[0], instants), 0, instants, assets, sampler)
             def measure(spp: int, threshold: float) -> float:
                 """One point of the curve over all seeds; returns its mean relMSE."""
                 errs = []
-                if not renderer.startswith("penumbra") and mitsuba_config(renderer)[1] != "independent":
+                if not is_penumbra and sampler != "independent":
                     # Mitsuba's other samplers compile the sample count into their kernels: a
                     # discarded render per count keeps that compilation (0.3 s and more, paid
                     # once per count thanks to Dr.Jit's kernel cache) out of the measured seeds.
-                    variant, sampler = mitsuba_config(renderer)
                     run_mitsuba(variant, scene, max(spp, instants), 0, instants, assets, sampler)
                 for seed in range(seeds):
                     start = time.perf_counter()
-                    if renderer.startswith("penumbra"):
+                    if is_penumbra:
                         image, seconds = run_penumbra(args.penumbra, scene_path, spp, seed, mi, threshold)
-                        used_instants = 1
+                        used_spp, used_instants = spp, 1
                     else:
-                        variant, sampler = mitsuba_config(renderer)
                         image, seconds, used_spp = run_mitsuba(variant, scene, max(spp, instants), seed,
                                                                instants, assets, sampler)
                         used_instants = instants
                     process = time.perf_counter() - start
-                    if renderer.startswith("penumbra"):
-                        used_spp = spp
                     row = {"scene": scene_name, "renderer": renderer, "spp": used_spp, "threshold": threshold,
                            "seed": seed, "seconds": seconds, "instants": used_instants, **errors(image, reference),
                            "process_seconds": process, "reference": "mitsuba"}
