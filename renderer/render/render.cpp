@@ -72,11 +72,11 @@ std::vector<size_t> balanced_items(const PixelOrder& order, const std::vector<ui
   return starts;
 }
 
-// Sample counts of the progressive passes: 1, 1, 2, 4, 8, ... so a preview appears at once and
-// each pass doubles the samples; the last pass takes what remains.
-std::vector<int> make_passes(int spp) {
+// Sample counts of the passes: `first`, then `first` again and doubling (1, 1, 2, 4, 8, ... for
+// first = 1); the last pass takes what remains.
+std::vector<int> make_passes(int spp, int first) {
   std::vector<int> passes;
-  int done = 0, next = 1;
+  int done = 0, next = std::max(1, first);
   while (done < spp) {
     const int n = std::min(next, spp - done);
     passes.push_back(n);
@@ -84,6 +84,24 @@ std::vector<int> make_passes(int spp) {
     if (passes.size() > 1) next *= 2;
   }
   return passes;
+}
+
+// The first pass's samples per pixel. Passes exist for three things: a preview after each
+// (RenderControl::on_pass) and a time budget that ends the render with every pixel about
+// equally sampled -- both want a first pass of one sample, then doubling -- and adaptive
+// sampling, whose limits are decided between passes from min_samples on. A pass boundary costs:
+// each pass visits every pixel again, re-deriving its sampler's dimension seeds, and its batches
+// hold a few samples of many pixels instead of a run of one pixel's, and both threads wait for
+// the pass's last tile (a uniform render of the accuracy scenes at 64 spp, two threads: 0.85-0.90
+// of the time in one pass, docs/performance.md). So where nothing asks for a boundary the
+// passes start at the first one that is needed: all samples at once for uniform sampling,
+// min_samples for adaptive sampling, whose limits are then decided after the same sample
+// counts (16, 32, 64, ...) and so are the same. Per pixel the samples and their order in the
+// film are the same whatever the passes, so the image is the same bit for bit.
+int first_pass_samples(const RenderSettings& settings, const RenderControl& control,
+                       bool adaptive, int min_samples, int spp) {
+  if (control.on_pass || settings.time_limit > 0) return 1;
+  return adaptive ? std::min(min_samples, spp) : spp;
 }
 
 // Adaptive sampling: re-estimates every pixel's sample limit from the samples so far. With a
@@ -128,7 +146,6 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
     layer_film.emplace(width, height, film_outputs, camera.position(), camera.forward());
   const PixelOrder order = make_pixel_order(width, height, std::max(1, settings.tile_size));
   const int spp = std::max(1, settings.spp);
-  const std::vector<int> passes = make_passes(spp);
   // Per pixel: samples taken so far and the most it may take. Uniform sampling keeps every limit
   // at spp; adaptive sampling (render.noise_threshold) re-estimates the limits after each pass
   // from 16 samples on (renderer/adaptive_sampling.h). Sample indices stay consecutive per pixel
@@ -136,6 +153,8 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
   std::vector<uint32_t> limit(size_t(width) * height, uint32_t(spp)), taken(size_t(width) * height, 0);
   const bool adaptive = settings.noise_threshold > 0.f;
   const AdaptiveLimits adaptive_limits{settings.noise_threshold, 16, spp};
+  const std::vector<int> passes =
+      make_passes(spp, first_pass_samples(settings, control, adaptive, adaptive_limits.min_samples, spp));
 
   std::atomic<uint64_t> rays{0}, samples_done{0}, nonfinite{0};
   std::atomic<bool> stop{false}, timed_out{false}, cancelled{false};

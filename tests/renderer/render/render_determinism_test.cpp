@@ -2,6 +2,8 @@
 // thread count and tile size; a different seed gives a different image.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "tests/renderer/render/render_test_util.h"
 
 namespace penumbra::test {
@@ -38,6 +40,53 @@ TEST(RenderDeterminism, SameImageForAnyThreadCountAndTileSize) {
   const Image c = render(*scene, s).image;
   EXPECT_EQ(a.rgb, b.rgb);
   EXPECT_EQ(a.rgb, c.rgb);
+}
+
+// The passes a render makes: the largest RenderProgress::passes_done its progress reports saw
+// (reports come after every tile, so the last pass's tiles report the passes before it).
+struct PassCount {
+  int passes = 0;
+  RenderControl control() {
+    RenderControl c;
+    c.on_progress = [this](const RenderProgress& p) { passes = std::max(passes, p.passes_done + 1); };
+    return c;
+  }
+};
+
+// Passes are where previews, time budgets and adaptive limits need them, and nowhere else; the
+// image does not depend on them.
+TEST(RenderDeterminism, SameImageWhateverThePasses) {
+  const auto scene = Scene::build(busy_scene());
+  for (const float threshold : {0.f, 0.02f}) {
+    SCOPED_TRACE(threshold);
+    RenderSettings s = small_settings(40, 30, 40, 6);
+    s.seed = 7;
+    s.tile_size = 8;
+    s.noise_threshold = threshold;
+    // Nothing asks for a boundary: uniform sampling in one pass, adaptive sampling's first pass
+    // at its 16 samples, then 16 and 8 (to 40).
+    PassCount plain;
+    const RenderResult a = render(*scene, s, plain.control());
+    EXPECT_EQ(plain.passes, threshold > 0.f ? 3 : 1);
+    // A preview after each pass: 1, 1, 2, 4, 8, 16 and the 8 left.
+    PassCount previewed;
+    RenderControl c = previewed.control();
+    int previews = 0;
+    c.on_pass = [&](const Image&, const RenderProgress&) { ++previews; };
+    const RenderResult b = render(*scene, s, c);
+    EXPECT_EQ(previews, 7);
+    EXPECT_EQ(previewed.passes, 7);
+    // A time budget it does not reach: the same progressive passes.
+    s.time_limit = 1000.0;
+    PassCount budgeted;
+    const RenderResult d = render(*scene, s, budgeted.control());
+    EXPECT_EQ(budgeted.passes, 7);
+    EXPECT_EQ(a.image.rgb, b.image.rgb);
+    EXPECT_EQ(a.image.rgb, d.image.rgb);
+    EXPECT_EQ(a.stats.spp_mean, b.stats.spp_mean);
+    EXPECT_EQ(a.stats.spp_mean, d.stats.spp_mean);
+    if (threshold > 0.f) EXPECT_LT(a.stats.spp_min, a.stats.spp_max);  // adaptive did decide
+  }
 }
 
 TEST(RenderDeterminism, DifferentSeedGivesDifferentNoise) {
