@@ -1,6 +1,7 @@
 #include "renderer/render/render.h"
 
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
@@ -71,6 +72,22 @@ std::vector<size_t> balanced_items(const PixelOrder& order, const std::vector<ui
   starts.push_back(order.pixels.size());
   return starts;
 }
+
+// A render thread's wavefront driver state between work items: the batch (with the surface
+// stages it makes for the scene), the camera stage, and the batch's per-pixel samplers and pixel
+// indices (the samplers reserved to the batch's capacity: the camera stage keeps pointers to them).
+struct WavefrontScratch {
+  PathBatch batch;
+  CameraStage camera_stage;
+  std::vector<Sampler> samplers;
+  std::vector<uint32_t> batch_pixels;
+  WavefrontScratch(const ThinLensCamera& camera, bool sample_lens, bool sample_time, bool first_hits)
+      : batch(kWavefrontBatch, first_hits),
+        camera_stage(camera, sample_lens, sample_time, kWavefrontBatch) {
+    samplers.reserve(kWavefrontBatch);
+    batch_pixels.reserve(kWavefrontBatch);
+  }
+};
 
 // Sample counts of the passes: `first`, then `first` again and doubling (1, 1, 2, 4, 8, ... for
 // first = 1); the last pass takes what remains.
@@ -182,6 +199,12 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
   };
 
   tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
+  // Each render thread's wavefront scratch, made on its first work item and kept for the rest of
+  // the render's items and passes: its batch's surface stages are built once per thread instead
+  // of once per item (eight stage objects, each with its own copy of the scene's light and
+  // coating tables, and some eighty lane arrays).
+  tbb::enumerable_thread_specific<WavefrontScratch> scratch(camera, sample_lens, sample_time,
+                                                            layer_film.has_value());
   int first_sample = 0;
   int passes_done = 0;
   for (size_t pass = 0; pass < passes.size() && !stop.load(); ++pass) {
@@ -238,12 +261,11 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
             // Batches of the item's samples in that order, one sampler per pixel of a batch;
             // the film takes each batch's results in that order, as the scalar loop adds them.
             const size_t capacity = std::min(kWavefrontBatch, (items[item + 1] - items[item]) * size_t(s1 - s0));
-            PathBatch batch(capacity, first != nullptr);
-            CameraStage camera_stage(camera, sample_lens, sample_time, capacity);
-            std::vector<Sampler> samplers;
-            samplers.reserve(capacity);
-            std::vector<uint32_t> batch_pixels;
-            batch_pixels.reserve(capacity);
+            WavefrontScratch& local = scratch.local();
+            PathBatch& batch = local.batch;
+            CameraStage& camera_stage = local.camera_stage;
+            std::vector<Sampler>& samplers = local.samplers;
+            std::vector<uint32_t>& batch_pixels = local.batch_pixels;
             auto flush = [&] {
               camera_stage.generate(batch);
               integrate_batch(scene, isettings, batch, counters);
