@@ -109,8 +109,8 @@ std::vector<int> make_passes(int spp, int first) {
 // sampling, whose limits are decided between passes from min_samples on. A pass boundary costs:
 // each pass visits every pixel again, re-deriving its sampler's dimension seeds, and its batches
 // hold a few samples of many pixels instead of a run of one pixel's, and both threads wait for
-// the pass's last tile (a uniform render of the accuracy scenes at 64 spp, two threads: 0.85-0.90
-// of the time in one pass, docs/performance.md). So where nothing asks for a boundary the
+// the pass's last tile (uniform renders of the accuracy scenes in one pass, two threads: 0.80-0.99
+// of the time at 64 spp, 0.91-0.96 at 256; docs/performance.md, levers). So where nothing asks for a boundary the
 // passes start at the first one that is needed: all samples at once for uniform sampling,
 // min_samples for adaptive sampling, whose limits are then decided after the same sample
 // counts (16, 32, 64, ...) and so are the same. Per pixel the samples and their order in the
