@@ -109,16 +109,17 @@ std::vector<int> make_passes(int spp, int first) {
 // sampling, whose limits are decided between passes from min_samples on. A pass boundary costs:
 // each pass visits every pixel again, re-deriving its sampler's dimension seeds, and its batches
 // hold a few samples of many pixels instead of a run of one pixel's, and both threads wait for
-// the pass's last tile (uniform renders of the accuracy scenes in one pass, two threads: 0.80-0.99
-// of the time at 64 spp, 0.91-0.96 at 256; docs/performance.md, levers). So where nothing asks for a boundary the
-// passes start at the first one that is needed: all samples at once for uniform sampling,
-// min_samples for adaptive sampling, whose limits are then decided after the same sample
-// counts (16, 32, 64, ...) and so are the same. Per pixel the samples and their order in the
-// film are the same whatever the passes, so the image is the same bit for bit.
+// the pass's last tile (uniform renders of the accuracy scenes in one pass, two threads:
+// 0.80-0.99 of the time at 64 spp, 0.91-0.96 at 256; docs/performance.md, levers). So where
+// nothing asks for a boundary the passes start at the first one that is needed: all samples at
+// once for uniform sampling, min_samples for adaptive sampling, whose limits are then decided
+// after the same sample counts (16, 32, 64, ...) and so are the same. Per pixel the samples and
+// their order in the film are the same whatever the passes, so the image is the same bit for
+// bit. (make_passes cuts a first pass larger than spp to spp.)
 int first_pass_samples(const RenderSettings& settings, const RenderControl& control,
-                       bool adaptive, int min_samples, int spp) {
+                       bool adaptive, int min_samples) {
   if (control.on_pass || settings.time_limit > 0) return 1;
-  return adaptive ? std::min(min_samples, spp) : spp;
+  return adaptive ? min_samples : settings.spp;
 }
 
 // Adaptive sampling: re-estimates every pixel's sample limit from the samples so far. With a
@@ -171,7 +172,7 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
   const bool adaptive = settings.noise_threshold > 0.f;
   const AdaptiveLimits adaptive_limits{settings.noise_threshold, 16, spp};
   const std::vector<int> passes =
-      make_passes(spp, first_pass_samples(settings, control, adaptive, adaptive_limits.min_samples, spp));
+      make_passes(spp, first_pass_samples(settings, control, adaptive, adaptive_limits.min_samples));
 
   std::atomic<uint64_t> rays{0}, samples_done{0}, nonfinite{0};
   std::atomic<bool> stop{false}, timed_out{false}, cancelled{false};
