@@ -15,6 +15,7 @@
 #include "renderer/render/integrator.h"
 #include "renderer/denoise/denoise_result.h"
 #include "renderer/render/output_layers.h"
+#include "renderer/render/pass_plan.h"
 #include "renderer/render/camera_stage.h"
 #include "renderer/render/thin_lens_camera.h"
 #include "renderer/render/wavefront_integrator.h"
@@ -89,37 +90,24 @@ struct WavefrontScratch {
   }
 };
 
-// Sample counts of the passes: `first`, then `first` again and doubling (1, 1, 2, 4, 8, ... for
-// first = 1); the last pass takes what remains.
-std::vector<int> make_passes(int spp, int first) {
-  std::vector<int> passes;
-  int done = 0, next = std::max(1, first);
-  while (done < spp) {
-    const int n = std::min(next, spp - done);
-    passes.push_back(n);
-    done += n;
-    if (passes.size() > 1) next *= 2;
-  }
-  return passes;
-}
-
-// The first pass's samples per pixel. Passes exist for three things: a preview after each
-// (RenderControl::on_pass) and a time budget that ends the render with every pixel about
-// equally sampled -- both want a first pass of one sample, then doubling -- and adaptive
-// sampling, whose limits are decided between passes from min_samples on. A pass boundary costs:
-// each pass visits every pixel again, re-deriving its sampler's dimension seeds, and its batches
-// hold a few samples of many pixels instead of a run of one pixel's, and both threads wait for
-// the pass's last tile (uniform renders of the accuracy scenes in one pass, two threads:
-// 0.80-0.99 of the time at 64 spp, 0.91-0.96 at 256; docs/performance.md, levers). So where
-// nothing asks for a boundary the passes start at the first one that is needed: all samples at
-// once for uniform sampling, min_samples for adaptive sampling, whose limits are then decided
-// after the same sample counts (16, 32, 64, ...) and so are the same. Per pixel the samples and
-// their order in the film are the same whatever the passes, so the image is the same bit for
-// bit. (make_passes cuts a first pass larger than spp to spp.)
-int first_pass_samples(const RenderSettings& settings, const RenderControl& control,
-                       bool adaptive, int min_samples) {
-  if (control.on_pass || settings.time_limit > 0) return 1;
-  return adaptive ? min_samples : settings.spp;
+// The render's passes (pass_plan.h). Where nothing asks for a boundary they start at the first
+// one that is needed: all samples at once for uniform sampling, min_samples for adaptive
+// sampling, whose limits are then decided after the same sample counts (16, 32, 64, ...) and so
+// are the same. A preview or a time budget wants a first pass of one sample (a first image at
+// once; a budget cut then leaves every pixel sampled), then passes of at least
+// control.min_pass_seconds (uniform renders of the accuracy scenes in one pass instead of 1, 1,
+// 2, 4, ..., two threads: 0.80-0.99 of the time at 64 spp, 0.91-0.96 at 256; docs/performance.md,
+// levers). Per pixel the samples and their order in the film are the same whatever the passes,
+// so the image is the same bit for bit.
+PassPlan plan_passes(const RenderSettings& settings, const RenderControl& control, bool adaptive,
+                     int min_samples) {
+  PassPlan plan;
+  plan.spp = std::max(1, settings.spp);
+  const bool progressive = control.on_pass || settings.time_limit > 0;
+  plan.first = progressive ? 1 : adaptive ? min_samples : plan.spp;
+  plan.fixed_from = adaptive ? min_samples : INT_MAX;
+  plan.min_seconds = progressive ? std::max(0.0, control.min_pass_seconds) : 0.0;
+  return plan;
 }
 
 // Adaptive sampling: re-estimates every pixel's sample limit from the samples so far. With a
@@ -171,8 +159,7 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
   std::vector<uint32_t> limit(size_t(width) * height, uint32_t(spp)), taken(size_t(width) * height, 0);
   const bool adaptive = settings.noise_threshold > 0.f;
   const AdaptiveLimits adaptive_limits{settings.noise_threshold, 16, spp};
-  const std::vector<int> passes =
-      make_passes(spp, first_pass_samples(settings, control, adaptive, adaptive_limits.min_samples));
+  const PassPlan plan = plan_passes(settings, control, adaptive, adaptive_limits.min_samples);
 
   std::atomic<uint64_t> rays{0}, samples_done{0}, nonfinite{0};
   std::atomic<bool> stop{false}, timed_out{false}, cancelled{false};
@@ -208,8 +195,11 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
                                                             layer_film.has_value());
   int first_sample = 0;
   int passes_done = 0;
-  for (size_t pass = 0; pass < passes.size() && !stop.load(); ++pass) {
-    const int s0 = first_sample, s1 = first_sample + passes[pass];
+  double seconds_per_sample = 0.0;  // the last pass's, per sample per pixel
+  for (int n = plan.next(0, 0.0); n > 0 && !stop.load();
+       n = plan.next(first_sample, seconds_per_sample)) {
+    const int s0 = first_sample, s1 = first_sample + n;
+    const double pass_start = elapsed();
     // Limits are decided here, between passes, so the image does not depend on threads or tile
     // order; the progress total follows them so the fraction and ETA stay meaningful.
     std::vector<size_t> items = order.tile_starts;
@@ -322,6 +312,7 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
     if (stop.load()) break;
     first_sample = s1;
     ++passes_done;
+    seconds_per_sample = (elapsed() - pass_start) / double(n);
     if (control.on_pass) control.on_pass(film.resolve(), make_progress(passes_done));
   }
 

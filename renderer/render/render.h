@@ -25,6 +25,13 @@ struct RenderControl {
   std::function<void(const RenderProgress&)> on_progress;
   // Called after every finished pass with the current resolved image (progressive preview).
   std::function<void(const Image&, const RenderProgress&)> on_pass;
+  // Where previews or a time budget make progressive passes: after the first pass (one sample
+  // per pixel, the first preview at once) each pass takes at least about this long at the
+  // previous pass's rate, or doubles the samples so far if that is more (pass_plan.h). Previews
+  // then come about this often at first (the service's clients poll every 1-1.5 s), and a short
+  // render is not cut into passes of 1, 1, 2, 4, ... samples, each a boundary that costs time.
+  // 0: the sizes just double (1, 1, 2, 4, ...).
+  double min_pass_seconds = 0.5;
 };
 
 struct RenderStats {

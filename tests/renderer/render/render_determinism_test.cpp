@@ -3,6 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <climits>
+#include <vector>
+
+#include "renderer/render/pass_plan.h"
 
 #include "tests/renderer/render/render_test_util.h"
 
@@ -59,6 +63,7 @@ TEST(RenderDeterminism, SameImageWhateverThePasses) {
   const auto scene = Scene::build(busy_scene());
   for (const float threshold : {0.f, 0.02f}) {
     SCOPED_TRACE(threshold);
+    const bool adaptive = threshold > 0.f;
     RenderSettings s = small_settings(40, 30, 40, 6);
     s.seed = 7;
     s.tile_size = 8;
@@ -67,26 +72,70 @@ TEST(RenderDeterminism, SameImageWhateverThePasses) {
     // at its 16 samples, then 16 and 8 (to 40).
     PassCount plain;
     const RenderResult a = render(*scene, s, plain.control());
-    EXPECT_EQ(plain.passes, threshold > 0.f ? 3 : 1);
-    // A preview after each pass: 1, 1, 2, 4, 8, 16 and the 8 left.
-    PassCount previewed;
-    RenderControl c = previewed.control();
+    EXPECT_EQ(plain.passes, adaptive ? 3 : 1);
+    // A preview after each pass, passes doubling: 1, 1, 2, 4, 8, 16 and the 8 left.
+    PassCount doubling;
+    RenderControl c = doubling.control();
+    c.min_pass_seconds = 0.0;
     int previews = 0;
     c.on_pass = [&](const Image&, const RenderProgress&) { ++previews; };
     const RenderResult b = render(*scene, s, c);
     EXPECT_EQ(previews, 7);
-    EXPECT_EQ(previewed.passes, 7);
+    EXPECT_EQ(doubling.passes, 7);
+    // Previews with passes of at least a (long) time: one sample, then all the rest (uniform),
+    // or the rest up to adaptive sampling's first decision at 16, then 16 and 8.
+    PassCount timed;
+    c = timed.control();
+    c.min_pass_seconds = 1e3;
+    previews = 0;
+    c.on_pass = [&](const Image&, const RenderProgress&) { ++previews; };
+    const RenderResult e = render(*scene, s, c);
+    EXPECT_EQ(previews, adaptive ? 4 : 2);
+    EXPECT_EQ(timed.passes, adaptive ? 4 : 2);
     // A time budget it does not reach: the same progressive passes.
     s.time_limit = 1000.0;
     PassCount budgeted;
-    const RenderResult d = render(*scene, s, budgeted.control());
+    c = budgeted.control();
+    c.min_pass_seconds = 0.0;
+    const RenderResult d = render(*scene, s, c);
     EXPECT_EQ(budgeted.passes, 7);
     EXPECT_EQ(a.image.rgb, b.image.rgb);
     EXPECT_EQ(a.image.rgb, d.image.rgb);
+    EXPECT_EQ(a.image.rgb, e.image.rgb);
     EXPECT_EQ(a.stats.spp_mean, b.stats.spp_mean);
     EXPECT_EQ(a.stats.spp_mean, d.stats.spp_mean);
-    if (threshold > 0.f) EXPECT_LT(a.stats.spp_min, a.stats.spp_max);  // adaptive did decide
+    EXPECT_EQ(a.stats.spp_mean, e.stats.spp_mean);
+    if (adaptive) {
+      EXPECT_LT(a.stats.spp_min, a.stats.spp_max);  // adaptive did decide
+    }
   }
+}
+
+// The pass sizes themselves, at a given rate: doubling, raised to last min_seconds where the
+// boundaries are free, never past adaptive sampling's fixed boundaries, cut to what is left.
+TEST(PassPlan, SizesDoubleRaisedToTheMinimumTimeUpToFixedBoundaries) {
+  auto sizes = [](PassPlan plan, double seconds_per_sample) {
+    std::vector<int> out;
+    for (int done = 0, n = plan.next(0, 0.0); n > 0; n = plan.next(done, seconds_per_sample)) {
+      out.push_back(n);
+      done += n;
+    }
+    return out;
+  };
+  PassPlan uniform{.spp = 256, .first = 1, .fixed_from = INT_MAX, .min_seconds = 0.0};
+  EXPECT_EQ(sizes(uniform, 0.01), (std::vector<int>{1, 1, 2, 4, 8, 16, 32, 64, 128}));
+  uniform.min_seconds = 0.5;  // 50 samples at 0.01 s each
+  EXPECT_EQ(sizes(uniform, 0.01), (std::vector<int>{1, 50, 51, 102, 52}));
+  EXPECT_EQ(sizes(uniform, 1.0), (std::vector<int>{1, 1, 2, 4, 8, 16, 32, 64, 128}));
+  EXPECT_EQ(sizes(uniform, 1e-9), (std::vector<int>{1, 255}));
+  PassPlan adaptive{.spp = 256, .first = 1, .fixed_from = 16, .min_seconds = 0.5};
+  EXPECT_EQ(sizes(adaptive, 0.01), (std::vector<int>{1, 15, 16, 32, 64, 128}));
+  EXPECT_EQ(sizes(adaptive, 0.1), (std::vector<int>{1, 5, 6, 4, 16, 32, 64, 128}));
+  adaptive.first = 16;
+  adaptive.min_seconds = 0.0;
+  EXPECT_EQ(sizes(adaptive, 0.01), (std::vector<int>{16, 16, 32, 64, 128}));
+  const PassPlan one{.spp = 40, .first = 40};
+  EXPECT_EQ(sizes(one, 0.0), (std::vector<int>{40}));
 }
 
 TEST(RenderDeterminism, DifferentSeedGivesDifferentNoise) {
