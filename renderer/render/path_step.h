@@ -224,7 +224,7 @@ template <bool kDistributed, uint32_t kFeatures>
 // Second part, after path_arrive: next-event estimation (its visibility test returned in
 // *shadow when `*has_shadow`), then the BSDF's sample for the next segment and Russian
 // roulette. Returns whether the path goes on with s.ray.
-// `sampler`: a Sampler, or anything with its get_1d/get_2d (the wavefront driver's
+// `sampler`: a Sampler, or anything with its get_1d/get_2d/get_1d_2d (the wavefront driver's
 // PrefetchedSampler hands out values computed for a whole bounce at once).
 template <bool kDistributed, uint32_t kFeatures, class PathSampler>
 inline bool path_scatter(const Scene& scene, const IntegratorSettings& settings, PathState& s,
@@ -249,8 +249,9 @@ inline bool path_scatter(const Scene& scene, const IntegratorSettings& settings,
 
   // Next-event estimation.
   if ((kFeatures & kFeatureLights) != 0 && (lobes & ~uint32_t(kLobeDelta)) && !lights.empty()) {
-    const float u_light = sampler.get_1d();
-    const vec2 u_point = sampler.get_2d();
+    float u_light;
+    vec2 u_point;
+    sampler.get_1d_2d(&u_light, &u_point);  // one 3D point (Sampler::get_1d_2d)
     LightSample ls;
     const int light = lights.choose(u_light);
     if (scene.light(light).sample(hit.p, ray.time, u_point, &ls)) {
@@ -304,8 +305,9 @@ inline bool path_scatter(const Scene& scene, const IntegratorSettings& settings,
   if constexpr (kDistributed) {
     if (!(lobes & kLobeNonDiffuse)) return false;
   }
-  const float u_lobe = sampler.get_1d();
-  const vec2 u_dir = sampler.get_2d();
+  float u_lobe;
+  vec2 u_dir;
+  sampler.get_1d_2d(&u_lobe, &u_dir);  // one 3D point (Sampler::get_1d_2d)
   const auto bs = bsdf->sample(BsdfContext{kContinueLobes}, wi, u_lobe, u_dir);
   if (!bs) return false;
   const vec3 wo_world = frame.to_world(bs->wo);

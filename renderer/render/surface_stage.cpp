@@ -552,7 +552,7 @@ void SurfaceStage::add_textured(size_t i, const PathState& s, const SurfaceHit& 
 }
 
 void SurfaceStage::add(uint32_t slot, const PathState& s, const SurfaceHit& hit, const float* x,
-                       const float* y, bool next_event) {
+                       const float* y, const float* z, size_t z_stride, bool next_event) {
   const size_t i = count_++;
   slot_[i] = slot;
   if (textured_of_[hit.object])
@@ -571,12 +571,12 @@ void SurfaceStage::add(uint32_t slot, const PathState& s, const SurfaceHit& hit,
   eta_[i] = s.eta;
   depth_[i] = s.depth;
   // The step's values in the order path_scatter takes them: light choice and point (with next-
-  // event estimation), lobe, direction, roulette.
+  // event estimation; one get_1d_2d pair), lobe and direction (the next pair), roulette.
   const int d = estimates_light(next_event) ? 2 : 0;
-  u_light_[i] = x[0];
+  u_light_[i] = z[0];
   u_point_[0][i] = x[1];
   u_point_[1][i] = y[1];
-  u_lobe_[i] = x[d];
+  u_lobe_[i] = z[size_t(d / 2) * z_stride];
   u_dir_[0][i] = x[d + 1];
   u_dir_[1][i] = y[d + 1];
   u_rr_[i] = x[d + 2];

@@ -35,6 +35,7 @@ void PathBatch::clear() {
 void make_stages(const Scene& scene, PathBatch& b) {
   b.stages_.clear();
   b.stage_of_.assign(scene.object_count(), -1);
+  b.lobe_choices_ = false;
   for (StageModel model : kStageModels) {
     auto stage = std::make_unique<SurfaceStage>(scene, model);
     bool used = false;
@@ -43,8 +44,13 @@ void make_stages(const Scene& scene, PathBatch& b) {
       b.stage_of_[o] = int8_t(b.stages_.size());
       used = true;
     }
-    if (used) b.stages_.push_back(std::move(stage));
+    if (used) {
+      b.lobe_choices_ = b.lobe_choices_ || stage->needs_lobe_choice();
+      b.stages_.push_back(std::move(stage));
+    }
   }
+  // Surfaces no stage takes step through path_scatter, which may pick a lobe.
+  for (uint32_t o = 0; o < scene.object_count(); ++o) b.lobe_choices_ = b.lobe_choices_ || b.stage_of_[o] < 0;
   b.staged_scene_ = &scene;
 }
 
@@ -84,7 +90,23 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
     const bool next_event =
         (kFeatures & kFeatureLights) != 0 && !next_event_lights<kDistributed>(scene).empty();
     BounceSamples& samples = b.samples_;
-    samples.start(hit_count, next_event ? BounceSamples::kBounce : BounceSamples::kBounceWithoutLight);
+    // The 1D values of the get_1d_2d pairs (Sampler::get_1d_2d) only where someone reads them:
+    // a light choice among several lights, a lobe choice where a surface has one (a path that
+    // takes a pair not computed here gets it from its sampler, PrefetchedSampler; the stages
+    // read the values only where their step uses them).
+    constexpr bool kStages = !kDistributed;
+    if (kStages && b.staged_scene_ != &scene) make_stages(scene, b);
+    const bool lobe_pairs = !kStages || b.lobe_choices_;
+    if (next_event) {
+      // Dimensions 0 and 1 are also the lobe and direction of a surface whose lobes are all
+      // Dirac (it estimates no light: a smooth dielectric picks reflection or refraction there).
+      const bool light_pairs = next_event_lights<kDistributed>(scene).cdf().size() > 1;
+      samples.start(hit_count, BounceSamples::kBounce, BounceSamples::kBouncePairs,
+                    (light_pairs || lobe_pairs ? 0b00001u : 0u) | (lobe_pairs ? 0b00100u : 0u));
+    } else {
+      samples.start(hit_count, BounceSamples::kBounceWithoutLight,
+                    BounceSamples::kBounceWithoutLightPairs, lobe_pairs ? 0b001u : 0u);
+    }
     for (size_t j = 0; j < hit_count; ++j) {
       const uint32_t p = live[hit_slots[j]];
       samples.add(*b.samplers_[p], b.cursors_[p]);
@@ -95,8 +117,6 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
     // conductors and plastics (path integrator) take theirs in the surface stages, the others one by one;
     // each path's results go to its own slot k, and the survivors and shadow queries are then
     // gathered in path order, as the scalar loop would leave them.
-    constexpr bool kStages = !kDistributed;
-    if (kStages && b.staged_scene_ != &scene) make_stages(scene, b);
     if (kStages)
       for (auto& stage : b.stages_) stage->start(live.size());
     std::vector<uint8_t>& goes_on = b.goes_on_;
@@ -131,7 +151,7 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
       if (stage >= 0) {
         if (path_arrive<kDistributed, kFeatures>(scene, settings, s, hit, first))
           b.stages_[size_t(stage)]->add(uint32_t(k), s, hit, samples.x(j), samples.y(j),
-                                        next_event);
+                                        samples.z(j), samples.z_stride(), next_event);
         continue;
       }
       PrefetchedSampler sampler(*b.samplers_[p], b.cursors_[p], samples, j);

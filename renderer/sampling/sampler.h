@@ -1,7 +1,10 @@
 #pragma once
 // Owen-scrambled Sobol sampler, padded in 2D pairs (Burley 2020, "Practical Hash-based Owen
-// Scrambling", JCGT 9(4)). Every value is a pure function of (seed, pixel, sample index,
-// dimension), so images do not depend on threads, tiles or the order samples are taken in.
+// Scrambling", JCGT 9(4)); a 1D value that goes with the 2D value after it (a light choice with
+// its light point, a BSDF's lobe choice with its direction) is taken as one 3D point instead
+// (get_1d_2d). Every value is a pure function of (seed, pixel, sample index, dimension), so
+// images do not depend on threads, tiles or the order samples are taken in.
+#include <array>
 #include <cstdint>
 #include <cstring>
 
@@ -69,6 +72,23 @@ inline uint32_t superset_parity(uint32_t x) {
 }
 inline uint32_t sobol_dimension1(uint32_t index) { return reverse_bits32(superset_parity(index)); }
 
+// Sobol's third dimension, as 0.32 fixed point: primitive polynomial x^2 + x + 1 with initial
+// direction numbers m = 1, 3 (Joe and Kuo 2008, their dimension 3), m_k = 2 m_{k-1} ^ 4 m_{k-2}
+// ^ m_{k-2}; column k of the generator matrix is m_{k+1} / 2^{k+1}. Branch-free over the index's
+// bits so that the batch kernel vectorises it.
+inline constexpr std::array<uint32_t, 32> kSobolDimension2Columns = [] {
+  std::array<uint32_t, 32> columns{};
+  uint64_t m[33] = {0, 1, 3};
+  for (int k = 3; k <= 32; ++k) m[k] = (2 * m[k - 1]) ^ (4 * m[k - 2]) ^ m[k - 2];
+  for (int k = 1; k <= 32; ++k) columns[size_t(k - 1)] = uint32_t(m[k] << (32 - k));
+  return columns;
+}();
+inline uint32_t sobol_dimension2(uint32_t index) {
+  uint32_t result = 0;
+  for (int k = 0; k < 32; ++k) result ^= kSobolDimension2Columns[size_t(k)] & (0u - ((index >> k) & 1u));
+  return result;
+}
+
 // The top 24 bits as a float in [0, 1). x >> 8 < 2^24 converts exactly; through int32, so that
 // vector code can use the signed conversion (SSE2 and AVX2 have no unsigned one).
 inline float fixed_to_unit_float(uint32_t x) { return float(int32_t(x >> 8)) * 0x1p-24f; }
@@ -92,6 +112,10 @@ inline float scrambled_sobol_x(uint32_t shuffled, uint32_t seed) {
 inline float scrambled_sobol_y(uint32_t shuffled, uint32_t seed) {
   // nested_uniform_scramble(sobol_dimension1(i)) = reverse(LK(superset_parity(i))).
   return fixed_to_unit_float(reverse_bits32(laine_karras_permutation(superset_parity(shuffled), seed)));
+}
+// The third coordinate of the same point, scrambled by its own seed.
+inline float scrambled_sobol_z(uint32_t shuffled, uint32_t seed) {
+  return fixed_to_unit_float(nested_uniform_scramble(sobol_dimension2(shuffled), seed));
 }
 
 // hash_combine(seed, d)'s hash of d for the dimensions the sampler caches: one of its two mixes,
@@ -144,6 +168,23 @@ class Sampler {
     const DimensionScramble h = scramble(dimension_++);
     const uint32_t shuffled = shuffled_sample_index(index_, h.index);
     return vec2(scrambled_sobol_x(shuffled, h.x), scrambled_sobol_y(shuffled, h.y));
+  }
+
+  // A 1D value and the 2D value that goes with it (dimensions d and d + 1) as one Owen-scrambled
+  // 3D point: Sobol dimensions 0 and 1 of dimension d + 1's shuffled index are the 2D value
+  // (get_2d's at d + 1, unchanged), Sobol dimension 2 of the same index, scrambled by dimension
+  // d's seed, the 1D value. Each value is still uniform and the pairs still padded against
+  // every other dimension, but the first 2^m samples of a pixel are now a net in the three
+  // together (8 x 8 x 4 boxes of 256 samples hold one each): the lobe a BSDF picks is stratified
+  // jointly with the direction it samples in that lobe, the light chosen with the point on it.
+  // Measured (docs/performance.md, levers): 0.81-0.85 of the variance on plastics, 0.91 on
+  // furnace, others unchanged.
+  void get_1d_2d(float* u1, vec2* u2) {
+    const DimensionScramble h1 = scramble(dimension_++);
+    const DimensionScramble h2 = scramble(dimension_++);
+    const uint32_t shuffled = shuffled_sample_index(index_, h2.index);
+    *u2 = vec2(scrambled_sobol_x(shuffled, h2.x), scrambled_sobol_y(shuffled, h2.y));
+    *u1 = scrambled_sobol_z(shuffled, h1.x);
   }
 
   // The seeds of a dimension of the current pixel (the batch kernel takes them from here).

@@ -20,7 +20,20 @@ void scrambled_sobol_kernel(size_t n, const uint32_t* __restrict index,
   }
 }
 
+PENUMBRA_SIMD_CLONES
+void scrambled_sobol_z_kernel(size_t n, const uint32_t* __restrict index,
+                              const uint32_t* __restrict seed_index,
+                              const uint32_t* __restrict seed_z, float* __restrict z) {
+  for (size_t i = 0; i < n; ++i)
+    z[i] = scrambled_sobol_z(shuffled_sample_index(index[i], seed_index[i]), seed_z[i]);
+}
+
 }  // namespace
+
+void scrambled_sobol_z_batch(size_t n, const uint32_t* index, const uint32_t* seed_index,
+                             const uint32_t* seed_z, float* z) {
+  scrambled_sobol_z_kernel(n, index, seed_index, seed_z, z);
+}
 
 void scrambled_sobol_batch(size_t n, const uint32_t* index, const uint32_t* seed_index,
                            const uint32_t* seed_x, const uint32_t* seed_y, float* x, float* y) {

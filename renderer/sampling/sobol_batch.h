@@ -5,6 +5,7 @@
 // waiting on. Over arrays the same operations run in SIMD lanes (eight or sixteen entries per
 // instruction where the CPU has AVX2 or AVX-512, chosen at run time). The values are those of
 // Sampler::get_1d/get_2d to the bit: integer operations and an exact conversion.
+#include <bit>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -18,6 +19,10 @@ namespace penumbra {
 // alias the inputs.
 void scrambled_sobol_batch(size_t n, const uint32_t* index, const uint32_t* seed_index,
                            const uint32_t* seed_x, const uint32_t* seed_y, float* x, float* y);
+// Entry i: the 1D value of Sampler::get_1d_2d whose 2D value has seeds (seed_index[i], ...) and
+// whose own dimension has x seed seed_z[i] (scrambled_sobol_z of the shared shuffled index).
+void scrambled_sobol_z_batch(size_t n, const uint32_t* index, const uint32_t* seed_index,
+                             const uint32_t* seed_z, float* z);
 
 // The values a step of many paths will take, computed together, and each path's view of them.
 // Entry block k holds path k's next per_path dimensions (a bounce takes at most five: light
@@ -30,9 +35,28 @@ class BounceSamples {
   // direction, Russian roulette.
   static constexpr int kBounceWithoutLight = 3;
 
-  // Room for `paths` paths' values, per_path each, from path 0.
-  void start(size_t paths, int per_path = kBounce) {
+  // The dimensions where a bounce's get_1d_2d pairs start (bit j: dimensions j and j + 1):
+  // light choice with light point, lobe with direction; without a light, lobe with direction.
+  // A surface that estimates no light (all lobes Dirac) takes its lobe and direction at
+  // dimensions 0 and 1 of a bounce with lights: the same pair.
+  static constexpr uint32_t kBouncePairs = 0b00101u, kBounceWithoutLightPairs = 0b001u;
+
+  // Room for `paths` paths' values, per_path each, from path 0. `pairs`: where get_1d_2d pairs
+  // start; `computed`: those of them whose 1D values are computed here too (z; a pair whose 1D
+  // value nobody reads, the light choice with one light or the lobe of single-lobe surfaces,
+  // need not be), besides every dimension's get_1d/get_2d values.
+  void start(size_t paths, int per_path = kBounce, uint32_t pairs = 0, uint32_t computed = 0) {
     per_path_ = per_path;
+    stride_ = paths;
+    pairs_ = pairs & ((uint32_t(1) << (per_path - 1)) - 1u);  // a pair needs its 2D dimension
+    computed_ = computed & pairs_;
+    const size_t nz = paths * size_t(std::popcount(pairs_));
+    if (z_seed_index_.size() < nz) {
+      z_seed_index_.resize(nz);
+      z_seed_.resize(nz);
+      z_.resize(nz);
+    }
+    if (path_index_.size() < paths) path_index_.resize(paths);
     const size_t n = paths * size_t(per_path);
     if (index_.size() < n) {
       index_.resize(n);
@@ -48,27 +72,51 @@ class BounceSamples {
   void add(Sampler& sampler, const Sampler::Cursor& cursor) {
     const size_t e = paths_++ * size_t(per_path_);
     for (int j = 0; j < per_path_; ++j) index_[e + j] = cursor.index;
+    path_index_[paths_ - 1] = cursor.index;
     if (per_path_ == kBounce)
       sampler.scrambles<kBounce>(cursor.dimension, &seed_index_[e], &seed_x_[e], &seed_y_[e]);
     else if (per_path_ == kBounceWithoutLight)
       sampler.scrambles<kBounceWithoutLight>(cursor.dimension, &seed_index_[e], &seed_x_[e], &seed_y_[e]);
     else
       sampler.scrambles(cursor.dimension, per_path_, &seed_index_[e], &seed_x_[e], &seed_y_[e]);
+    // Each computed pair's 1D value: its 2D dimension's index shuffle, its own dimension's x
+    // seed (pair k of path p at k * paths + p).
+    for (uint32_t bits = computed_; bits; bits &= bits - 1) {
+      const int j = std::countr_zero(bits);
+      const size_t q = size_t(pair_index(j)) * stride_ + (paths_ - 1);
+      z_seed_index_[q] = seed_index_[e + size_t(j) + 1];
+      z_seed_[q] = seed_x_[e + size_t(j)];
+    }
   }
   // Computes every queued value.
   void compute() {
     scrambled_sobol_batch(paths_ * size_t(per_path_), index_.data(), seed_index_.data(), seed_x_.data(),
                           seed_y_.data(), x_.data(), y_.data());
+    for (uint32_t bits = computed_; bits; bits &= bits - 1) {
+      const size_t q = size_t(pair_index(std::countr_zero(bits))) * stride_;
+      scrambled_sobol_z_batch(paths_, path_index_.data(), &z_seed_index_[q], &z_seed_[q], &z_[q]);
+    }
   }
   const float* x(size_t path) const { return x_.data() + path * size_t(per_path_); }
   const float* y(size_t path) const { return y_.data() + path * size_t(per_path_); }
+  // The path's pairs' 1D values: pair k (the k-th of `pairs` from the lowest dimension) at
+  // z(path)[k * z_stride()]; a pair that was not computed holds a stale value.
+  const float* z(size_t path) const { return z_.data() + path; }
+  size_t z_stride() const { return stride_; }
   int per_path() const { return per_path_; }
+  uint32_t pairs() const { return pairs_; }
+  uint32_t computed_pairs() const { return computed_; }
+  // Which pair starts at dimension j (j a bit of pairs).
+  int pair_index(int j) const { return std::popcount(pairs_ & ((uint32_t(1) << j) - 1u)); }
 
  private:
   int per_path_ = kBounce;
-  size_t paths_ = 0;
+  uint32_t pairs_ = 0, computed_ = 0;
+  size_t paths_ = 0, stride_ = 0;
   std::vector<uint32_t> index_, seed_index_, seed_x_, seed_y_;
   std::vector<float> x_, y_;
+  std::vector<uint32_t> path_index_, z_seed_index_, z_seed_;
+  std::vector<float> z_;
 };
 
 // One path's sampler during a bounce: the prefetched values first, then its own sampler (a
@@ -81,7 +129,11 @@ class PrefetchedSampler {
         cursor_(cursor),
         x_(samples.x(path)),
         y_(samples.y(path)),
-        count_(samples.per_path()) {}
+        z_(samples.z(path)),
+        z_stride_(samples.z_stride()),
+        count_(samples.per_path()),
+        pairs_(samples.pairs()),
+        computed_(samples.computed_pairs()) {}
 
   // The prefetched values inline, the rare rest out of line: inlined whole, the fallback's
   // sampler code made GCC call these from the bounce step instead.
@@ -100,9 +152,27 @@ class PrefetchedSampler {
     }
     return fallback_2d();
   }
+  // Sampler::get_1d_2d: prefetched where a pair was computed to start here, else the sampler's.
+  [[gnu::always_inline]] void get_1d_2d(float* u1, vec2* u2) {
+    if (used_ < count_ && ((computed_ >> used_) & 1u)) {
+      const int j = used_;
+      *u1 = z_[size_t(std::popcount(pairs_ & ((uint32_t(1) << j) - 1u))) * z_stride_];
+      *u2 = vec2(x_[j + 1], y_[j + 1]);
+      used_ += 2;
+      cursor_.dimension += 2;
+      return;
+    }
+    fallback_1d_2d(u1, u2);
+  }
   Sampler::Cursor cursor() const { return cursor_; }
 
  private:
+  [[gnu::noinline]] void fallback_1d_2d(float* u1, vec2* u2) {
+    sampler_.resume(cursor_);
+    sampler_.get_1d_2d(u1, u2);
+    cursor_ = sampler_.cursor();
+    used_ += 2;
+  }
   [[gnu::noinline]] float fallback_1d() {
     sampler_.resume(cursor_);
     const float u = sampler_.get_1d();
@@ -120,7 +190,10 @@ class PrefetchedSampler {
   Sampler::Cursor cursor_;
   const float* x_;
   const float* y_;
+  const float* z_;
+  size_t z_stride_;
   int count_;
+  uint32_t pairs_, computed_;
   int used_ = 0;
 };
 

@@ -39,17 +39,25 @@ bool same_bits(const T& a, const T& b) {
 // a 2D one (x[j], y[j]).
 class ListSampler {
  public:
-  ListSampler(const float* x, const float* y) : x_(x), y_(y) {}
+  ListSampler(const float* x, const float* y, const float* z) : x_(x), y_(y), z_(z) {}
   float get_1d() { return x_[used_++]; }
   vec2 get_2d() {
     const int j = used_++;
     return vec2(x_[j], y_[j]);
+  }
+  // A pair starts at dimension 0 or 2 (BounceSamples::kBouncePairs): its 1D value is z[0] or z[1].
+  void get_1d_2d(float* u1, vec2* u2) {
+    EXPECT_TRUE(used_ == 0 || used_ == 2) << "a pair at dimension " << used_;
+    *u1 = z_[used_ / 2];
+    *u2 = vec2(x_[used_ + 1], y_[used_ + 1]);
+    used_ += 2;
   }
   int used() const { return used_; }
 
  private:
   const float* x_;
   const float* y_;
+  const float* z_;
   int used_ = 0;
 };
 
@@ -136,7 +144,7 @@ SceneInput floor_scene(Lights lights, const MaterialParams& material) {
 struct Lane {
   PathState state;
   SurfaceHit hit;
-  float x[BounceSamples::kBounce], y[BounceSamples::kBounce];
+  float x[BounceSamples::kBounce], y[BounceSamples::kBounce], z[2];
 };
 
 // Rays onto the floor from above and below, from random points, with random path states and
@@ -170,6 +178,8 @@ std::vector<Lane> floor_hits(const Scene& scene, size_t count, uint32_t seed) {
       lane.x[j] = u(rng);
       lane.y[j] = u(rng);
     }
+    lane.z[0] = u(rng);
+    lane.z[1] = u(rng);
     if (lanes.size() % 10 == 3) lane.x[3] = lane.y[3] = 0.5f;  // the disk's centre
     if (lanes.size() % 10 == 5) lane.x[1] = lane.y[1] = 0.5f;
     if (lanes.size() % 10 == 7) lane.x[3] = 0.f, lane.y[3] = 0.5f;
@@ -201,7 +211,7 @@ Coverage expect_stage_matches_material(Lights which, uint32_t seed, StageModel m
   EXPECT_TRUE(stage.takes(1));
   stage.start(lanes.size());
   for (size_t k = 0; k < lanes.size(); ++k)
-    stage.add(uint32_t(k), lanes[k].state, lanes[k].hit, lanes[k].x, lanes[k].y, next_event);
+    stage.add(uint32_t(k), lanes[k].state, lanes[k].hit, lanes[k].x, lanes[k].y, lanes[k].z, 1, next_event);
   stage.compute(settings, next_event);
   EXPECT_EQ(stage.size(), lanes.size());
 
@@ -230,7 +240,7 @@ Coverage expect_stage_matches_material(Lights which, uint32_t seed, StageModel m
     const size_t k = stage.slot(lane);
     PathState s = lanes[k].state;
     SurfaceHit hit = lanes[k].hit;
-    ListSampler sampler(lanes[k].x, lanes[k].y);
+    ListSampler sampler(lanes[k].x, lanes[k].y, lanes[k].z);
     PathCounters counters;
     ShadowQuery shadow;
     bool has_shadow = false;

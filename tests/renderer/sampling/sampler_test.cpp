@@ -2,7 +2,9 @@
 // dimension pair, independent between pixels and dimensions.
 #include <gtest/gtest.h>
 
+#include <map>
 #include <set>
+#include <tuple>
 
 #include "renderer/sampling/sampler.h"
 
@@ -44,6 +46,42 @@ TEST(Sampler, TwoDimensionalSamplesFormANet) {
       for (const vec2& p : pts) cells.insert({int(p.x * (1 << k)), int(p.y * (1 << (m - k)))});
       EXPECT_EQ(int(cells.size()), n) << "dimension pair " << dim_pair << ", k " << k;
     }
+  }
+}
+
+// get_1d_2d: the 2D value is get_2d's of the second dimension, and with the 1D value the first
+// 2^m samples form a (1, m, 3)-net (Sobol's first three dimensions): every elementary box of
+// volume 2^-(m-1) holds exactly two of them, so the 1D value is stratified with the 2D one, not
+// only beside it.
+TEST(Sampler, OneAndTwoDimensionalPairIsA3DNet) {
+  constexpr int m = 8, n = 1 << m;
+  for (int first = 0; first < 3; ++first) {
+    std::vector<vec3> pts;
+    Sampler s(17), plain(17);
+    for (int i = 0; i < n; ++i) {
+      s.start_pixel_sample(2, 7, uint32_t(i));
+      plain.start_pixel_sample(2, 7, uint32_t(i));
+      for (int d = 0; d < 2 * first; ++d) s.get_1d(), plain.get_1d();
+      float u1;
+      vec2 u2;
+      s.get_1d_2d(&u1, &u2);
+      plain.get_1d();
+      const vec2 p2 = plain.get_2d();
+      ASSERT_EQ(u2.x, p2.x);
+      ASSERT_EQ(u2.y, p2.y);
+      ASSERT_EQ(s.cursor().dimension, plain.cursor().dimension);
+      ASSERT_GE(u1, 0.f);
+      ASSERT_LT(u1, 1.f);
+      pts.push_back(vec3(u1, u2.x, u2.y));
+    }
+    for (int a = 0; a <= m - 1; ++a)
+      for (int b = 0; a + b <= m - 1; ++b) {
+        const int c = m - 1 - a - b;
+        std::map<std::tuple<int, int, int>, int> boxes;
+        for (const vec3& p : pts) ++boxes[{int(p.x * (1 << a)), int(p.y * (1 << b)), int(p.z * (1 << c))}];
+        EXPECT_EQ(int(boxes.size()), n / 2) << "pair " << first << ", box " << a << " " << b << " " << c;
+        for (const auto& [box, count] : boxes) ASSERT_EQ(count, 2);
+      }
   }
 }
 

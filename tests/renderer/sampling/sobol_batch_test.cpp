@@ -16,6 +16,13 @@ void take(S& sampler, const int* pattern, int count, std::vector<float>* out) {
   for (int j = 0; j < count; ++j) {
     if (pattern[j] == 1) {
       out->push_back(sampler.get_1d());
+    } else if (pattern[j] == 3) {  // get_1d_2d
+      float u1;
+      vec2 u2;
+      sampler.get_1d_2d(&u1, &u2);
+      out->push_back(u1);
+      out->push_back(u2.x);
+      out->push_back(u2.y);
     } else {
       const vec2 u = sampler.get_2d();
       out->push_back(u.x);
@@ -46,6 +53,19 @@ TEST(SobolBatch, KernelIsTheScalarSamplerToTheBit) {
       const float ey = fixed_to_unit_float(nested_uniform_scramble(sobol_dimension1_reference(shuffled), sy[i]));
       ASSERT_EQ(float_bits(x[i]), float_bits(ex)) << "n " << n << " entry " << i;
       ASSERT_EQ(float_bits(y[i]), float_bits(ey)) << "n " << n << " entry " << i;
+    }
+    // The 1D value of a get_1d_2d pair: Sobol's third dimension of the shared shuffled index
+    // (its generator matrix column by column, as Joe and Kuo define it), scrambled.
+    std::vector<float> z(n);
+    scrambled_sobol_z_batch(n, index.data(), si.data(), sx.data(), z.data());
+    for (size_t i = 0; i < n; ++i) {
+      const uint32_t shuffled = nested_uniform_scramble(index[i], si[i]);
+      uint32_t m[33] = {0, 1, 3}, sobol2 = 0;
+      for (int k = 3; k <= 32; ++k) m[k] = (2 * m[k - 1]) ^ (4 * m[k - 2]) ^ m[k - 2];
+      for (int k = 0; k < 32; ++k)
+        if ((shuffled >> k) & 1u) sobol2 ^= uint32_t(uint64_t(m[k + 1]) << (31 - k));
+      const float ez = fixed_to_unit_float(nested_uniform_scramble(sobol2, sx[i]));
+      ASSERT_EQ(float_bits(z[i]), float_bits(ez)) << "n " << n << " entry " << i;
     }
   }
 }
@@ -86,6 +106,44 @@ TEST(SobolBatch, PrefetchedPathsSeeTheSamplersSequence) {
     ASSERT_EQ(got[p].size(), expected[p].size());
     for (size_t i = 0; i < got[p].size(); ++i)
       ASSERT_EQ(float_bits(got[p][i]), float_bits(expected[p][i])) << "path " << p << " value " << i;
+  }
+}
+
+// get_1d_2d pairs through BounceSamples/PrefetchedSampler: a bounce's light pair and lobe pair
+// (pattern 3 at dimensions 0 and 2), a surface with Dirac lobes only (its pair at 0, Russian
+// roulette's plain 1D value at 2, where the layout has the lobe pair), a pair where none was
+// laid out (dimension 1), with every subset of the pairs computed: the values a Sampler gives.
+TEST(SobolBatch, PrefetchedPairsSeeTheSamplersSequence) {
+  constexpr int kPaths = 5;
+  const int patterns[3][4] = {{3, 3, 1, 0}, {3, 1, 1, 2}, {1, 3, 2, 1}};
+  const int takes[3] = {3, 4, 4};
+  for (uint32_t computed = 0; computed < 8; ++computed) {
+    for (int which = 0; which < 3; ++which) {
+      SCOPED_TRACE(testing::Message() << "computed " << computed << ", pattern " << which);
+      Sampler shared(9), alone(9);
+      std::vector<Sampler::Cursor> cursors;
+      for (int p = 0; p < kPaths; ++p) {
+        shared.start_pixel_sample(4, 1, uint32_t(p * 7 + 1));
+        for (int d = 0; d < p; ++d) shared.get_1d();  // paths at different dimensions
+        cursors.push_back(shared.cursor());
+      }
+      BounceSamples samples;
+      samples.start(kPaths, BounceSamples::kBounce, BounceSamples::kBouncePairs, computed);
+      for (int p = 0; p < kPaths; ++p) samples.add(shared, cursors[p]);
+      samples.compute();
+      for (int p = 0; p < kPaths; ++p) {
+        std::vector<float> got, expected;
+        PrefetchedSampler s(shared, cursors[p], samples, size_t(p));
+        take(s, patterns[which], takes[which], &got);
+        alone.start_pixel_sample(4, 1, uint32_t(p * 7 + 1));
+        for (int d = 0; d < p; ++d) alone.get_1d();
+        take(alone, patterns[which], takes[which], &expected);
+        EXPECT_EQ(s.cursor().dimension, alone.cursor().dimension);
+        ASSERT_EQ(got.size(), expected.size());
+        for (size_t i = 0; i < got.size(); ++i)
+          ASSERT_EQ(float_bits(got[i]), float_bits(expected[i])) << "path " << p << " value " << i;
+      }
+    }
   }
 }
 
