@@ -46,6 +46,35 @@ void check_tile_count(bool tiled, int64_t w, int64_t h, uint32_t tile_w, uint32_
                        " make more than " + std::to_string(kMaxExrTiles) + " tiles");
 }
 
+// OpenEXR 3.1 also sizes a scanline file's decompression buffers by the header before it reads
+// a pixel: a chunk's lines (1 to 256 by compression) times the widest line's bytes (the data
+// window's width times the channels' sample sizes). A 688-byte file with an 8-million-pixel-wide
+// window of four float channels under ZIP made it allocate 2.1 GB (found by the exr_window
+// fuzzer); a tile's buffer is its tile's pixels times the same bytes. Refused above 256 MiB
+// (a 16384-wide image of 16 float channels under DWAB is 256 MiB; real files are far below).
+// The scanline offset table, one 8-byte entry per chunk of lines, must also fit in the file.
+constexpr uint64_t kMaxExrChunkBytes = uint64_t(256) << 20;
+
+// Lines per chunk of each compression (OpenEXR's ImfCompression.h, numLinesInBuffer).
+uint64_t lines_per_chunk(uint32_t compression) {
+  constexpr uint64_t kLines[] = {1, 1, 1, 16, 32, 16, 32, 32, 32, 256};
+  return compression < std::size(kLines) ? kLines[compression] : 256;  // unknown: the largest
+}
+
+void check_buffer_sizes(bool tiled, int64_t w, int64_t h, uint32_t tile_w, uint32_t tile_h,
+                        uint64_t sample_bytes, uint32_t compression, uint64_t file_size,
+                        const std::string& path) {
+  if (w <= 0 || h <= 0) return;  // OpenEXR refuses an empty or inverted window itself
+  const uint64_t chunk = tiled ? uint64_t(tile_w) * uint64_t(tile_h) * sample_bytes
+                               : uint64_t(w) * sample_bytes * lines_per_chunk(compression);
+  if (chunk > kMaxExrChunkBytes)
+    throw ImageIoError(path + ": a " + (tiled ? "tile" : "chunk of lines") + " of the " +
+                       std::to_string(w) + " x " + std::to_string(h) + " pixel image would take " +
+                       std::to_string(chunk) + " bytes to decode, over " + std::to_string(kMaxExrChunkBytes));
+  if (!tiled && (uint64_t(h) + lines_per_chunk(compression) - 1) / lines_per_chunk(compression) * 8 > file_size)
+    throw ImageIoError(path + ": the " + std::to_string(h) + " lines' offset table is larger than the file");
+}
+
 }  // namespace
 
 // OpenEXR 3.1 allocates an attribute's value at the size the file declares before reading it, so
@@ -69,11 +98,16 @@ uint32_t check_exr_header(const uint8_t* head, size_t head_size, uint64_t file_s
   int64_t window_w = 0, window_h = 0;
   uint32_t tile_w = 0, tile_h = 0, level_mode = 0;
   bool tiled = false;
+  // The channels' bytes per pixel (half: 2, float and uint: 4; subsampling ignored, which only
+  // overestimates) and the compression, for the decode buffers' sizes.
+  uint64_t sample_bytes = 0;
+  uint32_t compression = 0;
   while (true) {
     if (pos >= head_size)
       throw ImageIoError(path + ": the header is truncated or larger than " + std::to_string(kMaxExrHeaderBytes) + " bytes");
     if (head[pos] == 0) {
       check_tile_count(tiled, window_w, window_h, tile_w, tile_h, level_mode, path);
+      check_buffer_sizes(tiled, window_w, window_h, tile_w, tile_h, sample_bytes, compression, file_size, path);
       return flags;
     }
     const size_t name_at = pos;
@@ -99,6 +133,8 @@ uint32_t check_exr_header(const uint8_t* head, size_t head_size, uint64_t file_s
       if (available == size_t(size) && name == "dataWindow" && type == "box2i") {
         window_w = int64_t(int32_t(le32(value + 8))) - int32_t(le32(value)) + 1;
         window_h = int64_t(int32_t(le32(value + 12))) - int32_t(le32(value + 4)) + 1;
+      } else if (available == size_t(size) && name == "compression" && type == "compression") {
+        compression = value[0];
       } else if (available == size_t(size) && name == "tiles" && type == "tiledesc") {
         tiled = true;
         tile_w = le32(value);
@@ -111,7 +147,9 @@ uint32_t check_exr_header(const uint8_t* head, size_t head_size, uint64_t file_s
       while (at < available && value[at] != 0) {
         const uint8_t* zero = static_cast<const uint8_t*>(std::memchr(value + at, 0, available - at));
         if (!zero) throw bad("unterminated channel name");
-        at = size_t(zero - value) + 1 + 16;
+        at = size_t(zero - value) + 1;
+        if (name == "channels" && at + 4 <= available) sample_bytes += le32(value + at) == 1 ? 2 : 4;
+        at += 16;
       }
       if (at + 1 != size_t(size) || at >= available) throw bad("channel list does not fill its size");
     } else if (type == "stringvector") {

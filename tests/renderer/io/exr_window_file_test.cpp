@@ -3,6 +3,8 @@
 // window inside the display window), and files that are not windows penumbra can merge.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <OpenImageIO/imageio.h>
 #include <OpenImageIO/filesystem.h>
 
@@ -112,6 +114,20 @@ TEST(ExrWindowFile, FilesThatAreNotWindowsAreErrorsNamingTheFile) {
   for (char ch : std::string("x\0string\0", 9)) liar.push_back(uint8_t(ch));
   for (int b : {0xff, 0xff, 0xff, 0x7f, int('a'), int('b')}) liar.push_back(uint8_t(b));
   expect_error(liar, "header attribute \"x\" claims 2147483647 bytes, more than the file holds");
+  // A data window whose lines (or whose number of lines) OpenEXR would size its decode buffers
+  // (offset table) by before reading a pixel: refused from the header (the exr_window fuzzer's
+  // 688-byte file had OpenEXR allocate 2.1 GB).
+  auto with_window_coordinate = [&good](int which, int32_t value) {
+    std::vector<uint8_t> out = good;
+    const std::string key("dataWindow\0box2i\0", 17);
+    const auto at = std::search(out.begin(), out.end(), key.begin(), key.end());
+    EXPECT_NE(at, out.end());
+    const size_t value_at = size_t(at - out.begin()) + key.size() + 4 + 4 * size_t(which);
+    for (int k = 0; k < 4; ++k) out[value_at + size_t(k)] = uint8_t(uint32_t(value) >> (8 * k));
+    return out;
+  };
+  expect_error(with_window_coordinate(2, 1 << 29), "would take");              // max.x
+  expect_error(with_window_coordinate(3, 1 << 29), "offset table is larger than the file");  // max.y
   std::vector<uint8_t> deep = good;
   deep[5] |= 0x08;  // the deep-data flag of the version field
   expect_error(deep, "multi-part or deep");
