@@ -4,7 +4,7 @@
 // a chain of some sixty dependent integer operations, which one path at a time leaves the CPU
 // waiting on. Over arrays the same operations run in SIMD lanes (eight or sixteen entries per
 // instruction where the CPU has AVX2 or AVX-512, chosen at run time). The values are those of
-// Sampler::get_1d/get_2d to the bit: integer operations and an exact conversion.
+// Sampler::get_1d/get_2d/get_1d_2d to the bit: integer operations and an exact conversion.
 #include <bit>
 #include <cstddef>
 #include <cstdint>
@@ -48,7 +48,8 @@ class BounceSamples {
   void start(size_t paths, int per_path = kBounce, uint32_t pairs = 0, uint32_t computed = 0) {
     per_path_ = per_path;
     stride_ = paths;
-    pairs_ = pairs & ((uint32_t(1) << (per_path - 1)) - 1u);  // a pair needs its 2D dimension
+    // A pair needs its 2D dimension among the prefetched ones.
+    pairs_ = per_path > 1 ? pairs & ((uint32_t(1) << (per_path - 1)) - 1u) : 0u;
     computed_ = computed & pairs_;
     const size_t nz = paths * size_t(std::popcount(pairs_));
     if (z_seed_index_.size() < nz) {
