@@ -94,18 +94,25 @@ uint32_t check_exr_header(const uint8_t* head, size_t head_size, uint64_t file_s
     if (!zero) throw ImageIoError(path + ": the header's attribute " + what + " is unterminated or too long");
     pos = size_t(zero - head) + 1;
   };
-  // The data window and the tile description, for the tile count below.
+  // The data window and the tile description, for the tile count below. Whether OpenEXR reads
+  // the file as tiles or as lines is the version field's tiled flag, not the presence of a
+  // "tiles" attribute (a scanline file may carry one as any other attribute: sizing its lines'
+  // buffers by its tiles let a fuzzed file through to a 2.1 GB allocation).
   int64_t window_w = 0, window_h = 0;
   uint32_t tile_w = 0, tile_h = 0, level_mode = 0;
-  bool tiled = false;
+  const bool tiled = (flags & kExrTiled) != 0;
+  bool has_tiles = false;
   // The channels' bytes per pixel (half: 2, float and uint: 4; subsampling ignored, which only
   // overestimates) and the compression, for the decode buffers' sizes.
+  // A file without a "compression" attribute is read as ZIP, OpenEXR's Header() default, 16
+  // lines per chunk (a fuzzed file whose attribute name was altered hid its 2.1 GB this way).
   uint64_t sample_bytes = 0;
-  uint32_t compression = 0;
+  uint32_t compression = 3;
   while (true) {
     if (pos >= head_size)
       throw ImageIoError(path + ": the header is truncated or larger than " + std::to_string(kMaxExrHeaderBytes) + " bytes");
     if (head[pos] == 0) {
+      if (tiled && !has_tiles) throw ImageIoError(path + ": a tiled file without a tile description");
       check_tile_count(tiled, window_w, window_h, tile_w, tile_h, level_mode, path);
       check_buffer_sizes(tiled, window_w, window_h, tile_w, tile_h, sample_bytes, compression, file_size, path);
       return flags;
@@ -136,7 +143,7 @@ uint32_t check_exr_header(const uint8_t* head, size_t head_size, uint64_t file_s
       } else if (available == size_t(size) && name == "compression" && type == "compression") {
         compression = value[0];
       } else if (available == size_t(size) && name == "tiles" && type == "tiledesc") {
-        tiled = true;
+        has_tiles = true;
         tile_w = le32(value);
         tile_h = le32(value + 4);
         level_mode = value[8] & 0x0fu;

@@ -14,7 +14,7 @@ namespace penumbra {
 // The file's first bytes the walk reads at most; a header beyond them is refused.
 constexpr size_t kMaxExrHeaderBytes = size_t(1) << 20;
 // Flags of the version field (OpenEXR file layout).
-constexpr uint32_t kExrDeep = 0x800, kExrMultiPart = 0x1000;
+constexpr uint32_t kExrTiled = 0x200, kExrDeep = 0x800, kExrMultiPart = 0x1000;
 
 // Walks the single-part header in `head` (the file's first min(size, kMaxExrHeaderBytes) bytes;
 // `file_size` the whole file's) and throws ImageIoError("<path>: ...") for a file that is not an

@@ -93,9 +93,11 @@ class BounceSamples {
   void compute() {
     scrambled_sobol_batch(paths_ * size_t(per_path_), index_.data(), seed_index_.data(), seed_x_.data(),
                           seed_y_.data(), x_.data(), y_.data());
+    // data() + q, not &v[q]: a step with no paths has empty vectors (q = 0).
     for (uint32_t bits = computed_; bits; bits &= bits - 1) {
       const size_t q = size_t(pair_index(std::countr_zero(bits))) * stride_;
-      scrambled_sobol_z_batch(paths_, path_index_.data(), &z_seed_index_[q], &z_seed_[q], &z_[q]);
+      scrambled_sobol_z_batch(paths_, path_index_.data(), z_seed_index_.data() + q, z_seed_.data() + q,
+                              z_.data() + q);
     }
   }
   const float* x(size_t path) const { return x_.data() + path * size_t(per_path_); }

@@ -128,6 +128,31 @@ TEST(ExrWindowFile, FilesThatAreNotWindowsAreErrorsNamingTheFile) {
   };
   expect_error(with_window_coordinate(2, 1 << 29), "would take");              // max.x
   expect_error(with_window_coordinate(3, 1 << 29), "offset table is larger than the file");  // max.y
+  // A scanline file is read as lines whatever attributes it carries: a "tiles" attribute (2^16 x 1
+  // tiles) must not stand in for its lines' buffers (found by the fuzzer, 2.1 GB).
+  auto with_tiles = [](std::vector<uint8_t> out, uint32_t flags_byte1) {
+    std::vector<uint8_t> tiles;
+    for (char ch : std::string("tiles\0tiledesc\0", 15)) tiles.push_back(uint8_t(ch));
+    for (int b : {9, 0, 0, 0, 0, 0, 1, 0, 1, 0, 0, 0, 0}) tiles.push_back(uint8_t(b));
+    out.insert(out.begin() + 8, tiles.begin(), tiles.end());
+    out[5] = uint8_t(flags_byte1);
+    return out;
+  };
+  expect_error(with_tiles(with_window_coordinate(2, 1 << 20), 0x00), "chunk of lines");
+  // Without a "compression" attribute OpenEXR reads ZIP, 16 lines per chunk (the fuzzer's file
+  // had its attribute's name altered): a 2^20-pixel-wide window, fine uncompressed line by line,
+  // needs 16 lines' buffers.
+  std::vector<uint8_t> unnamed = with_window_coordinate(2, 1 << 20);
+  const std::string compression_key("compression\0compression\0", 24);
+  const auto named = std::search(unnamed.begin(), unnamed.end(), compression_key.begin(), compression_key.end());
+  ASSERT_NE(named, unnamed.end());
+  named[1] = 'x';
+  expect_error(unnamed, "chunk of lines");
+  // A file flagged tiled is read as tiles, and needs their description.
+  expect_error(with_tiles(good, 0x02), "");
+  std::vector<uint8_t> untiled_flagged = good;
+  untiled_flagged[5] |= 0x02;
+  expect_error(untiled_flagged, "tiled file without a tile description");
   std::vector<uint8_t> deep = good;
   deep[5] |= 0x08;  // the deep-data flag of the version field
   expect_error(deep, "multi-part or deep");
