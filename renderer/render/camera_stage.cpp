@@ -14,23 +14,24 @@ void CameraStage::generate(PathBatch& batch) {
     for (auto* v : {&film_x_, &film_y_, &lens_x_, &lens_y_, &time_}) v->resize(n);
     for (auto& v : rays_) v.resize(n);
   }
-  // The camera's dimensions, in the scalar loop's order: film, lens, time.
-  const int dims = 1 + int(sample_lens_) + int(sample_time_);
-  samples_.start(n, dims);
+  // The camera's dimensions in take_camera_sample's order (camera_sample.h); with motion the
+  // time is the 1D value of the film's pair.
+  const int dims = camera_sample_dimensions(sample_lens_, sample_time_);
+  const uint32_t pair = sample_time_ ? 1u << kCameraTimeDimension : 0u;
+  samples_.start(n, dims, pair, pair);
   for (const Queued& q : queued_) samples_.add(*q.sampler, Sampler::Cursor{q.index, 0});
   samples_.compute();
-  // The values in the order the scalar loop takes them: film (2D), lens (2D), time (1D).
-  const int lens_dim = 1, time_dim = sample_lens_ ? 2 : 1;
+  const int film_dim = camera_film_dimension(sample_time_), lens_dim = camera_lens_dimension(sample_time_);
   for (size_t i = 0; i < n; ++i) {
     const Queued& q = queued_[i];
     const float* x = samples_.x(i);
     const float* y = samples_.y(i);
-    const vec2 film = vec2(float(q.x), float(q.y)) + vec2(x[0], y[0]);
+    const vec2 film = vec2(float(q.x), float(q.y)) + vec2(x[film_dim], y[film_dim]);
     film_x_[i] = film.x;
     film_y_[i] = film.y;
     lens_x_[i] = sample_lens_ ? x[lens_dim] : 0.5f;
     lens_y_[i] = sample_lens_ ? y[lens_dim] : 0.5f;
-    time_[i] = sample_time_ ? x[time_dim] : 0.f;
+    time_[i] = sample_time_ ? samples_.z(i)[0] : 0.f;
   }
   float* const out[6] = {rays_[0].data(), rays_[1].data(), rays_[2].data(),
                          rays_[3].data(), rays_[4].data(), rays_[5].data()};

@@ -2,10 +2,11 @@
 // The wavefront driver's camera stage: a batch's camera samples queued, then their sampler
 // dimensions (sobol_batch.h) and rays (ThinLensCamera::generate_rays) computed for all of them
 // at once, and handed to the PathBatch. Per sample the values and rays are those of the scalar
-// loop's start_pixel_sample, get_2d (film), get_2d (lens), get_1d (time), generate_ray, to the bit.
+// loop's start_pixel_sample, take_camera_sample (camera_sample.h), generate_ray, to the bit.
 #include <cstdint>
 #include <vector>
 
+#include "renderer/render/camera_sample.h"
 #include "renderer/render/thin_lens_camera.h"
 #include "renderer/render/wavefront_integrator.h"
 #include "renderer/sampling/sobol_batch.h"

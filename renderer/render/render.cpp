@@ -16,6 +16,7 @@
 #include "renderer/denoise/denoise_result.h"
 #include "renderer/render/output_layers.h"
 #include "renderer/render/pass_plan.h"
+#include "renderer/render/camera_sample.h"
 #include "renderer/render/camera_stage.h"
 #include "renderer/render/thin_lens_camera.h"
 #include "renderer/render/wavefront_integrator.h"
@@ -231,10 +232,8 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
           // sampler, then its ray.
           auto camera_ray = [&](Sampler& sampler, int x, int y, uint32_t s) {
             sampler.start_pixel_sample(x, y, s);
-            const vec2 film_pos = vec2(float(x), float(y)) + sampler.get_2d();
-            const vec2 lens = sample_lens ? sampler.get_2d() : vec2(0.5f);
-            const float time = sample_time ? sampler.get_1d() : 0.f;
-            const CameraRay cr = camera.generate_ray(film_pos, lens, time);
+            const CameraSample cs = take_camera_sample(sampler, sample_lens, sample_time);
+            const CameraRay cr = camera.generate_ray(vec2(float(x), float(y)) + cs.film, cs.lens, cs.time);
             return Ray{cr.origin, cr.direction, cr.time};
           };
           // The item's samples in order: each pixel's next samples of this pass, up to its limit.

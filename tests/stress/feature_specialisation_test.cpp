@@ -5,6 +5,7 @@
 
 #include <cstring>
 
+#include "renderer/render/camera_sample.h"
 #include "renderer/render/integrator.h"
 #include "renderer/sampling/sampler.h"
 #include "renderer/scene/scene.h"
@@ -29,10 +30,8 @@ Image render_generic(const Scene& scene, const RenderSettings& s) {
       int n = 0;
       for (int i = 0; i < s.spp; ++i) {
         sampler.start_pixel_sample(x, y, uint32_t(i));
-        const vec2 film = vec2(float(x), float(y)) + sampler.get_2d();
-        const vec2 lens = scene.features().lens ? sampler.get_2d() : vec2(0.5f);
-        const float time = scene.features().motion ? sampler.get_1d() : 0.f;
-        const CameraRay cr = camera.generate_ray(film, lens, time);
+        const CameraSample cs = take_camera_sample(sampler, scene.features().lens, scene.features().motion);
+        const CameraRay cr = camera.generate_ray(vec2(float(x), float(y)) + cs.film, cs.lens, cs.time);
         const Spectrum L = integrate(scene, is, Ray{cr.origin, cr.direction, cr.time}, sampler, counters, nullptr);
         if (!is_finite(L)) continue;
         for (int c = 0; c < 3; ++c) sum[c] += double(L[c]);
