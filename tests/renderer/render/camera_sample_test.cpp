@@ -12,7 +12,8 @@ namespace {
 // With motion, a pixel's first 2^m samples of (time, film x, film y) form a (1, m, 3)-net: every
 // elementary box of volume 2^-(m-1) holds two of them, so where a moving edge crosses a pixel
 // the times are stratified within each part of the pixel, not paired with its positions at
-// random. Lens and the next dimension (the first bounce's) follow the camera's.
+// random. The sample takes exactly camera_sample_dimensions() dimensions, where CameraStage
+// starts each path's first bounce.
 TEST(CameraSample, TimeAndFilmPositionAreOne3DNet) {
   constexpr int m = 8, n = 1 << m;
   for (bool lens : {false, true}) {
