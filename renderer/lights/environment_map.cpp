@@ -1,5 +1,7 @@
 #include "renderer/lights/environment_map.h"
 
+#include "renderer/core/arc_tangent.h"
+#include "renderer/core/simd_clones.h"
 #include "renderer/sampling/sampling.h"
 
 namespace penumbra {
@@ -15,21 +17,11 @@ constexpr float kMinSinTheta = 1e-9f;
 
 float clean(float v) { return std::isfinite(v) && v > 0.f ? v : 0.f; }
 
-// A sample of [0, 1] with density proportional to (1 - x) a + x b, 0 <= a, b <= 2 (pbrt-v4
-// SampleLinear): the root of the CDF's quadratic in the form that stays accurate for a << b.
-float sample_linear(float u, float a, float b) {
-  if (!(a + b > 0.f)) return u;  // both zero: no shape to follow (its density is 0 anyway)
-  if (u == 0.f && a == 0.f) return 0.f;
-  const float x = u * (a + b) / (a + std::sqrt((1.f - u) * a * a + u * b * b));
-  return std::min(x, kOneMinusEpsilon);
-}
-
 // Density on the unit square, proportional to the bilinear interpolant of the four corners.
-float bilinear_pdf(float x, float y, float w00, float w10, float w01, float w11) {
+inline float bilinear_pdf(float x, float y, float w00, float w10, float w01, float w11) {
   const float sum = w00 + w10 + w01 + w11;
-  if (!(sum > 0.f)) return 0.f;
   const float v = (1.f - x) * (1.f - y) * w00 + x * (1.f - y) * w10 + (1.f - x) * y * w01 + x * y * w11;
-  return 4.f * v / sum;
+  return sum > 0.f ? 4.f * v / sum : 0.f;
 }
 
 // The end of every sample: a usable density, and the fields of a direction from infinity.
@@ -42,18 +34,6 @@ bool finish_sample(LightSample* out) {
 }
 
 }  // namespace
-
-vec2 EnvironmentMap::direction_to_uv(const vec3& d) {
-  float u = std::atan2(d.x, -d.z) * kInv2Pi;
-  if (u < 0.f) u += 1.f;
-  return vec2(u, std::acos(std::clamp(d.y, -1.f, 1.f)) * kInvPi);
-}
-
-vec3 EnvironmentMap::uv_to_direction(const vec2& uv) {
-  const float theta = uv.y * kPi, phi = uv.x * (2.f * kPi);
-  const float sin_theta = std::sin(theta);
-  return vec3(std::sin(phi) * sin_theta, std::cos(theta), -std::cos(phi) * sin_theta);
-}
 
 EnvironmentMap::EnvironmentMap(const EnvironmentMapDesc& desc)
     : uniform_sampling_(desc.uniform_sampling) {
@@ -119,35 +99,144 @@ EnvironmentMap::Corners EnvironmentMap::corners(int x, int y) const {
           luminance(texel(x1, y + 1)) * s1};
 }
 
-Spectrum EnvironmentMap::lookup(const vec2& uv) const {
-  // Texel centres at u = (x + 0.5) / width; the seam wraps.
-  const float fx = uv.x * float(width_) - 0.5f;
-  const float x_floor = std::floor(fx);
-  const float tx = fx - x_floor;
-  // u in [0, 1] puts x0 in [-1, width - 1]: one wrap at most, without the two integer divisions
-  // of a modulo (measured 1/5 of the lookup's time). Anything else (not from a direction) still
-  // wraps by the modulo.
-  int x0 = int(x_floor);
-  if (x0 < 0) x0 += width_;
-  if (x0 < 0 || x0 >= width_) {
-    x0 = int(x_floor) % width_;
-    if (x0 < 0) x0 += width_;
-  }
-  const int x1 = x0 + 1 == width_ ? 0 : x0 + 1;
-  // Rows at v = y / (height - 1).
-  const float fy = std::clamp(uv.y, 0.f, 1.f) * float(height_ - 1);
-  const int y0 = std::min(int(fy), height_ - 2);
-  const float ty = fy - float(y0);
-  const Spectrum top = texel(x0, y0) * (1.f - tx) + texel(x1, y0) * tx;
-  const Spectrum bottom = texel(x0, y0 + 1) * (1.f - tx) + texel(x1, y0 + 1) * tx;
-  return top * (1.f - ty) + bottom * ty;
+Spectrum EnvironmentMap::lookup(const TexelSpot& t) const {
+  const Spectrum top = texel(t.x0, t.y0) * (1.f - t.tx) + texel(t.x1, t.y0) * t.tx;
+  const Spectrum bottom = texel(t.x0, t.y0 + 1) * (1.f - t.tx) + texel(t.x1, t.y0 + 1) * t.tx;
+  return top * (1.f - t.ty) + bottom * t.ty;
 }
+
+// The maps' arithmetic over a chunk of lanes, in structure-of-arrays form so that GCC vectorises
+// it (target clones); the texel and distribution loads between the kernels stay scalar loops
+// (the lanes' cells are scattered: a gather is no faster than the loads). Every scalar entry
+// point runs the same kernels on one lane, so a path's bits do not depend on the driver.
+namespace {
+
+constexpr size_t kChunk = 64;
+
+struct MapShape {
+  glm::mat3 to_world, to_local;
+  int width, height;
+  float half_texel;
+};
+
+// The lanes of radiance_and_pdf_many, after `locate`.
+struct LocatedLanes {
+  float sin_theta[kChunk];
+  int cx[kChunk], cy[kChunk];  // the density's cell and the place in it
+  float fx[kChunk], fy[kChunk];
+  int x0[kChunk], x1[kChunk], y0[kChunk];  // the lookup's texels and weights
+  float tx[kChunk], ty[kChunk];
+};
+
+// Each direction's lat-long coordinates, the cell of the distribution holding it (the one
+// distribution_.pdf would find: cell coordinates start half a texel right of u) and the texels
+// of its bilinear lookup.
+PENUMBRA_SIMD_CLONES
+void locate_kernel(size_t m, const vec3* __restrict dirs, const MapShape& __restrict shape,
+                   LocatedLanes* __restrict out) {
+  const int nu = shape.width, nv = shape.height - 1;
+  for (size_t k = 0; k < m; ++k) {
+    const vec3 d = shape.to_local * dirs[k];
+    const vec2 uv = EnvironmentMap::direction_to_uv(d);
+    float s = uv.x - shape.half_texel;
+    s = s < 0.f ? s + 1.f : s;
+    out->sin_theta[k] = std::sqrt(d.x * d.x + d.z * d.z);
+    // cell_point; NaN (from a NaN direction) is read at cell 0.
+    const float sx = s >= 0.f ? s * float(nu) : 0.f, sy = uv.y >= 0.f ? uv.y * float(nv) : 0.f;
+    const int cx = std::clamp(int(std::min(sx, float(nu))), 0, nu - 1);
+    const int cy = std::clamp(int(std::min(sy, float(nv))), 0, nv - 1);
+    out->cx[k] = cx;
+    out->cy[k] = cy;
+    out->fx[k] = std::clamp(sx - float(cx), 0.f, 1.f);
+    out->fy[k] = std::clamp(sy - float(cy), 0.f, 1.f);
+    const EnvironmentMap::TexelSpot t = EnvironmentMap::texel_spot(uv.x, uv.y, shape.width, shape.height);
+    out->x0[k] = t.x0;
+    out->x1[k] = t.x1;
+    out->y0[k] = t.y0;
+    out->tx[k] = t.tx;
+    out->ty[k] = t.ty;
+  }
+}
+
+// The lanes of sample_many's last stage.
+struct CellLanes {
+  int cx[kChunk], cy[kChunk];
+  float fx[kChunk], fy[kChunk];  // the uniform point in the cell
+  float w00[kChunk], w10[kChunk], w01[kChunk], w11[kChunk];  // the cell's corners
+  float pdf_cell[kChunk];
+};
+struct WarpedLanes {
+  int32_t ok[kChunk];  // 0 or 1: as wide as the floats, so the loop's masks need no conversion
+  float wx[kChunk], wy[kChunk], wz[kChunk], pdf[kChunk];
+  int x0[kChunk], x1[kChunk], y0[kChunk];
+  float tx[kChunk], ty[kChunk];
+};
+
+// A sample of [0, 1] with density proportional to (1 - x) a + x b, 0 <= a, b <= 2 (pbrt-v4
+// SampleLinear): the root of the CDF's quadratic in the form that stays accurate for a << b;
+// a = b = 0 has no shape to follow (its density is 0 anyway) and keeps u.
+inline float sample_linear(float u, float a, float b) {
+  const float x = std::min(u * (a + b) / (a + std::sqrt((1.f - u) * a * a + u * b * b)), kOneMinusEpsilon);
+  return !(a + b > 0.f) ? u : (u == 0.f && a == 0.f ? 0.f : x);
+}
+
+// GCC's tree PRE merges the lane's validity tests into selects between booleans of different
+// widths, which its vectoriser refuses (as the metallic-roughness kernel's, surface_stage.cpp):
+// without it the loop vectorises.
+#if defined(__GNUC__) && !defined(__clang__)
+#define PENUMBRA_WARP_NO_TREE_PRE __attribute__((optimize("no-tree-pre")))
+#else
+#define PENUMBRA_WARP_NO_TREE_PRE
+#endif
+
+// The bilinear warp within each cell (its density follows the bilinear interpolant of the
+// corners), the direction, its density and the texels of its radiance lookup.
+PENUMBRA_SIMD_CLONES PENUMBRA_WARP_NO_TREE_PRE
+void warp_kernel(size_t m, const CellLanes& __restrict in, const MapShape& __restrict shape,
+                 WarpedLanes* __restrict out) {
+  for (size_t k = 0; k < m; ++k) {
+    const float pdf_cell = in.pdf_cell[k];
+    // The warp depends only on the corners' ratios: scaled to at most 1, their squares cannot
+    // overflow (texels up to 1e30 are allowed).
+    const float top = std::max(std::max(in.w00[k], in.w10[k]), std::max(in.w01[k], in.w11[k]));
+    const bool usable = pdf_cell > 0.f && top > 0.f;
+    const float inv = usable ? 1.f / top : 0.f;
+    const float c00 = in.w00[k] * inv, c10 = in.w10[k] * inv, c01 = in.w01[k] * inv, c11 = in.w11[k] * inv;
+    const float fy = sample_linear(in.fy[k], c00 + c10, c01 + c11);
+    const float fx = sample_linear(in.fx[k], (1.f - fy) * c00 + fy * c01, (1.f - fy) * c10 + fy * c11);
+    const float pdf_uv = pdf_cell * bilinear_pdf(fx, fy, c00, c10, c01, c11);
+    float u = (float(in.cx[k]) + fx) / float(shape.width) + shape.half_texel;
+    u = u >= 1.f ? u - 1.f : u;
+    const float v = std::min((float(in.cy[k]) + fy) / float(shape.height - 1), 1.f);
+    float sin_theta, cos_theta;
+    sincos_two_pi(0.5f * v, &sin_theta, &cos_theta);  // theta = pi v
+    const vec3 wi = shape.to_world * EnvironmentMap::uv_to_direction(u, sin_theta, cos_theta);
+    const float pdf = pdf_uv * kInv2PiSquared / sin_theta;
+    out->ok[k] = usable && pdf_uv > 0.f && sin_theta > kMinSinTheta && pdf > 0.f && std::isfinite(pdf) ? 1 : 0;
+    out->wx[k] = wi.x;
+    out->wy[k] = wi.y;
+    out->wz[k] = wi.z;
+    out->pdf[k] = pdf;
+    const EnvironmentMap::TexelSpot t = EnvironmentMap::texel_spot(u, v, shape.width, shape.height);
+    out->x0[k] = t.x0;
+    out->x1[k] = t.x1;
+    out->y0[k] = t.y0;
+    out->tx[k] = t.tx;
+    out->ty[k] = t.ty;
+  }
+}
+
+}  // namespace
 
 Spectrum EnvironmentMap::radiance(const vec3& dir) const {
-  return lookup(direction_to_uv(to_local_ * dir));
+  const uint8_t want = 0;
+  Spectrum r;
+  float p;
+  radiance_and_pdf_many(1, &dir, &want, &r, &p);
+  return r;
 }
 
-bool EnvironmentMap::sample(const vec3&, float, const vec2& u, LightSample* out) const {
+bool EnvironmentMap::sample(const vec3& ref, float time, const vec2& u, LightSample* out) const {
   if (is_black()) return false;
   if (uniform_sampling_) {
     out->wi = square_to_uniform_sphere(u);
@@ -155,9 +244,9 @@ bool EnvironmentMap::sample(const vec3&, float, const vec2& u, LightSample* out)
     out->value = radiance(out->wi);
     return finish_sample(out);
   }
-  float pdf_cell = 0.f;
-  const vec2 st = distribution_.sample(u, &pdf_cell);
-  return sample_in_cell(st, pdf_cell, out);
+  bool ok = false;
+  sample_many(1, &ref, &time, &u, out, &ok);
+  return ok;
 }
 
 void EnvironmentMap::sample_many(size_t n, const vec3* refs, const float* times, const vec2* u,
@@ -166,54 +255,41 @@ void EnvironmentMap::sample_many(size_t n, const vec3* refs, const float* times,
   // The chain of one sample (marginal search, the row's search, the cell's texels) is a series
   // of dependent loads; each stage's loads are independent across samples, so the processor
   // overlaps them. Chunks keep the stages' state on the stack.
-  constexpr size_t kChunk = 64;
+  const MapShape shape{to_world_, to_local_, width_, height_, half_texel_};
   for (size_t k0 = 0; k0 < n; k0 += kChunk) {
     const size_t m = std::min(kChunk, n - k0);
     int row[kChunk], column[kChunk];
     float v[kChunk], x[kChunk];
-    CellPoint q[kChunk];
-    Corners c[kChunk];
-    float pdf_cell[kChunk];
+    CellLanes cells;
+    WarpedLanes warped;
     for (size_t k = 0; k < m; ++k) v[k] = distribution_.sample_row(u[k0 + k].y, &row[k]);
+    for (size_t k = 0; k < m; ++k) distribution_.prefetch_column(row[k], u[k0 + k].x);
     for (size_t k = 0; k < m; ++k) x[k] = distribution_.sample_column(row[k], u[k0 + k].x, &column[k]);
     for (size_t k = 0; k < m; ++k) {
-      pdf_cell[k] = distribution_.cell_pdf(column[k], row[k]);
-      q[k] = cell_point(vec2(x[k], v[k]));
-      c[k] = corners(q[k].x, q[k].y);
+      distribution_.prefetch_cell(column[k], row[k]);
+      __builtin_prefetch(&texel(column[k], row[k]));
+      __builtin_prefetch(&texel(column[k], row[k] + 1));
     }
-    for (size_t k = 0; k < m; ++k) ok[k0 + k] = sample_in_cell(q[k], c[k], pdf_cell[k], &out[k0 + k]);
+    for (size_t k = 0; k < m; ++k) {
+      cells.pdf_cell[k] = distribution_.cell_pdf(column[k], row[k]);
+      // A uniform point of the cell (its row and column were drawn independently), which the
+      // bilinear warp then reshapes.
+      const CellPoint q = cell_point(vec2(x[k], v[k]));
+      const Corners c = corners(q.x, q.y);
+      cells.cx[k] = q.x, cells.cy[k] = q.y, cells.fx[k] = q.fx, cells.fy[k] = q.fy;
+      cells.w00[k] = c.w00, cells.w10[k] = c.w10, cells.w01[k] = c.w01, cells.w11[k] = c.w11;
+    }
+    warp_kernel(m, cells, shape, &warped);
+    for (size_t k = 0; k < m; ++k) {
+      LightSample& s = out[k0 + k];
+      ok[k0 + k] = warped.ok[k] != 0;
+      if (!warped.ok[k]) continue;
+      s.wi = vec3(warped.wx[k], warped.wy[k], warped.wz[k]);
+      s.pdf = warped.pdf[k];
+      s.value = lookup(TexelSpot{warped.x0[k], warped.x1[k], warped.y0[k], warped.tx[k], warped.ty[k]});
+      finish_sample(&s);
+    }
   }
-}
-
-bool EnvironmentMap::sample_in_cell(const vec2& st, float pdf_cell, LightSample* out) const {
-  // The cell, and where in it the sample fell: a uniform point of the cell (its row and column
-  // were drawn independently), which the bilinear warp then reshapes.
-  if (!(pdf_cell > 0.f)) return false;
-  const CellPoint q = cell_point(st);
-  return sample_in_cell(q, corners(q.x, q.y), pdf_cell, out);
-}
-
-bool EnvironmentMap::sample_in_cell(const CellPoint& q, Corners c, float pdf_cell,
-                                    LightSample* out) const {
-  if (!(pdf_cell > 0.f)) return false;
-  // The warp depends only on the corners' ratios: scaled to at most 1, their squares cannot
-  // overflow (texels up to 1e30 are allowed).
-  const float top = std::max(std::max(c.w00, c.w10), std::max(c.w01, c.w11));
-  if (!(top > 0.f)) return false;
-  const float inv = 1.f / top;
-  c = {c.w00 * inv, c.w10 * inv, c.w01 * inv, c.w11 * inv};
-  const float fy = sample_linear(q.fy, c.w00 + c.w10, c.w01 + c.w11);
-  const float fx = sample_linear(q.fx, (1.f - fy) * c.w00 + fy * c.w01, (1.f - fy) * c.w10 + fy * c.w11);
-  const float pdf_uv = pdf_cell * bilinear_pdf(fx, fy, c.w00, c.w10, c.w01, c.w11);
-  vec2 uv((float(q.x) + fx) / float(width_) + half_texel_,
-          std::min((float(q.y) + fy) / float(height_ - 1), 1.f));
-  if (uv.x >= 1.f) uv.x -= 1.f;
-  const float sin_theta = std::sin(uv.y * kPi);
-  if (!(pdf_uv > 0.f) || !(sin_theta > kMinSinTheta)) return false;
-  out->wi = to_world_ * uv_to_direction(uv);
-  out->pdf = pdf_uv * kInv2PiSquared / sin_theta;
-  out->value = lookup(uv);
-  return finish_sample(out);
 }
 
 EnvironmentMap::CellPoint EnvironmentMap::cell_point(const vec2& st) const {
@@ -226,49 +302,51 @@ EnvironmentMap::CellPoint EnvironmentMap::cell_point(const vec2& st) const {
 float EnvironmentMap::pdf(const vec3& dir) const {
   if (is_black()) return 0.f;
   if (uniform_sampling_) return uniform_sphere_pdf();
-  const vec3 d = to_local_ * dir;
-  return pdf_local(d, direction_to_uv(d));
+  float p = 0.f;
+  radiance_and_pdf(dir, &p);
+  return p;
 }
 
 Spectrum EnvironmentMap::radiance_and_pdf(const vec3& dir, float* pdf) const {
-  const vec3 d = to_local_ * dir;
-  const vec2 uv = direction_to_uv(d);
-  if (pdf) *pdf = pdf_local(d, uv);
-  return lookup(uv);
+  const uint8_t want = pdf ? 1 : 0;
+  Spectrum r;
+  float p = 0.f;
+  radiance_and_pdf_many(1, &dir, &want, &r, &p);
+  if (pdf) *pdf = p;
+  return r;
 }
 
 void EnvironmentMap::radiance_and_pdf_many(size_t n, const vec3* dirs, const uint8_t* want_pdf,
                                            Spectrum* radiance, float* pdf) const {
-  constexpr size_t kChunk = 64;
+  const MapShape shape{to_world_, to_local_, width_, height_, half_texel_};
+  // The density: 0 for a black map, the sphere's for uniform sampling, else the bilinear density
+  // of the direction's cell (pbrt-v3 §14.2.4's Jacobian 1 / (2 pi^2 sin theta) per steradian; 0
+  // within kMinSinTheta of a pole, as sample() draws nothing there).
+  const int density = is_black() ? 0 : uniform_sampling_ ? 1 : 2;
   for (size_t k0 = 0; k0 < n; k0 += kChunk) {
     const size_t m = std::min(kChunk, n - k0);
-    vec3 d[kChunk];
-    vec2 uv[kChunk];
+    LocatedLanes lanes;
+    locate_kernel(m, dirs + k0, shape, &lanes);
     for (size_t k = 0; k < m; ++k) {
-      d[k] = to_local_ * dirs[k0 + k];
-      uv[k] = direction_to_uv(d[k]);
+      if (density == 2 && want_pdf[k0 + k]) distribution_.prefetch_cell(lanes.cx[k], lanes.cy[k]);
+      __builtin_prefetch(&texel(lanes.x0[k], lanes.y0[k]));
+      __builtin_prefetch(&texel(lanes.x0[k], lanes.y0[k] + 1));
     }
     for (size_t k = 0; k < m; ++k) {
-      if (want_pdf[k0 + k]) pdf[k0 + k] = pdf_local(d[k], uv[k]);
-      radiance[k0 + k] = lookup(uv[k]);
+      if (want_pdf[k0 + k]) {
+        float p = density == 1 ? uniform_sphere_pdf() : 0.f;
+        const float pdf_cell = density == 2 ? distribution_.cell_pdf(lanes.cx[k], lanes.cy[k]) : 0.f;
+        if (pdf_cell > 0.f && lanes.sin_theta[k] > kMinSinTheta) {
+          const Corners c = corners(lanes.cx[k], lanes.cy[k]);
+          p = pdf_cell * bilinear_pdf(lanes.fx[k], lanes.fy[k], c.w00, c.w10, c.w01, c.w11) *
+              kInv2PiSquared / lanes.sin_theta[k];
+          p = std::isfinite(p) ? p : 0.f;
+        }
+        pdf[k0 + k] = p;
+      }
+      radiance[k0 + k] = lookup(TexelSpot{lanes.x0[k], lanes.x1[k], lanes.y0[k], lanes.tx[k], lanes.ty[k]});
     }
   }
-}
-
-float EnvironmentMap::pdf_local(const vec3& d, const vec2& uv) const {
-  if (is_black()) return 0.f;
-  if (uniform_sampling_) return uniform_sphere_pdf();
-  float s = uv.x - half_texel_;
-  if (s < 0.f) s += 1.f;
-  const float sin_theta = std::sqrt(d.x * d.x + d.z * d.z);
-  if (!(sin_theta > kMinSinTheta)) return 0.f;
-  // The point's cell (the one distribution_.pdf would find) and its place in it.
-  const CellPoint q = cell_point(vec2(s, uv.y));
-  const float pdf_cell = distribution_.cell_pdf(q.x, q.y);
-  if (!(pdf_cell > 0.f)) return 0.f;
-  const Corners c = corners(q.x, q.y);
-  const float p = pdf_cell * bilinear_pdf(q.fx, q.fy, c.w00, c.w10, c.w01, c.w11) * kInv2PiSquared / sin_theta;
-  return std::isfinite(p) ? p : 0.f;
 }
 
 float EnvironmentMap::power(float scene_radius) const {

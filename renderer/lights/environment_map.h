@@ -11,9 +11,13 @@
 //    within it from the bilinear interpolant of its corners' luminance x sin(theta) (pbrt-v4
 //    SampleBilinear, §A.3.2) -- the shape of the bilinear radiance itself, so a cell half lit by
 //    the sun's edge gets its samples where the light is.
+#include <algorithm>
+#include <cmath>
 #include <vector>
 
+#include "renderer/core/arc_tangent.h"
 #include "renderer/lights/environment_light.h"
+#include "renderer/sampling/sampling.h"
 #include "renderer/sampling/distribution_2d.h"
 #include "renderer/scene/scene_input.h"
 
@@ -25,7 +29,9 @@ class EnvironmentMap final : public EnvironmentLight {
   explicit EnvironmentMap(const EnvironmentMapDesc& desc);
 
   bool sample(const vec3& ref, float time, const vec2& u, LightSample* out) const override;
-  // In three stages over all n: every sample's row, then every column, then the rest.
+  // In stages over chunks of samples: every sample's row, then every column, then the cells'
+  // loads, the warp within the cells in SIMD lanes, and the radiance lookups. sample() is this
+  // on one sample.
   void sample_many(size_t n, const vec3* refs, const float* times, const vec2* u, LightSample* out,
                    bool* ok) const override;
   // Like ConstantEnvironment: the radiance integral over the sphere onto the scene's bounding
@@ -35,7 +41,9 @@ class EnvironmentMap final : public EnvironmentLight {
   float pdf(const vec3& dir) const override;
   Spectrum radiance_and_pdf(const vec3& dir, float* pdf) const override;
   bool prefers_many() const override { return true; }
-  // In two stages: every direction's lat-long coordinates, then every texel lookup and density.
+  // In two stages over chunks: every direction's lat-long coordinates, cell and texels in SIMD
+  // lanes, then every texel lookup and density. radiance(), pdf() and radiance_and_pdf() are
+  // this on one direction.
   void radiance_and_pdf_many(size_t n, const vec3* dirs, const uint8_t* want_pdf, Spectrum* radiance,
                              float* pdf) const override;
 
@@ -44,22 +52,23 @@ class EnvironmentMap final : public EnvironmentLight {
   // Nothing to emit (every texel black, or scale 0): the scene build leaves such a map out.
   bool is_black() const { return !(integral_ > 0.0); }
 
+  // Where a bilinear lookup at (u, v) in [0, 1]^2 reads: texels x0 and x1 (wrapping at the seam)
+  // of rows y0 and y0 + 1, with weights tx and ty.
+  struct TexelSpot {
+    int x0, x1, y0;
+    float tx, ty;
+  };
+  static TexelSpot texel_spot(float u, float v, int width, int height);
+
   // The lat-long coordinates of a map-space unit direction, u in [0, 1], v in [0, 1], and back.
   static vec2 direction_to_uv(const vec3& d);
+  // (Angles by inline arithmetic: atan2_inline, sincos_two_pi; theta = pi v, phi = 2 pi u.)
   static vec3 uv_to_direction(const vec2& uv);
+  static vec3 uv_to_direction(float u, float sin_theta, float cos_theta);
 
  private:
-  // Bilinear lookup at (u, v), as Mitsuba's EnvironmentMapEmitter::eval_spectrum.
-  Spectrum lookup(const vec2& uv) const;
-  // sample() from the point st of the distribution's cell (density pdf_cell) on: the bilinear
-  // warp within the cell, the direction, its radiance and density.
-  bool sample_in_cell(const vec2& st, float pdf_cell, LightSample* out) const;
-  struct CellPoint;
-  struct Corners;
-  // The same from the point's place in its cell and the cell's corners.
-  bool sample_in_cell(const CellPoint& q, Corners c, float pdf_cell, LightSample* out) const;
-  // pdf() of the map-space direction d whose lat-long coordinates are uv.
-  float pdf_local(const vec3& d, const vec2& uv) const;
+  // Bilinear lookup at the texels `t` names, as Mitsuba's EnvironmentMapEmitter::eval_spectrum.
+  Spectrum lookup(const TexelSpot& t) const;
   // The distribution's cell holding st (cell coordinates, u from texel x's centre) and st's place
   // within it, each in [0, 1]: where the bilinear warp starts and where its density is read.
   struct CellPoint {
@@ -85,5 +94,43 @@ class EnvironmentMap final : public EnvironmentLight {
   double integral_ = 0.0;
   bool uniform_sampling_ = false;
 };
+
+// Inline: the SIMD kernels of environment_map.cpp run them in their lanes.
+inline vec2 EnvironmentMap::direction_to_uv(const vec3& d) {
+  // theta = atan2(sin theta, cos theta) rather than acos(y): the same angle for a unit d, one
+  // function for both coordinates, and no loss of digits near the poles.
+  float u = atan2_inline(d.x, -d.z) * kInv2Pi;
+  if (u < 0.f) u += 1.f;
+  return vec2(u, atan2_inline(std::sqrt(d.x * d.x + d.z * d.z), d.y) * kInvPi);
+}
+
+inline vec3 EnvironmentMap::uv_to_direction(const vec2& uv) {
+  float sin_theta, cos_theta;
+  sincos_two_pi(0.5f * uv.y, &sin_theta, &cos_theta);  // theta = pi v
+  return uv_to_direction(uv.x, sin_theta, cos_theta);
+}
+
+inline vec3 EnvironmentMap::uv_to_direction(float u, float sin_theta, float cos_theta) {
+  float sin_phi, cos_phi;
+  sincos_two_pi(u, &sin_phi, &cos_phi);  // phi = 2 pi u
+  return vec3(sin_phi * sin_theta, cos_theta, -cos_phi * sin_theta);
+}
+
+// Where the bilinear lookup at (u, v) reads: texels x0, x1 of rows y0, y0 + 1, weights tx, ty
+// (Mitsuba's EnvironmentMapEmitter::eval_spectrum: texel x's centre at u = (x + 0.5) / width,
+// the seam wrapping; row y at v = y / (height - 1)). u and v are in [0, 1] here (from a
+// direction or a sample; anything else, NaN included, is read at 0), so x0 is in
+// [-1, width - 1] and wraps once at most.
+inline EnvironmentMap::TexelSpot EnvironmentMap::texel_spot(float u, float v, int width, int height) {
+  u = u >= 0.f && u <= 1.f ? u : 0.f;
+  v = v >= 0.f && v <= 1.f ? v : 0.f;
+  const float fx = u * float(width) - 0.5f;
+  const float x_floor = std::floor(fx);
+  int x0 = int(x_floor);
+  x0 = x0 < 0 ? x0 + width : x0;
+  const float fy = v * float(height - 1);
+  const int y0 = std::min(int(fy), height - 2);
+  return {x0, x0 + 1 == width ? 0 : x0 + 1, y0, fx - x_floor, fy - float(y0)};
+}
 
 }  // namespace penumbra

@@ -13,6 +13,7 @@
 // Robustness: negative or non-finite weights count as 0. A distribution whose weights are all
 // zero still samples (uniformly) but reports pdf 0 for every point, so a caller that divides by
 // the pdf must reject pdf == 0; nothing here divides by zero.
+#include <algorithm>
 #include <cstddef>
 #include <span>
 #include <vector>
@@ -93,8 +94,21 @@ class Distribution2D {
   float pdf(const vec2& p) const;
   // Density of cell (i, j), constant over it.
   float cell_pdf(int i, int j) const { return pdf_[size_t(j) * size_t(nu_) + size_t(i)]; }
+  // Hints that cell_pdf(i, j), or sample_column(row, u)'s first load, will be read soon: a caller
+  // with many samples issues them for all before it reads any, so their cache misses overlap.
+  void prefetch_cell(int i, int j) const { __builtin_prefetch(&pdf_[size_t(j) * size_t(nu_) + size_t(i)]); }
+  // (sample_column's search reads the row's guide entry for u first. A second hint for the CDF
+  // from there, once the entry is in cache, was measured and gains nothing more.)
+  void prefetch_column(int row, float u) const { __builtin_prefetch(&guide_[guide_index(row, u)]); }
 
  private:
+  // The guide entry of u in [0, 1) in row `row` (the one CdfSearch::find_cell reads first;
+  // anything else is clamped into the row).
+  size_t guide_index(int row, float u) const {
+    const size_t k = u > 0.f ? std::min(size_t(std::min(u, 1.f) * float(buckets_)), buckets_ - 1) : 0;
+    return size_t(row) * (buckets_ + 1) + k;
+  }
+
   int nu_ = 0, nv_ = 0;
   // The rows' conditional distributions, flat: row j's CDF is cdf_[j * (nu + 1) ...], its guide
   // guide_[j * (buckets + 1) ...]. One array per kind instead of a Distribution1D per row

@@ -27,12 +27,11 @@ inline void sincos_two_pi(float u, float* s, float* c) {
   const int k = int(t + std::copysign(0.5f, t));  // rounded half away from zero
   float a, b;
   sincos_quarter_pi((t - float(k)) * (kPi / 2.f), &a, &b);
-  switch (k & 3) {
-    case 0: *s = a, *c = b; break;
-    case 1: *s = b, *c = -a; break;
-    case 2: *s = -a, *c = -b; break;
-    default: *s = -b, *c = a; break;
-  }
+  // Quarter turns k & 3 = 0, 1, 2, 3: (s, c) = (a, b), (b, -a), (-a, -b), (-b, a), as selects
+  // (a loop over many angles vectorises).
+  const float s0 = (k & 1) ? b : a, c0 = (k & 1) ? a : b;
+  *s = (k & 2) ? -s0 : s0;
+  *c = ((k + 1) & 2) ? -c0 : c0;
 }
 
 // Shirley & Chiu 1997 concentric map, unit disk. The second wedge's angle pi/2 - t is folded
