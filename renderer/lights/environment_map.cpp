@@ -262,9 +262,11 @@ void EnvironmentMap::sample_many(size_t n, const vec3* refs, const float* times,
     float v[kChunk], x[kChunk];
     CellLanes cells;
     WarpedLanes warped;
-    for (size_t k = 0; k < m; ++k) v[k] = distribution_.sample_row(u[k0 + k].y, &row[k]);
-    for (size_t k = 0; k < m; ++k) distribution_.prefetch_column(row[k], u[k0 + k].x);
-    for (size_t k = 0; k < m; ++k) x[k] = distribution_.sample_column(row[k], u[k0 + k].x, &column[k]);
+    float ux[kChunk], uy[kChunk];
+    for (size_t k = 0; k < m; ++k) ux[k] = u[k0 + k].x, uy[k] = u[k0 + k].y;
+    distribution_.sample_rows(m, uy, row, v);
+    for (size_t k = 0; k < m; ++k) distribution_.prefetch_column(row[k], ux[k]);
+    distribution_.sample_columns(m, row, ux, column, x);
     for (size_t k = 0; k < m; ++k) {
       distribution_.prefetch_cell(column[k], row[k]);
       __builtin_prefetch(&texel(column[k], row[k]));

@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstdint>
+
+#include "renderer/core/simd_clones.h"
 
 namespace penumbra {
 namespace {
@@ -14,6 +17,78 @@ int cell_of(float x, size_t n) {
   const float scaled = x * float(n);
   if (!(scaled > 0.f)) return 0;  // also NaN
   return int(std::min(size_t(scaled), n - 1));
+}
+
+// CdfSearch::sample for many u at once, in SIMD lanes (target clones; the guide entries and CDF
+// values are gathers): lane k searches the CDF at cdf + cdf_base[k] (n + 1 values) through the
+// guide at guide + guide_base[k] (buckets + 1 entries); a null base array means 0 for all. The
+// search halves the guide's range `steps` times by selects -- steps is enough for the widest
+// range of the guide, and a lane whose range is already one cell wide keeps it -- then finishes
+// as CdfSearch::sample does, one step of its rounding fix-up included. The answer is the same
+// cell and x to the bit (the last cell whose CDF is <= u is unique, the arithmetic is
+// sample()'s); a lane outside that (u outside [0, 1) or NaN, a fix-up of more than one step)
+// is flagged in `redo` for the caller to take through CdfSearch::sample.
+PENUMBRA_SIMD_CLONES
+void cdf_sample_lanes(size_t m, const float* __restrict cdf, const int* __restrict guide,
+                      const int32_t* __restrict cdf_base, const int32_t* __restrict guide_base,
+                      int32_t n, int32_t buckets, int steps, const float* __restrict u,
+                      int32_t* __restrict cell, float* __restrict x, int32_t* __restrict redo) {
+  // (Loops over the lanes innermost, each its own pass: GCC vectorises only innermost loops.)
+  constexpr size_t kLanes = 64;  // m <= kLanes
+  int32_t cb[kLanes], first[kLanes], len[kLanes];
+  float uc[kLanes];
+  for (size_t k = 0; k < m; ++k) {
+    cb[k] = cdf_base ? cdf_base[k] : 0;
+    const int32_t gb = guide_base ? guide_base[k] : 0;
+    const float uk = u[k];
+    const bool in_range = uk >= 0.f && uk < 1.f;
+    uc[k] = in_range ? uk : 0.f;
+    redo[k] = in_range ? 0 : 1;
+    const int32_t b = std::min(int32_t(uc[k] * float(buckets)), buckets - 1);
+    const int32_t lo = guide[gb + b], hi = guide[gb + b + 1];
+    // The first of cdf[lo + 1 .. hi] above u lies in [first, first + len].
+    first[k] = lo + 1;
+    len[k] = hi - lo;
+  }
+  for (int step = 0; step < steps; ++step)
+    for (size_t k = 0; k < m; ++k) {
+      const int32_t half = len[k] >> 1;
+      // (half = 0 reads cdf[first - 1], a valid index, and moves nothing.)
+      const bool up = cdf[cb[k] + first[k] + half - 1] <= uc[k];
+      first[k] = up ? first[k] + half : first[k];
+      len[k] = len[k] - half;
+    }
+  const auto cell_of = [n](float v) {
+    const float scaled = v * float(n);
+    return scaled > 0.f ? std::min(int32_t(scaled), n - 1) : 0;
+  };
+  for (size_t k = 0; k < m; ++k) {
+    // (len is 0 or 1 here; cdf[first] is at most cdf[n].)
+    const float next = cdf[cb[k] + first[k]];  // read by every lane: a gather without a mask
+    const int32_t i = first[k] - 1 + (len[k] == 1 && next <= uc[k] ? 1 : 0);
+    const float c0 = cdf[cb[k] + i], c1 = cdf[cb[k] + i + 1];
+    const float width = c1 - c0;
+    float du = width > 0.f ? (uc[k] - c0) / width : 0.f;
+    du = std::clamp(du, 0.f, kOneMinusEpsilon);
+    float xi = std::min((float(i) + du) / float(n), kOneMinusEpsilon);
+    // sample()'s fix-up: rounding may carry x onto the next cell's edge, where pdf(x) would find
+    // the next cell; one step down (the next float towards 0) as a select.
+    const bool fix = xi > 0.f && cell_of(xi) > i;
+    xi = fix ? std::bit_cast<float>(std::bit_cast<int32_t>(xi) - 1) : xi;
+    cell[k] = i;
+    x[k] = xi;
+    redo[k] = redo[k] || (xi > 0.f && cell_of(xi) > i) || len[k] > 1 ? 1 : 0;
+  }
+}
+
+// The number of halvings that bring the widest of a guide's ranges to one cell.
+int search_steps(std::span<const int> guide, size_t buckets) {
+  int widest = 1;
+  for (size_t start = 0; start + buckets < guide.size(); start += buckets + 1)
+    for (size_t k = 0; k < buckets; ++k) widest = std::max(widest, guide[start + k + 1] - guide[start + k]);
+  int steps = 0;
+  for (int len = widest; len > 1; len -= len >> 1) ++steps;
+  return steps;
 }
 
 }  // namespace
@@ -42,6 +117,20 @@ Distribution1D::Distribution1D(std::span<const float> weights) {
     const float t = float(double(k) / double(buckets));  // exact: buckets is a power of two
     while (i + 1 < n && cdf_[i + 1] <= t) ++i;
     guide_[k] = int(i);
+  }
+  search_steps_ = search_steps(guide_, buckets);
+}
+
+void Distribution1D::sample_many(size_t m, const float* u, int* cell, float* x) const {
+  const CdfSearch search = this->search();
+  constexpr size_t kChunk = 64;
+  for (size_t k0 = 0; k0 < m; k0 += kChunk) {
+    const size_t c = std::min(kChunk, m - k0);
+    int32_t redo[kChunk];
+    cdf_sample_lanes(c, cdf_.data(), guide_.data(), nullptr, nullptr, int32_t(pdf_.size()),
+                     int32_t(search.buckets), search_steps_, u + k0, cell + k0, x + k0, redo);
+    for (size_t k = 0; k < c; ++k)
+      if (redo[k]) x[k0 + k] = search.sample(u[k0 + k], &cell[k0 + k]);
   }
 }
 
@@ -102,6 +191,7 @@ Distribution2D::Distribution2D(std::span<const float> weights, int nu, int nv)
     row_integrals[size_t(j)] = float(d.integral());
   }
   marginal_ = Distribution1D(row_integrals);
+  search_steps_ = search_steps(guide_, buckets_);
   pdf_.resize(row_pdfs.size());
   for (int j = 0; j < nv_; ++j)
     for (int i = 0; i < nu_; ++i) {
@@ -114,6 +204,22 @@ float Distribution2D::sample_column(int row, float u, int* column) const {
   const CdfSearch conditional{cdf_.data() + size_t(row) * size_t(nu_ + 1),
                               guide_.data() + size_t(row) * (buckets_ + 1), size_t(nu_), buckets_};
   return conditional.sample(u, column);
+}
+
+void Distribution2D::sample_columns(size_t m, const int* row, const float* u, int* column, float* x) const {
+  constexpr size_t kChunk = 64;
+  for (size_t k0 = 0; k0 < m; k0 += kChunk) {
+    const size_t c = std::min(kChunk, m - k0);
+    int32_t cdf_base[kChunk], guide_base[kChunk], redo[kChunk];
+    for (size_t k = 0; k < c; ++k) {
+      cdf_base[k] = int32_t(size_t(row[k0 + k]) * size_t(nu_ + 1));
+      guide_base[k] = int32_t(size_t(row[k0 + k]) * (buckets_ + 1));
+    }
+    cdf_sample_lanes(c, cdf_.data(), guide_.data(), cdf_base, guide_base, int32_t(nu_), int32_t(buckets_),
+                     search_steps_, u + k0, column + k0, x + k0, redo);
+    for (size_t k = 0; k < c; ++k)
+      if (redo[k]) x[k0 + k] = sample_column(row[k0 + k], u[k0 + k], &column[k0 + k]);
+  }
 }
 
 vec2 Distribution2D::sample(const vec2& u, float* pdf, glm::ivec2* cell) const {

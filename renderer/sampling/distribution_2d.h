@@ -46,6 +46,8 @@ class Distribution1D {
   double integral() const { return integral_; }
   // x in [0, 1) with density pdf(x); *cell (if given) receives the cell x lies in.
   float sample(float u, float* pdf, int* cell = nullptr) const;
+  // sample() for m values of u at once in SIMD lanes, to the bit (no densities: cell_pdf).
+  void sample_many(size_t m, const float* u, int* cell, float* x) const;
   // Density at x in [0, 1] (x == 1 counts as the last cell).
   float pdf(float x) const;
   // The CDF at the cells' edges: n + 1 values from 0 to 1.
@@ -68,6 +70,7 @@ class Distribution1D {
   // k / K and u * K are exact in float and u in [k / K, (k + 1) / K) lies in cells
   // guide_[k]..guide_[k + 1].
   std::vector<int> guide_;
+  int search_steps_ = 0;  // halvings that bring the guide's widest range to one cell
   double integral_ = 0.0;
 };
 
@@ -90,6 +93,10 @@ class Distribution2D {
   // row from u.x; the point (x, v) lies in cell (column, row).
   float sample_row(float u, int* row) const { return marginal_.sample(u, nullptr, row); }
   float sample_column(int row, float u, int* column) const;
+  // The same for m samples at once in SIMD lanes, to the bit: every v and row from u[k], then
+  // every x and column within row[k].
+  void sample_rows(size_t m, const float* u, int* row, float* v) const { marginal_.sample_many(m, u, row, v); }
+  void sample_columns(size_t m, const int* row, const float* u, int* column, float* x) const;
   // Density at p in [0, 1]^2.
   float pdf(const vec2& p) const;
   // Density of cell (i, j), constant over it.
@@ -117,6 +124,7 @@ class Distribution2D {
   std::vector<float> cdf_;
   std::vector<int> guide_;
   size_t buckets_ = 0;
+  int search_steps_ = 0;  // halvings that bring the widest range of any row's guide to one cell
   // The joint density of every cell, marginal x conditional (the product sample and pdf return),
   // so a pdf is one load.
   std::vector<float> pdf_;

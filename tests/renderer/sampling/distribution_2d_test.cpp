@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -105,6 +106,101 @@ TEST(Distribution1D, GuidedSearchFindsTheCellOfTheFullSearch) {
         int cell = -1;
         d.sample(u, nullptr, &cell);
         ASSERT_EQ(cell, std::clamp(expected, 0, n - 1)) << "n " << n << " shape " << shape << " u " << u;
+      }
+    }
+  }
+}
+
+// Weights of four kinds (uniform-ish, one sun, mostly zero, twelve decades) and, for them, u on
+// every CDF value and bucket edge and their float neighbours, random u, and u outside [0, 1):
+// what the SIMD lanes of sample_many / sample_rows / sample_columns must take to the bit.
+std::vector<float> shaped_weights(int n, int shape, uint32_t* state) {
+  const auto next = [state] {
+    *state = *state * 1664525u + 1013904223u;
+    return float(*state >> 8) * 0x1p-24f;
+  };
+  std::vector<float> w(static_cast<size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    const float r = next();
+    w[size_t(i)] = shape == 0 ? r : shape == 1 ? (i == n / 3 ? 1e6f : r * 1e-3f)
+                 : shape == 2 ? (r < 0.8f ? 0.f : r) : std::exp2(40.f * r - 20.f);
+  }
+  return w;
+}
+
+std::vector<float> probing_us(std::span<const float> cdf, int n, uint32_t* state) {
+  std::vector<float> us;
+  for (const float c : cdf) {
+    us.push_back(c);
+    us.push_back(std::nextafter(c, 0.f));
+    us.push_back(std::nextafter(c, 1.f));
+  }
+  for (int k = 0; k <= 4 * n; ++k) {
+    const float t = float(k) / float(4 * n);
+    us.push_back(t);
+    us.push_back(std::nextafter(t, 0.f));
+  }
+  for (int j = 0; j < 500; ++j) {
+    *state = *state * 1664525u + 1013904223u;
+    us.push_back(float(*state >> 8) * 0x1p-24f);
+  }
+  for (const float u : {-0.f, -1e-30f, -0.5f, 1.f, 1.5f, kOneMinusEpsilon, INFINITY, NAN}) us.push_back(u);
+  return us;
+}
+
+TEST(Distribution1D, SampleManyIsSampleToTheBit) {
+  uint32_t state = 99u;
+  for (const int n : {1, 2, 3, 5, 8, 9, 33, 100, 255, 512, 1000}) {
+    for (int shape = 0; shape < 4; ++shape) {
+      const Distribution1D d(shaped_weights(n, shape, &state));
+      const std::vector<float> us = probing_us(d.cdf(), n, &state);
+      std::vector<int> cells(us.size(), -1);
+      std::vector<float> xs(us.size(), -1.f);
+      d.sample_many(us.size(), us.data(), cells.data(), xs.data());
+      for (size_t k = 0; k < us.size(); ++k) {
+        int cell = -1;
+        const float x = d.sample(us[k], nullptr, &cell);
+        ASSERT_EQ(cells[k], cell) << "n " << n << " shape " << shape << " u " << us[k];
+        ASSERT_EQ(std::bit_cast<uint32_t>(xs[k]), std::bit_cast<uint32_t>(x))
+            << "n " << n << " shape " << shape << " u " << us[k];
+      }
+    }
+  }
+}
+
+TEST(Distribution2D, SampleRowsAndColumnsAreSampleToTheBit) {
+  uint32_t state = 7u;
+  for (const int nu : {1, 3, 64, 257, 512}) {
+    const int nv = 8;
+    std::vector<float> w;
+    for (int j = 0; j < nv; ++j) {
+      const std::vector<float> row = shaped_weights(nu, j % 4, &state);
+      w.insert(w.end(), row.begin(), row.end());
+    }
+    const Distribution2D d(w, nu, nv);
+    std::vector<float> cdf_probe(size_t(nu) + 1);
+    for (int i = 0; i <= nu; ++i) cdf_probe[size_t(i)] = float(i) / float(nu);
+    const std::vector<float> us = probing_us(cdf_probe, nu, &state);
+    std::vector<int> rows(us.size(), -1);
+    std::vector<float> vs(us.size(), -1.f);
+    d.sample_rows(us.size(), us.data(), rows.data(), vs.data());
+    for (size_t k = 0; k < us.size(); ++k) {
+      int row = -1;
+      const float v = d.sample_row(us[k], &row);
+      ASSERT_EQ(rows[k], row) << "u " << us[k];
+      ASSERT_EQ(std::bit_cast<uint32_t>(vs[k]), std::bit_cast<uint32_t>(v)) << "u " << us[k];
+    }
+    for (int j = 0; j < nv; ++j) {
+      const std::vector<int> row(us.size(), j);
+      std::vector<int> columns(us.size(), -1);
+      std::vector<float> xs(us.size(), -1.f);
+      d.sample_columns(us.size(), row.data(), us.data(), columns.data(), xs.data());
+      for (size_t k = 0; k < us.size(); ++k) {
+        int column = -1;
+        const float x = d.sample_column(j, us[k], &column);
+        ASSERT_EQ(columns[k], column) << "nu " << nu << " row " << j << " u " << us[k];
+        ASSERT_EQ(std::bit_cast<uint32_t>(xs[k]), std::bit_cast<uint32_t>(x))
+            << "nu " << nu << " row " << j << " u " << us[k];
       }
     }
   }
