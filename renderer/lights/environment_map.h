@@ -17,8 +17,8 @@
 
 #include "renderer/core/arc_tangent.h"
 #include "renderer/lights/environment_light.h"
-#include "renderer/sampling/sampling.h"
 #include "renderer/sampling/distribution_2d.h"
+#include "renderer/sampling/sampling.h"
 #include "renderer/scene/scene_input.h"
 
 namespace penumbra {
