@@ -105,9 +105,9 @@ Spectrum EnvironmentMap::lookup(const TexelSpot& t) const {
   return top * (1.f - t.ty) + bottom * t.ty;
 }
 
-// The maps' arithmetic over a chunk of lanes, in structure-of-arrays form so that GCC vectorises
-// it (target clones); the texel and distribution loads between the kernels stay scalar loops
-// (the lanes' cells are scattered: a gather is no faster than the loads). Every scalar entry
+// The map's arithmetic over a chunk of lanes, in structure-of-arrays form so that GCC vectorises
+// it (target clones); the texel and distribution loads between the kernels (scattered over the
+// map) stay scalar loops, after prefetch hints for all the chunk's lanes. Every scalar entry
 // point runs the same kernels on one lane, so a path's bits do not depend on the driver.
 namespace {
 
@@ -231,8 +231,8 @@ void warp_kernel(size_t m, const CellLanes& __restrict in, const MapShape& __res
 Spectrum EnvironmentMap::radiance(const vec3& dir) const {
   const uint8_t want = 0;
   Spectrum r;
-  float p;
-  radiance_and_pdf_many(1, &dir, &want, &r, &p);
+  float unused = 0.f;
+  radiance_and_pdf_many(1, &dir, &want, &r, &unused);
   return r;
 }
 
@@ -302,8 +302,6 @@ EnvironmentMap::CellPoint EnvironmentMap::cell_point(const vec2& st) const {
 }
 
 float EnvironmentMap::pdf(const vec3& dir) const {
-  if (is_black()) return 0.f;
-  if (uniform_sampling_) return uniform_sphere_pdf();
   float p = 0.f;
   radiance_and_pdf(dir, &p);
   return p;

@@ -248,7 +248,9 @@ TEST(EnvironmentMap, SampleManyIsSampleToTheBit) {
           ASSERT_EQ(out[k].value[c], one.value[c]);
         }
       }
-      if (desc == &black) EXPECT_EQ(failures, int(n));
+      if (desc == &black) {
+        EXPECT_EQ(failures, int(n));
+      }
     }
   }
 }
