@@ -66,54 +66,10 @@ TEST(Distribution1D, ExtremeRandomNumbersStayInTheSampledCell) {
   }
 }
 
-// The guide table narrows the search; the cell must be the one a binary search over the whole CDF
-// finds (the last cell whose CDF is <= u), so images do not change with it. Peaked weights (an
-// environment map's sun), long runs of zeros, every size around the powers of two that set the
-// table's length, and u on every CDF value, bucket edge and their float neighbours.
-TEST(Distribution1D, GuidedSearchFindsTheCellOfTheFullSearch) {
-  uint32_t state = 12345u;
-  const auto next = [&state] {
-    state = state * 1664525u + 1013904223u;
-    return float(state >> 8) * 0x1p-24f;
-  };
-  for (const int n : {1, 2, 3, 4, 5, 7, 8, 9, 31, 33, 64, 100, 255, 257, 512, 1000}) {
-    for (int shape = 0; shape < 4; ++shape) {
-      std::vector<float> w(static_cast<size_t>(n));
-      for (int i = 0; i < n; ++i) {
-        const float r = next();
-        w[size_t(i)] = shape == 0 ? r                                      // uniform-ish
-                     : shape == 1 ? (i == n / 3 ? 1e6f : r * 1e-3f)         // one sun
-                     : shape == 2 ? (r < 0.8f ? 0.f : r)                    // mostly zero
-                                  : std::exp2(40.f * r - 20.f);             // 12 decades
-      }
-      const Distribution1D d(w);
-      const std::span<const float> cdf = d.cdf();
-      std::vector<float> us;
-      for (const float c : cdf) {
-        us.push_back(c);
-        us.push_back(std::nextafter(c, 0.f));
-        us.push_back(std::nextafter(c, 1.f));
-      }
-      for (int k = 0; k <= 4 * n; ++k) {
-        const float t = float(k) / float(4 * n);
-        us.push_back(t);
-        us.push_back(std::nextafter(t, 0.f));
-      }
-      for (int j = 0; j < 2000; ++j) us.push_back(next());
-      for (const float u : us) {
-        if (!(u >= 0.f && u < 1.f)) continue;
-        const int expected = int(std::upper_bound(cdf.begin(), cdf.end(), u) - cdf.begin()) - 1;
-        int cell = -1;
-        d.sample(u, nullptr, &cell);
-        ASSERT_EQ(cell, std::clamp(expected, 0, n - 1)) << "n " << n << " shape " << shape << " u " << u;
-      }
-    }
-  }
-}
-
 // Weights of four kinds (uniform-ish, one sun, mostly zero, twelve decades) and, for them, u on
 // every CDF value and bucket edge and their float neighbours, random u, and u outside [0, 1):
-// what the SIMD lanes of sample_many / sample_rows / sample_columns must take to the bit.
+// what the guided search and the SIMD lanes of sample_many / sample_rows / sample_columns must
+// take exactly.
 std::vector<float> shaped_weights(int n, int shape, uint32_t* state) {
   const auto next = [state] {
     *state = *state * 1664525u + 1013904223u;
@@ -146,6 +102,27 @@ std::vector<float> probing_us(std::span<const float> cdf, int n, uint32_t* state
   }
   for (const float u : {-0.f, -1e-30f, -0.5f, 1.f, 1.5f, kOneMinusEpsilon, INFINITY, NAN}) us.push_back(u);
   return us;
+}
+
+// The guide table narrows the search; the cell must be the one a binary search over the whole CDF
+// finds (the last cell whose CDF is <= u), so images do not change with it. Peaked weights (an
+// environment map's sun), long runs of zeros, every size around the powers of two that set the
+// table's length, and u on every CDF value, bucket edge and their float neighbours.
+TEST(Distribution1D, GuidedSearchFindsTheCellOfTheFullSearch) {
+  uint32_t state = 12345u;
+  for (const int n : {1, 2, 3, 4, 5, 7, 8, 9, 31, 33, 64, 100, 255, 257, 512, 1000}) {
+    for (int shape = 0; shape < 4; ++shape) {
+      const Distribution1D d(shaped_weights(n, shape, &state));
+      const std::span<const float> cdf = d.cdf();
+      for (const float u : probing_us(cdf, n, &state)) {
+        if (!(u >= 0.f && u < 1.f)) continue;
+        const int expected = int(std::upper_bound(cdf.begin(), cdf.end(), u) - cdf.begin()) - 1;
+        int cell = -1;
+        d.sample(u, nullptr, &cell);
+        ASSERT_EQ(cell, std::clamp(expected, 0, n - 1)) << "n " << n << " shape " << shape << " u " << u;
+      }
+    }
+  }
 }
 
 TEST(Distribution1D, SampleManyIsSampleToTheBit) {
