@@ -123,6 +123,10 @@ Distribution1D::Distribution1D(std::span<const float> weights) {
 
 void Distribution1D::sample_many(size_t m, const float* u, int* cell, float* x) const {
   const CdfSearch search = this->search();
+  if (search.buckets == 0) {  // default-constructed: no cells, CdfSearch's own answer
+    for (size_t k = 0; k < m; ++k) x[k] = search.sample(u[k], &cell[k]);
+    return;
+  }
   constexpr size_t kChunk = 64;
   for (size_t k0 = 0; k0 < m; k0 += kChunk) {
     const size_t c = std::min(kChunk, m - k0);
@@ -207,6 +211,10 @@ float Distribution2D::sample_column(int row, float u, int* column) const {
 }
 
 void Distribution2D::sample_columns(size_t m, const int* row, const float* u, int* column, float* x) const {
+  if (buckets_ == 0) {  // default-constructed: no rows
+    for (size_t k = 0; k < m; ++k) x[k] = sample_column(row[k], u[k], &column[k]);
+    return;
+  }
   constexpr size_t kChunk = 64;
   for (size_t k0 = 0; k0 < m; k0 += kChunk) {
     const size_t c = std::min(kChunk, m - k0);

@@ -106,7 +106,9 @@ class Distribution2D {
   void prefetch_cell(int i, int j) const { __builtin_prefetch(&pdf_[size_t(j) * size_t(nu_) + size_t(i)]); }
   // (sample_column's search reads the row's guide entry for u first. A second hint for the CDF
   // from there, once the entry is in cache, was measured and gains nothing more.)
-  void prefetch_column(int row, float u) const { __builtin_prefetch(&guide_[guide_index(row, u)]); }
+  void prefetch_column(int row, float u) const {
+    if (buckets_ > 0) __builtin_prefetch(&guide_[guide_index(row, u)]);
+  }
 
  private:
   // The guide entry of u in [0, 1) in row `row` (the one CdfSearch::find_cell reads first;
