@@ -134,21 +134,17 @@ struct LocatedLanes {
 PENUMBRA_SIMD_CLONES
 void locate_kernel(size_t m, const vec3* __restrict dirs, const MapShape& __restrict shape,
                    LocatedLanes* __restrict out) {
-  const int nu = shape.width, nv = shape.height - 1;
   for (size_t k = 0; k < m; ++k) {
     const vec3 d = shape.to_local * dirs[k];
     const vec2 uv = EnvironmentMap::direction_to_uv(d);
     float s = uv.x - shape.half_texel;
     s = s < 0.f ? s + 1.f : s;
     out->sin_theta[k] = std::sqrt(d.x * d.x + d.z * d.z);
-    // cell_point; NaN (from a NaN direction) is read at cell 0.
-    const float sx = s >= 0.f ? s * float(nu) : 0.f, sy = uv.y >= 0.f ? uv.y * float(nv) : 0.f;
-    const int cx = std::clamp(int(std::min(sx, float(nu))), 0, nu - 1);
-    const int cy = std::clamp(int(std::min(sy, float(nv))), 0, nv - 1);
-    out->cx[k] = cx;
-    out->cy[k] = cy;
-    out->fx[k] = std::clamp(sx - float(cx), 0.f, 1.f);
-    out->fy[k] = std::clamp(sy - float(cy), 0.f, 1.f);
+    const EnvironmentMap::CellPoint q = EnvironmentMap::cell_point(s, uv.y, shape.width, shape.height);
+    out->cx[k] = q.x;
+    out->cy[k] = q.y;
+    out->fx[k] = q.fx;
+    out->fy[k] = q.fy;
     const EnvironmentMap::TexelSpot t = EnvironmentMap::texel_spot(uv.x, uv.y, shape.width, shape.height);
     out->x0[k] = t.x0;
     out->x1[k] = t.x1;
@@ -276,7 +272,7 @@ void EnvironmentMap::sample_many(size_t n, const vec3* refs, const float* times,
       cells.pdf_cell[k] = distribution_.cell_pdf(column[k], row[k]);
       // A uniform point of the cell (its row and column were drawn independently), which the
       // bilinear warp then reshapes.
-      const CellPoint q = cell_point(vec2(x[k], v[k]));
+      const CellPoint q = cell_point(x[k], v[k], width_, height_);
       const Corners c = corners(q.x, q.y);
       cells.cx[k] = q.x, cells.cy[k] = q.y, cells.fx[k] = q.fx, cells.fy[k] = q.fy;
       cells.w00[k] = c.w00, cells.w10[k] = c.w10, cells.w01[k] = c.w01, cells.w11[k] = c.w11;
@@ -292,13 +288,6 @@ void EnvironmentMap::sample_many(size_t n, const vec3* refs, const float* times,
       finish_sample(&s);
     }
   }
-}
-
-EnvironmentMap::CellPoint EnvironmentMap::cell_point(const vec2& st) const {
-  const int nu = width_, nv = height_ - 1;
-  const float sx = st.x * float(nu), sy = st.y * float(nv);
-  const int cx = std::clamp(int(sx), 0, nu - 1), cy = std::clamp(int(sy), 0, nv - 1);
-  return {cx, cy, std::clamp(sx - float(cx), 0.f, 1.f), std::clamp(sy - float(cy), 0.f, 1.f)};
 }
 
 float EnvironmentMap::pdf(const vec3& dir) const {

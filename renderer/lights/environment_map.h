@@ -59,6 +59,14 @@ class EnvironmentMap final : public EnvironmentLight {
     float tx, ty;
   };
   static TexelSpot texel_spot(float u, float v, int width, int height);
+  // The sampling distribution's cell holding (s, t) in [0, 1]^2 (cell coordinates: s starts at
+  // texel 0's centre) and the point's place within it, each in [0, 1]: where the bilinear warp
+  // starts and where its density is read. NaN is read at cell 0.
+  struct CellPoint {
+    int x, y;
+    float fx, fy;
+  };
+  static CellPoint cell_point(float s, float t, int width, int height);
 
   // The lat-long coordinates of a map-space unit direction, u in [0, 1], v in [0, 1], and back.
   static vec2 direction_to_uv(const vec3& d);
@@ -69,13 +77,6 @@ class EnvironmentMap final : public EnvironmentLight {
  private:
   // Bilinear lookup at the texels `t` names, as Mitsuba's EnvironmentMapEmitter::eval_spectrum.
   Spectrum lookup(const TexelSpot& t) const;
-  // The distribution's cell holding st (cell coordinates, u from texel x's centre) and st's place
-  // within it, each in [0, 1]: where the bilinear warp starts and where its density is read.
-  struct CellPoint {
-    int x, y;
-    float fx, fy;
-  };
-  CellPoint cell_point(const vec2& st) const;
   // Cell (x, y)'s corners: luminance x sin(theta) of texels x, x + 1 in rows y, y + 1.
   struct Corners {
     float w00, w10, w01, w11;
@@ -121,6 +122,14 @@ inline vec3 EnvironmentMap::uv_to_direction(float u, float sin_theta, float cos_
 // the seam wrapping; row y at v = y / (height - 1)). u and v are in [0, 1] here (from a
 // direction or a sample; anything else, NaN included, is read at 0), so x0 is in
 // [-1, width - 1] and wraps once at most.
+inline EnvironmentMap::CellPoint EnvironmentMap::cell_point(float s, float t, int width, int height) {
+  const int nu = width, nv = height - 1;
+  const float sx = s >= 0.f ? s * float(nu) : 0.f, sy = t >= 0.f ? t * float(nv) : 0.f;
+  const int cx = std::clamp(int(std::min(sx, float(nu))), 0, nu - 1);
+  const int cy = std::clamp(int(std::min(sy, float(nv))), 0, nv - 1);
+  return {cx, cy, std::clamp(sx - float(cx), 0.f, 1.f), std::clamp(sy - float(cy), 0.f, 1.f)};
+}
+
 inline EnvironmentMap::TexelSpot EnvironmentMap::texel_spot(float u, float v, int width, int height) {
   u = u >= 0.f && u <= 1.f ? u : 0.f;
   v = v >= 0.f && v <= 1.f ? v : 0.f;

@@ -12,11 +12,12 @@ namespace {
 
 float clean(float w) { return std::isfinite(w) && w > 0.f ? w : 0.f; }
 
-// The cell of x in [0, 1] among n equal cells (x == 1 belongs to the last).
-int cell_of(float x, size_t n) {
+// The cell of x in [0, 1] among n equal cells (x == 1, and anything above, belongs to the last;
+// NaN to the first). In int32 arithmetic with the float clamped first, so that the SIMD lanes
+// below use it too (vector units have no float-to-unsigned conversion).
+int32_t cell_of(float x, int32_t n) {
   const float scaled = x * float(n);
-  if (!(scaled > 0.f)) return 0;  // also NaN
-  return int(std::min(size_t(scaled), n - 1));
+  return scaled > 0.f ? std::min(int32_t(std::min(scaled, float(n))), n - 1) : 0;
 }
 
 // CdfSearch::sample for many u at once, in SIMD lanes (target clones; the guide entries and CDF
@@ -58,10 +59,6 @@ void cdf_sample_lanes(size_t m, const float* __restrict cdf, const int* __restri
       first[k] = up ? first[k] + half : first[k];
       len[k] = len[k] - half;
     }
-  const auto cell_of = [n](float v) {
-    const float scaled = v * float(n);
-    return scaled > 0.f ? std::min(int32_t(scaled), n - 1) : 0;
-  };
   for (size_t k = 0; k < m; ++k) {
     // (len is 0 or 1 here; cdf[first] is at most cdf[n].)
     const float next = cdf[cb[k] + first[k]];  // read by every lane: a gather without a mask
@@ -73,11 +70,11 @@ void cdf_sample_lanes(size_t m, const float* __restrict cdf, const int* __restri
     float xi = std::min((float(i) + du) / float(n), kOneMinusEpsilon);
     // sample()'s fix-up: rounding may carry x onto the next cell's edge, where pdf(x) would find
     // the next cell; one step down (the next float towards 0) as a select.
-    const bool fix = xi > 0.f && cell_of(xi) > i;
+    const bool fix = xi > 0.f && cell_of(xi, n) > i;
     xi = fix ? std::bit_cast<float>(std::bit_cast<int32_t>(xi) - 1) : xi;
     cell[k] = i;
     x[k] = xi;
-    redo[k] = redo[k] || (xi > 0.f && cell_of(xi) > i) || len[k] > 1 ? 1 : 0;
+    redo[k] = redo[k] || (xi > 0.f && cell_of(xi, n) > i) || len[k] > 1 ? 1 : 0;
   }
 }
 
@@ -161,7 +158,7 @@ float CdfSearch::sample(float u, int* cell) const {
   du = std::clamp(du, 0.f, kOneMinusEpsilon);
   float x = std::min((float(i) + du) / float(n), kOneMinusEpsilon);
   // Rounding may carry x onto the next cell's edge; pdf(x) must find the cell sampled here.
-  while (x > 0.f && cell_of(x, n) > i) x = std::nextafter(x, 0.f);
+  while (x > 0.f && cell_of(x, int32_t(n)) > i) x = std::nextafter(x, 0.f);
   *cell = i;
   return x;
 }
@@ -174,7 +171,7 @@ float Distribution1D::sample(float u, float* pdf, int* cell) const {
   return x;
 }
 
-float Distribution1D::pdf(float x) const { return cell_pdf(cell_of(x, pdf_.size())); }
+float Distribution1D::pdf(float x) const { return cell_pdf(cell_of(x, int32_t(pdf_.size()))); }
 
 Distribution2D::Distribution2D(std::span<const float> weights, int nu, int nv)
     : nu_(std::max(nu, 1)), nv_(std::max(nv, 1)) {
@@ -240,7 +237,7 @@ vec2 Distribution2D::sample(const vec2& u, float* pdf, glm::ivec2* cell) const {
 }
 
 float Distribution2D::pdf(const vec2& p) const {
-  return cell_pdf(cell_of(p.x, size_t(nu_)), cell_of(p.y, size_t(nv_)));
+  return cell_pdf(cell_of(p.x, nu_), cell_of(p.y, nv_));
 }
 
 }  // namespace penumbra
