@@ -97,6 +97,15 @@ Material::Material(const MaterialParams& params, CoatingTableCache* coatings,
       params);
   parameters_vary_ = m.color || m.roughness || m.metallic;
   varies_ = parameters_vary_ || m.normal_map;
+  std::visit(
+      [&](const auto& p) {
+        using P = std::decay_t<decltype(p)>;
+        if constexpr (std::is_same_v<P, DiffuseParams> || std::is_same_v<P, ConductorParams>) {
+          only_color_varies_ = m.color && !m.roughness && !m.metallic && !m.normal_map;
+          color_factor_ = p.color;
+        }
+      },
+      params);
   // glTF's normalTexture.scale multiplies x and y before normalising (glTF 2.0 section 3.9.3);
   // 1 for the other materials.
   m.normal_scale = std::visit(
@@ -114,6 +123,10 @@ Material& Material::operator=(Material&&) noexcept = default;
 vec3 Material::mapped_normal_at(const TextureQuery& q) const {
   const float s = impl_->normal_scale;
   return (2.f * impl_->normal_map->eval(q) - vec3(1.f)) * vec3(s, s, 1.f);
+}
+
+Spectrum Material::color_at(const TextureQuery& q) const {
+  return color_factor_ * clamp01(impl_->color->eval(q));
 }
 
 SurfaceBsdf Material::bsdf_at(const TextureQuery& q) const {

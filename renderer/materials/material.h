@@ -43,6 +43,12 @@ class Material {
   // Only the normal map varies (no parameter is textured): bsdf_at(q) is bsdf() with
   // mapped_normal_at(q) set, so a caller that holds bsdf()'s parameters needs only that normal.
   bool only_normal_varies() const { return varies_ && !parameters_vary_; }
+  // Only the colour is textured, on a diffuse or conductor model, and no normal map is set:
+  // bsdf_at(q) is bsdf() with the colour color_at(q), every other parameter bsdf()'s, so a
+  // caller that holds bsdf()'s parameters needs only that colour (no BSDF built per hit).
+  bool only_color_varies() const { return only_color_varies_; }
+  // The colour at q as bsdf_at sets it: the factor times the texture clamped to [0, 1].
+  Spectrum color_at(const TextureQuery& q) const;
   // The normal map's normal at q as bsdf_at sets it (SurfaceBsdf::mapped_normal): 2 rgb - 1,
   // its x and y times glTF's normal scale. Only where normal_mapped().
   vec3 mapped_normal_at(const TextureQuery& q) const;
@@ -72,6 +78,8 @@ class Material {
   bool varies_ = false;
   bool parameters_vary_ = false;  // some parameter (not the normal) is textured
   bool normal_mapped_ = false;
+  bool only_color_varies_ = false;
+  Spectrum color_factor_{1.f};  // the textured colour's factor (only_color_varies_)
   uint32_t lobes_ = 0;
 };
 

@@ -526,6 +526,15 @@ void SurfaceStage::add_textured(size_t i, const PathState& s, const SurfaceHit& 
   // path_scatter's lookup, at the same point: the same parameters to the bit.
   const Material& m = scene_.material(scene_.object(hit.object).material);
   const TextureQuery query{hit.p, hit.uv, s.ray.time};
+  if (m.only_color_varies()) {
+    // bsdf_at is bsdf() with the texture's colour: the object's parameters, and the colour
+    // alone looked up (fill_params's finiteness check on it).
+    SurfaceParams q = params_[size_t(params_of_[hit.object])];
+    q.colour = m.color_at(query);
+    if (!is_finite(q.colour)) unfit_.push_back(uint32_t(i));
+    write_params(i, q);
+    return;
+  }
   vec3 mapped_normal;
   if (m.only_normal_varies()) {
     // bsdf_at is bsdf() with the map's normal: the object's parameters, and the normal alone

@@ -180,6 +180,49 @@ TEST(TexturedMaterial, NormalMapAloneIsTheConstantBsdfWithTheMapsNormal) {
   }
 }
 
+// A material whose only texture is its colour, on a diffuse or conductor model, is its constant
+// BSDF with the colour looked up (the surface stages take only color_at): the colour to the bit,
+// with texels beyond [0, 1] clamped; any other texture, a normal map or another model takes the
+// general lookup.
+TEST(TexturedMaterial, ColourAloneIsTheConstantBsdfWithTheTexturesColour) {
+  TempFolder dir("textured_colour_only");
+  const ImageTextureDesc colour =
+      two_texels(dir, "c.exr", Spectrum(0.3f, 1.7f, 0.55f), Spectrum(0.9f, 0.05f, -0.2f));
+  const ImageTextureDesc other = two_texels(dir, "o.exr", Spectrum(0.4f), Spectrum(0.6f));
+  DiffuseParams diffuse{Spectrum(0.8f, 0.6f, 0.4f)};
+  diffuse.color_texture = colour;
+  ConductorParams conductor{Spectrum(0.9f, 0.8f, 0.7f), 0.35f};
+  conductor.color_texture = colour;
+  CoatingTableCache coatings;
+  const std::pair<MaterialParams, Spectrum> cases[] = {{diffuse, diffuse.color},
+                                                       {conductor, conductor.color}};
+  for (const auto& [p, factor] : cases) {
+    const Material m(p, &coatings);
+    ASSERT_TRUE(m.only_color_varies());
+    // The texels clamped to [0, 1], times the factor.
+    EXPECT_EQ(m.color_at(at(0.25f, 0.5f)), factor * Spectrum(0.3f, 1.f, 0.55f));
+    EXPECT_EQ(m.color_at(at(0.75f, 0.5f)), factor * Spectrum(0.9f, 0.05f, 0.f));
+    for (const float u : {0.25f, 0.75f}) {
+      const SurfaceBsdf b = m.bsdf_at(at(u, 0.5f));
+      EXPECT_EQ(m.color_at(at(u, 0.5f)), b.albedo());
+      EXPECT_EQ(b.lobes(), m.bsdf().lobes());
+      EXPECT_FALSE(b.normal_mapped());
+    }
+  }
+  DiffuseParams mapped = diffuse;
+  mapped.normal_map = other;
+  ConductorParams rough = conductor;
+  rough.roughness_texture = other;
+  PlasticParams plastic{Spectrum(0.5f, 0.3f, 0.2f), 1.5f, 0.3f};
+  plastic.color_texture = colour;
+  MetallicRoughnessParams gltf{Spectrum(0.7f, 0.6f, 0.3f), 0.4f, 0.5f};
+  gltf.color_texture = colour;
+  for (const MaterialParams& p : {MaterialParams(mapped), MaterialParams(rough),
+                                  MaterialParams(plastic), MaterialParams(gltf)})
+    EXPECT_FALSE(Material(p, &coatings).only_color_varies());
+  EXPECT_FALSE(Material(DiffuseParams{Spectrum(0.5f)}, &coatings).only_color_varies());
+}
+
 TEST(TexturedMaterial, MissingImageThrowsNamingTheFile) {
   DiffuseParams p;
   p.color_texture = ImageTextureDesc{"/nonexistent/albedo.png"};
