@@ -104,6 +104,10 @@ Material::Material(const MaterialParams& params, CoatingTableCache* coatings,
           only_color_varies_ = m.color && !m.roughness && !m.metallic && !m.normal_map;
           color_factor_ = p.color;
         }
+        if constexpr (std::is_same_v<P, ConductorParams> || std::is_same_v<P, DielectricParams>) {
+          only_roughness_varies_ = m.roughness && !m.color && !m.metallic && !m.normal_map;
+          roughness_factor_ = p.roughness;
+        }
       },
       params);
   // glTF's normalTexture.scale multiplies x and y before normalising (glTF 2.0 section 3.9.3);
@@ -125,9 +129,23 @@ vec3 Material::mapped_normal_at(const TextureQuery& q) const {
   return (2.f * impl_->normal_map->eval(q) - vec3(1.f)) * vec3(s, s, 1.f);
 }
 
-Spectrum Material::color_at(const TextureQuery& q) const {
-  return color_factor_ * clamp01(impl_->color->eval(q));
+Spectrum Material::color_of_texel(const Spectrum& texel) const {
+  return color_factor_ * clamp01(texel);
 }
+
+Spectrum Material::color_at(const TextureQuery& q) const {
+  return color_of_texel(impl_->color->eval(q));
+}
+
+const ImageSpectrumTexture* Material::color_image() const {
+  return only_color_varies_ ? impl_->color.get() : nullptr;
+}
+
+const ImageFloatTexture* Material::roughness_image() const {
+  return only_roughness_varies_ ? impl_->roughness.get() : nullptr;
+}
+
+float Material::roughness_of_texel(float texel) const { return roughness_factor_ * clamp01(texel); }
 
 SurfaceBsdf Material::bsdf_at(const TextureQuery& q) const {
   const Impl& m = *impl_;

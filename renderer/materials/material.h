@@ -11,6 +11,8 @@
 namespace penumbra {
 
 class CoatingTableCache;
+class ImageFloatTexture;
+class ImageSpectrumTexture;
 class SurfaceBsdf;
 class TextureImageCache;
 
@@ -49,6 +51,16 @@ class Material {
   bool only_color_varies() const { return only_color_varies_; }
   // The colour at q as bsdf_at sets it: the factor times the texture clamped to [0, 1].
   Spectrum color_at(const TextureQuery& q) const;
+  // Where only_color_varies(): the colour's image texture, whose eval_many looks up many points
+  // at once; else nullptr. color_at(q) is color_of_texel(its eval(q)).
+  const ImageSpectrumTexture* color_image() const;
+  // The colour of a looked-up texel: the factor times the texel clamped to [0, 1].
+  Spectrum color_of_texel(const Spectrum& texel) const;
+  // Likewise for a conductor's or a dielectric's roughness as the only texture (no normal map):
+  // bsdf_at(q) is the model built with roughness_of_texel(roughness_image()->eval(q)), every
+  // other parameter bsdf()'s. roughness_image() is nullptr for any other material.
+  const ImageFloatTexture* roughness_image() const;
+  float roughness_of_texel(float texel) const;
   // The normal map's normal at q as bsdf_at sets it (SurfaceBsdf::mapped_normal): 2 rgb - 1,
   // its x and y times glTF's normal scale. Only where normal_mapped().
   vec3 mapped_normal_at(const TextureQuery& q) const;
@@ -80,6 +92,8 @@ class Material {
   bool normal_mapped_ = false;
   bool only_color_varies_ = false;
   Spectrum color_factor_{1.f};  // the textured colour's factor (only_color_varies_)
+  bool only_roughness_varies_ = false;
+  float roughness_factor_ = 1.f;
   uint32_t lobes_ = 0;
 };
 

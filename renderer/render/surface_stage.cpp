@@ -14,6 +14,7 @@
 #include "renderer/materials/plastic.h"
 #include "renderer/render/lane_bsdfs.h"
 #include "renderer/sampling/sampling.h"
+#include "renderer/textures/image_texture.h"
 
 namespace penumbra {
 namespace {
@@ -455,6 +456,7 @@ SurfaceStage::SurfaceStage(const Scene& scene, StageModel model)
     : scene_(scene), model_(model), lights_(scene) {
   params_of_.assign(scene.object_count(), -1);
   textured_of_.assign(scene.object_count(), 0);
+  texture_lookups_of_.assign(scene.object_count(), -1);
   for (size_t o = 0; o < scene.object_count(); ++o) {
     const Material& m = scene.material(scene.object(uint32_t(o)).material);
     // A rough plastic's coating tables join the stage's list the first time a surface uses them.
@@ -475,6 +477,16 @@ SurfaceStage::SurfaceStage(const Scene& scene, StageModel model)
     params_of_[o] = int32_t(params_.size());
     textured_of_[o] = m.varies();  // (a normal map makes a material vary)
     params_.push_back(q);
+    const bool roughness_model =
+        model == StageModel::kRoughConductor || model == StageModel::kSmoothConductor ||
+        model == StageModel::kRoughDielectric || model == StageModel::kSmoothDielectric;
+    if (m.color_image() || (m.roughness_image() && roughness_model)) {
+      size_t k = 0;
+      while (k < texture_lookups_.size() && texture_lookups_[k].material != &m) ++k;
+      if (k == texture_lookups_.size())
+        texture_lookups_.push_back(TextureLookups{&m, m.color_image() == nullptr, {}, {}, {}});
+      texture_lookups_of_[o] = int32_t(k);
+    }
   }
   if (model == StageModel::kMetallicRoughness) albedo_table_ = ggx_albedo_table();
 }
@@ -484,6 +496,11 @@ void SurfaceStage::start(size_t paths) {
   unfit_.clear();
   own_code_lanes_.clear();
   mapped_lanes_.clear();
+  for (TextureLookups& l : texture_lookups_) {
+    l.lanes.clear();
+    l.u.clear();
+    l.v.clear();
+  }
   if (slot_.size() >= paths) return;
   slot_.resize(paths);
   for (int c = 0; c < 3; ++c)
@@ -526,6 +543,16 @@ void SurfaceStage::add_textured(size_t i, const PathState& s, const SurfaceHit& 
   // path_scatter's lookup, at the same point: the same parameters to the bit.
   const Material& m = scene_.material(scene_.object(hit.object).material);
   const TextureQuery query{hit.p, hit.uv, s.ray.time};
+  if (const int32_t k = texture_lookups_of_[hit.object]; k >= 0) {
+    // bsdf_at is bsdf() with the texture's colour or roughness: the object's parameters now,
+    // the texel looked up with the other hits on the material's image (look_up_textures).
+    write_params(i, params_[size_t(params_of_[hit.object])]);
+    TextureLookups& l = texture_lookups_[size_t(k)];
+    l.lanes.push_back(uint32_t(i));
+    l.u.push_back(hit.uv.x);
+    l.v.push_back(hit.uv.y);
+    return;
+  }
   if (m.only_color_varies()) {
     // bsdf_at is bsdf() with the texture's colour: the object's parameters, and the colour
     // alone looked up (fill_params's finiteness check on it).
@@ -591,10 +618,45 @@ void SurfaceStage::add(uint32_t slot, const PathState& s, const SurfaceHit& hit,
   u_rr_[i] = x[d + 2];
 }
 
+void SurfaceStage::look_up_textures() {
+  const bool smooth_model =
+      model_ == StageModel::kSmoothConductor || model_ == StageModel::kSmoothDielectric;
+  for (const TextureLookups& l : texture_lookups_) {
+    const size_t n = l.lanes.size();
+    if (n == 0) continue;
+    for (auto& a : looked_up_)
+      if (a.size() < n) a.resize(n);
+    if (l.roughness) {
+      l.material->roughness_image()->eval_many(n, l.u.data(), l.v.data(), looked_up_[0].data());
+      for (size_t j = 0; j < n; ++j) {
+        // The model's constructor on the looked-up roughness (ConductorBsdf, DielectricBsdf):
+        // smooth below the least alpha, else GGX with alpha clamped to it; a hit whose lobe is
+        // not the stage's leaves it (fill_params).
+        const float alpha = roughness_to_alpha(l.material->roughness_of_texel(looked_up_[0][j]));
+        const uint32_t i = l.lanes[j];
+        if ((alpha < kMinMicrofacetAlpha) != smooth_model) unfit_.push_back(i);
+        alpha_[i] = GgxDistribution(alpha).alpha();
+      }
+      continue;
+    }
+    l.material->color_image()->eval_many(n, l.u.data(), l.v.data(), looked_up_[0].data(),
+                                         looked_up_[1].data(), looked_up_[2].data());
+    for (size_t j = 0; j < n; ++j) {
+      // Material::color_at on the looked-up texel; fill_params's finiteness check.
+      const Spectrum c = l.material->color_of_texel(
+          Spectrum(looked_up_[0][j], looked_up_[1][j], looked_up_[2][j]));
+      const uint32_t i = l.lanes[j];
+      if (!is_finite(c)) unfit_.push_back(i);
+      for (int k = 0; k < 3; ++k) colour_[k][i] = c[k];
+    }
+  }
+}
+
 void SurfaceStage::compute(const IntegratorSettings& settings, bool scene_next_event) {
   const bool next_event = estimates_light(scene_next_event);
   const size_t n = count_;
   if (n == 0) return;
+  look_up_textures();
   // Lanes are staged unless their parameters leave the model; normal-mapped lanes are marked
   // (listed by add, which so writes nothing per plain lane).
   for (size_t i = 0; i < n; ++i) staged_[i] = 1;

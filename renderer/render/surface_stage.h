@@ -152,6 +152,21 @@ class SurfaceStage {
   // normal-mapped lanes: their mask (set in compute, only when there are any: the kernels'
   // mapped case then costs the other batches nothing), tangent frames' s and t, mapped normals.
   std::vector<uint32_t> unfit_, mapped_lanes_;
+  // The hits on materials whose only texture is an image colour (Material::color_image) or a
+  // conductor's or dielectric's roughness (roughness_image), one list per such material of the
+  // scene, looked up together when the stage computes.
+  struct TextureLookups {
+    const Material* material;
+    bool roughness;  // else the colour
+    std::vector<uint32_t> lanes;
+    std::vector<float> u, v;
+  };
+  std::vector<TextureLookups> texture_lookups_;
+  std::vector<int32_t> texture_lookups_of_;  // per object: index into texture_lookups_, or -1
+  std::vector<float> looked_up_[3];
+  // Each list's texels (eval_many), made the lanes' colours or GGX alphas as bsdf_at and
+  // fill_params make them.
+  [[gnu::noinline]] void look_up_textures();
   std::vector<int32_t> mapped_;
   std::vector<float> frame_s_[3], frame_t_[3], mapped_n_[3];
   // Results per lane.

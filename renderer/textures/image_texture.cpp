@@ -1,5 +1,9 @@
 #include "renderer/textures/image_texture.h"
 
+#include <algorithm>
+
+#include "renderer/core/lane.h"
+#include "renderer/core/simd_clones.h"
 #include "renderer/io/image_io.h"
 #include "renderer/textures/texture_image_cache.h"
 
@@ -22,7 +26,105 @@ inline int wrap_index(int i, int size, TextureWrap wrap) {
   return m < 0 ? m + size : m;
 }
 
+// finite_position on one lane: std::clamp's comparisons as selects, the finiteness test in
+// integer arithmetic (lane.h).
+[[gnu::always_inline]] inline float lane_finite_position(float p) {
+  const float clamped =
+      when(mask(p < -kMaxTexelPosition), -kMaxTexelPosition,
+           when(mask(kMaxTexelPosition < p), kMaxTexelPosition, p));
+  return when(lane::finite(p), clamped, 0.f);
+}
+
+constexpr size_t kChunk = 64;  // lanes per pass of eval_many (its arrays live on the stack)
+
+// The bilinear lookup's texel coordinates: the upper-left texel (ix, iy) of each lane and the
+// weights (ax, ay) of the right and lower ones, as eval computes them.
+PENUMBRA_SIMD_CLONES
+void bilinear_coordinates(size_t n, const float* __restrict u, const float* __restrict v, float w,
+                          float h, float* __restrict ax, float* __restrict ay,
+                          int32_t* __restrict ix, int32_t* __restrict iy) {
+  for (size_t i = 0; i < n; ++i) {
+    const float px = lane_finite_position(u[i] * w - 0.5f);
+    const float py = lane_finite_position(v[i] * h - 0.5f);
+    const float fx = std::floor(px), fy = std::floor(py);
+    ax[i] = px - fx;
+    ay[i] = py - fy;
+    ix[i] = int32_t(fx);
+    iy[i] = int32_t(fy);
+  }
+}
+
+// The nearest lookup's texel of each lane, before wrapping.
+PENUMBRA_SIMD_CLONES
+void nearest_coordinates(size_t n, const float* __restrict u, const float* __restrict v, float w,
+                         float h, int32_t* __restrict ix, int32_t* __restrict iy) {
+  for (size_t i = 0; i < n; ++i) {
+    ix[i] = int32_t(std::floor(lane_finite_position(u[i] * w)));
+    iy[i] = int32_t(std::floor(lane_finite_position(v[i] * h)));
+  }
+}
+
+// eval's blend of the four texels of each lane.
+PENUMBRA_SIMD_CLONES
+void bilinear_blend(size_t n, const float* __restrict ax, const float* __restrict ay,
+                    const float* __restrict t00, const float* __restrict t10,
+                    const float* __restrict t01, const float* __restrict t11,
+                    float* __restrict out) {
+  for (size_t i = 0; i < n; ++i) {
+    const float top = (1.f - ax[i]) * t00[i] + ax[i] * t10[i];
+    const float bottom = (1.f - ax[i]) * t01[i] + ax[i] * t11[i];
+    out[i] = (1.f - ay[i]) * top + ay[i] * bottom;
+  }
+}
+
 }  // namespace
+
+void ImageLookup::eval_many(size_t n, const float* u, const float* v, int first, int count,
+                            float* const* out) const {
+  const int w = image_->width(), h = image_->height();
+  alignas(64) float ax[kChunk], ay[kChunk], t[4][4][kChunk];
+  alignas(64) int32_t ix[kChunk], iy[kChunk];
+  for (size_t start = 0; start < n; start += kChunk) {
+    const size_t m = std::min(kChunk, n - start);
+    if (filter_ == TextureFilter::kNearest) {
+      nearest_coordinates(m, u + start, v + start, float(w), float(h), ix, iy);
+      for (size_t i = 0; i < m; ++i) {
+        float texel[4];
+        image_->fetch(wrap_index(ix[i], w, wrap_), wrap_index(iy[i], h, wrap_), first, count,
+                      texel);
+        for (int c = 0; c < count; ++c) out[c][start + i] = texel[c];
+      }
+      continue;
+    }
+    bilinear_coordinates(m, u + start, v + start, float(w), float(h), ax, ay, ix, iy);
+    for (size_t i = 0; i < m; ++i) {
+      const int x0 = wrap_index(ix[i], w, wrap_), x1 = wrap_index(ix[i] + 1, w, wrap_);
+      const int y0 = wrap_index(iy[i], h, wrap_), y1 = wrap_index(iy[i] + 1, h, wrap_);
+      float texel[4][4];
+      image_->fetch(x0, y0, first, count, texel[0]);
+      image_->fetch(x1, y0, first, count, texel[1]);
+      image_->fetch(x0, y1, first, count, texel[2]);
+      image_->fetch(x1, y1, first, count, texel[3]);
+      for (int k = 0; k < 4; ++k)
+        for (int c = 0; c < count; ++c) t[c][k][i] = texel[k][c];
+    }
+    for (int c = 0; c < count; ++c)
+      bilinear_blend(m, ax, ay, t[c][0], t[c][1], t[c][2], t[c][3], out[c] + start);
+  }
+}
+
+void ImageSpectrumTexture::eval_many(size_t n, const float* u, const float* v, float* r, float* g,
+                                     float* b) const {
+  if (grey_) {
+    float* const out[1] = {r};
+    lookup_.eval_many(n, u, v, 0, 1, out);
+    std::copy(r, r + n, g);
+    std::copy(r, r + n, b);
+    return;
+  }
+  float* const out[3] = {r, g, b};
+  lookup_.eval_many(n, u, v, 0, 3, out);
+}
 
 void ImageLookup::eval(const vec2& uv, int first, int count, float* out) const {
   const int w = image_->width(), h = image_->height();
@@ -78,6 +180,11 @@ float ImageFloatTexture::eval(const TextureQuery& q) const {
   float v;
   lookup_.eval(q.uv, channel_, 1, &v);
   return v;
+}
+
+void ImageFloatTexture::eval_many(size_t n, const float* u, const float* v, float* out) const {
+  float* const outs[1] = {out};
+  lookup_.eval_many(n, u, v, channel_, 1, outs);
 }
 
 float ImageFloatTexture::mean() const { return lookup_.image().mean(channel_); }

@@ -29,6 +29,11 @@ class ImageLookup {
       : image_(&image), wrap_(wrap), filter_(filter) {}
 
   void eval(const vec2& uv, int first, int count, float* out) const;
+  // eval at (u[i], v[i]) for i < n, channel first + c into out[c][i]: the same values to the
+  // bit, with the texel coordinates and the bilinear blend in SIMD lanes and the texel loads
+  // between them in one loop (docs/performance.md, "textured colours in lanes").
+  void eval_many(size_t n, const float* u, const float* v, int first, int count,
+                 float* const* out) const;
   const TextureImage& image() const { return *image_; }
 
  private:
@@ -46,6 +51,8 @@ class ImageSpectrumTexture final : public SpectrumTexture {
 
   Spectrum eval(const TextureQuery& q) const override;
   Spectrum mean() const override;  // over the image's texels
+  // eval at uv (u[i], v[i]) for i < n into (r[i], g[i], b[i]), to the bit.
+  void eval_many(size_t n, const float* u, const float* v, float* r, float* g, float* b) const;
 
  private:
   ImageLookup lookup_;
@@ -60,6 +67,8 @@ class ImageFloatTexture final : public FloatTexture {
 
   float eval(const TextureQuery& q) const override;
   float mean() const override;  // over the image's texels
+  // eval at uv (u[i], v[i]) for i < n into out[i], to the bit.
+  void eval_many(size_t n, const float* u, const float* v, float* out) const;
 
  private:
   ImageLookup lookup_;

@@ -5,8 +5,11 @@
 #include <gtest/gtest.h>
 
 #include "renderer/materials/coating_tables.h"
+#include "renderer/materials/conductor.h"
+#include "renderer/materials/dielectric.h"
 #include "renderer/materials/material.h"
 #include "renderer/materials/surface_bsdf.h"
+#include "renderer/textures/image_texture.h"
 #include "tests/renderer/textures/texture_test_util.h"
 
 namespace penumbra::test {
@@ -221,6 +224,51 @@ TEST(TexturedMaterial, ColourAloneIsTheConstantBsdfWithTheTexturesColour) {
                                   MaterialParams(plastic), MaterialParams(gltf)})
     EXPECT_FALSE(Material(p, &coatings).only_color_varies());
   EXPECT_FALSE(Material(DiffuseParams{Spectrum(0.5f)}, &coatings).only_color_varies());
+}
+
+// Likewise a conductor's or dielectric's roughness as its only texture: the model built with
+// roughness_of_texel of the texel is bsdf_at's (the stages derive the GGX alpha and the smooth
+// limit from it); a texel of 0 makes the lobe smooth there.
+TEST(TexturedMaterial, RoughnessAloneIsTheModelWithTheTexturesRoughness) {
+  TempFolder dir("textured_roughness_only");
+  ImageTextureDesc rough = two_texels(dir, "r.exr", Spectrum(0.6f), Spectrum(0.f));
+  ConductorParams conductor{Spectrum(0.9f, 0.8f, 0.7f), 0.7f};
+  conductor.roughness_texture = rough;
+  DielectricParams dielectric{1.5f, 0.9f};
+  dielectric.roughness_texture = rough;
+  CoatingTableCache coatings;
+  const Material c(conductor, &coatings), d(dielectric, &coatings);
+  for (const Material* m : {&c, &d}) {
+    ASSERT_NE(m->roughness_image(), nullptr);
+    EXPECT_EQ(m->color_image(), nullptr);
+    for (const float u : {0.25f, 0.75f}) {
+      const TextureQuery q = at(u, 0.5f);
+      const float r = m->roughness_of_texel(m->roughness_image()->eval(q));
+      const SurfaceBsdf b = m->bsdf_at(q);
+      const float alpha = roughness_to_alpha(r);
+      if (m == &c) {
+        const auto& model = std::get<ConductorBsdf>(b.model());
+        EXPECT_EQ(model.smooth(), alpha < kMinMicrofacetAlpha);
+        EXPECT_EQ(model.alpha(), GgxDistribution(alpha).alpha());
+      } else {
+        const auto& model = std::get<DielectricBsdf>(b.model());
+        EXPECT_EQ(model.smooth(), alpha < kMinMicrofacetAlpha);
+        EXPECT_EQ(model.alpha(), GgxDistribution(alpha).alpha());
+      }
+    }
+    // The factor times the texel: 0.7 x 0.6 and 0.9 x 0.6; 0 on the right texel (smooth).
+    EXPECT_EQ(m->roughness_of_texel(0.6f), (m == &c ? 0.7f : 0.9f) * 0.6f);
+    EXPECT_EQ(m->roughness_of_texel(1.5f), m == &c ? 0.7f : 0.9f);
+  }
+  ConductorParams with_colour = conductor;
+  with_colour.color_texture = rough;
+  DielectricParams mapped = dielectric;
+  mapped.normal_map = rough;
+  MetallicRoughnessParams gltf{Spectrum(0.7f, 0.6f, 0.3f), 0.4f, 0.5f};
+  gltf.roughness_texture = rough;
+  for (const MaterialParams& p :
+       {MaterialParams(with_colour), MaterialParams(mapped), MaterialParams(gltf)})
+    EXPECT_EQ(Material(p, &coatings).roughness_image(), nullptr);
 }
 
 TEST(TexturedMaterial, MissingImageThrowsNamingTheFile) {

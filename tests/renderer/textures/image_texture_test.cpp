@@ -5,6 +5,10 @@
 
 #include <gtest/gtest.h>
 
+#include <bit>
+#include <cmath>
+#include <vector>
+
 namespace penumbra::test {
 namespace {
 
@@ -102,6 +106,56 @@ TEST(ImageTexture, NonFiniteOrHugeUvStaysInsideTheImage) {
         EXPECT_TRUE(v >= a && v <= d) << uv.x << ", " << uv.y << " -> " << v;
       }
   }
+}
+
+// eval_many (the surface stages' lookups of many hits at once: coordinates and blend in SIMD
+// lanes) gives eval's values to the bit: float and 8-bit sRGB images, RGB and grey, both filters
+// and wraps, uv inside, on texel centres and edges, beyond the border, huge and non-finite, over
+// more lanes than one chunk.
+TEST(ImageTexture, EvalManyIsEvalToTheBit) {
+  std::vector<float> floats;
+  std::vector<uint8_t> bytes;
+  for (int i = 0; i < 5 * 3 * 3; ++i) {
+    floats.push_back(0.013f * float(i * i % 71) + 0.001f * float(i));
+    bytes.push_back(uint8_t((i * 37 + 11) % 256));
+  }
+  const TextureImage images[] = {TextureImage(5, 3, 3, floats),
+                                 TextureImage(5, 3, 3, bytes, TextureColorspace::kSrgb),
+                                 TextureImage(5, 3, 1, {floats.begin(), floats.begin() + 15})};
+  std::vector<float> u, v;
+  for (int i = 0; i < 150; ++i) {  // more than one chunk of 64
+    u.push_back(-1.3f + 0.0271f * float(i));
+    v.push_back(0.9f - 0.0133f * float(i * 7 % 150));
+  }
+  for (const float x : {0.f, 0.1f, 0.5f, 1.f, 1.f / 3.f, -0.f, NAN, INFINITY, -INFINITY, 1e30f,
+                        3e9f, -2.5e9f, 0.7f}) {
+    u.push_back(x);
+    v.push_back(0.5f);
+    u.push_back(0.25f);
+    v.push_back(x);
+  }
+  const size_t n = u.size();
+  for (const TextureImage& image : images)
+    for (TextureWrap wrap : {TextureWrap::kRepeat, TextureWrap::kClamp})
+      for (TextureFilter filter : {TextureFilter::kBilinear, TextureFilter::kNearest}) {
+        const ImageSpectrumTexture texture(image, wrap, filter);
+        std::vector<float> r(n), g(n), b(n);
+        texture.eval_many(n, u.data(), v.data(), r.data(), g.data(), b.data());
+        const ImageFloatTexture last(image, image.channels() - 1, wrap, filter);
+        std::vector<float> f(n);
+        last.eval_many(n, u.data(), v.data(), f.data());
+        for (size_t i = 0; i < n; ++i) {
+          ASSERT_EQ(std::bit_cast<uint32_t>(f[i]),
+                    std::bit_cast<uint32_t>(
+                        last.eval(TextureQuery{vec3(0.f), vec2(u[i], v[i]), 0.f})))
+              << "lane " << i << " uv " << u[i] << ", " << v[i];
+          const Spectrum e = texture.eval(TextureQuery{vec3(0.f), vec2(u[i], v[i]), 0.f});
+          ASSERT_EQ(std::bit_cast<uint32_t>(r[i]), std::bit_cast<uint32_t>(e.x))
+              << "lane " << i << " uv " << u[i] << ", " << v[i];
+          ASSERT_EQ(std::bit_cast<uint32_t>(g[i]), std::bit_cast<uint32_t>(e.y)) << "lane " << i;
+          ASSERT_EQ(std::bit_cast<uint32_t>(b[i]), std::bit_cast<uint32_t>(e.z)) << "lane " << i;
+        }
+      }
 }
 
 }  // namespace
