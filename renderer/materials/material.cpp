@@ -100,7 +100,8 @@ Material::Material(const MaterialParams& params, CoatingTableCache* coatings,
   std::visit(
       [&](const auto& p) {
         using P = std::decay_t<decltype(p)>;
-        if constexpr (std::is_same_v<P, DiffuseParams> || std::is_same_v<P, ConductorParams>) {
+        if constexpr (std::is_same_v<P, DiffuseParams> || std::is_same_v<P, ConductorParams> ||
+                      std::is_same_v<P, PlasticParams>) {
           only_color_varies_ = m.color && !m.roughness && !m.metallic && !m.normal_map;
           color_factor_ = p.color;
         }

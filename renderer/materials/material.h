@@ -45,9 +45,10 @@ class Material {
   // Only the normal map varies (no parameter is textured): bsdf_at(q) is bsdf() with
   // mapped_normal_at(q) set, so a caller that holds bsdf()'s parameters needs only that normal.
   bool only_normal_varies() const { return varies_ && !parameters_vary_; }
-  // Only the colour is textured, on a diffuse or conductor model, and no normal map is set:
-  // bsdf_at(q) is bsdf() with the colour color_at(q), every other parameter bsdf()'s, so a
-  // caller that holds bsdf()'s parameters needs only that colour (no BSDF built per hit).
+  // Only the colour is textured, on a diffuse, conductor or plastic model, and no normal map is
+  // set: bsdf_at(q) is bsdf() with the colour color_at(q) (for the plastic, with_color: its
+  // sampling weight follows the colour), every other parameter bsdf()'s, so a caller that holds
+  // bsdf()'s parameters needs only that colour (no BSDF built per hit).
   bool only_color_varies() const { return only_color_varies_; }
   // The colour at q as bsdf_at sets it: the factor times the texture clamped to [0, 1].
   Spectrum color_at(const TextureQuery& q) const;

@@ -553,15 +553,6 @@ void SurfaceStage::add_textured(size_t i, const PathState& s, const SurfaceHit& 
     l.v.push_back(hit.uv.y);
     return;
   }
-  if (m.only_color_varies()) {
-    // bsdf_at is bsdf() with the texture's colour: the object's parameters, and the colour
-    // alone looked up (fill_params's finiteness check on it).
-    SurfaceParams q = params_[size_t(params_of_[hit.object])];
-    q.colour = m.color_at(query);
-    if (!is_finite(q.colour)) unfit_.push_back(uint32_t(i));
-    write_params(i, q);
-    return;
-  }
   vec3 mapped_normal;
   if (m.only_normal_varies()) {
     // bsdf_at is bsdf() with the map's normal: the object's parameters, and the normal alone
@@ -641,6 +632,8 @@ void SurfaceStage::look_up_textures() {
     }
     l.material->color_image()->eval_many(n, l.u.data(), l.v.data(), looked_up_[0].data(),
                                          looked_up_[1].data(), looked_up_[2].data());
+    // A plastic's sampling weight follows its colour (PlasticBsdf::with_color, as bsdf_at).
+    const auto* plastic = std::get_if<PlasticBsdf>(&l.material->bsdf().model());
     for (size_t j = 0; j < n; ++j) {
       // Material::color_at on the looked-up texel; fill_params's finiteness check.
       const Spectrum c = l.material->color_of_texel(
@@ -648,6 +641,7 @@ void SurfaceStage::look_up_textures() {
       const uint32_t i = l.lanes[j];
       if (!is_finite(c)) unfit_.push_back(i);
       for (int k = 0; k < 3; ++k) colour_[k][i] = c[k];
+      if (plastic) spec_weight_[i] = plastic->with_color(c).specular_sampling_weight();
     }
   }
 }

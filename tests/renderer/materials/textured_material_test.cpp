@@ -8,6 +8,7 @@
 #include "renderer/materials/conductor.h"
 #include "renderer/materials/dielectric.h"
 #include "renderer/materials/material.h"
+#include "renderer/materials/plastic.h"
 #include "renderer/materials/surface_bsdf.h"
 #include "renderer/textures/image_texture.h"
 #include "tests/renderer/textures/texture_test_util.h"
@@ -183,10 +184,10 @@ TEST(TexturedMaterial, NormalMapAloneIsTheConstantBsdfWithTheMapsNormal) {
   }
 }
 
-// A material whose only texture is its colour, on a diffuse or conductor model, is its constant
-// BSDF with the colour looked up (the surface stages take only color_at): the colour to the bit,
-// with texels beyond [0, 1] clamped; any other texture, a normal map or another model takes the
-// general lookup.
+// A material whose only texture is its colour, on a diffuse, conductor or plastic model, is its
+// constant BSDF with the colour looked up (the surface stages take only color_at, and the
+// plastic's sampling weight with it): the colour to the bit, with texels beyond [0, 1] clamped;
+// any other texture, a normal map or another model takes the general lookup.
 TEST(TexturedMaterial, ColourAloneIsTheConstantBsdfWithTheTexturesColour) {
   TempFolder dir("textured_colour_only");
   const ImageTextureDesc colour =
@@ -196,9 +197,11 @@ TEST(TexturedMaterial, ColourAloneIsTheConstantBsdfWithTheTexturesColour) {
   diffuse.color_texture = colour;
   ConductorParams conductor{Spectrum(0.9f, 0.8f, 0.7f), 0.35f};
   conductor.color_texture = colour;
+  PlasticParams plastic{Spectrum(0.5f, 0.3f, 0.2f), 1.5f, 0.3f};
+  plastic.color_texture = colour;
   CoatingTableCache coatings;
-  const std::pair<MaterialParams, Spectrum> cases[] = {{diffuse, diffuse.color},
-                                                       {conductor, conductor.color}};
+  const std::pair<MaterialParams, Spectrum> cases[] = {
+      {diffuse, diffuse.color}, {conductor, conductor.color}, {plastic, plastic.color}};
   for (const auto& [p, factor] : cases) {
     const Material m(p, &coatings);
     ASSERT_TRUE(m.only_color_varies());
@@ -210,18 +213,21 @@ TEST(TexturedMaterial, ColourAloneIsTheConstantBsdfWithTheTexturesColour) {
       EXPECT_EQ(m.color_at(at(u, 0.5f)), b.albedo());
       EXPECT_EQ(b.lobes(), m.bsdf().lobes());
       EXPECT_FALSE(b.normal_mapped());
+      // A plastic's sampling weight follows the colour: with_color on the constant BSDF.
+      if (const auto* p = std::get_if<PlasticBsdf>(&m.bsdf().model()))
+        EXPECT_EQ(std::get<PlasticBsdf>(b.model()).specular_sampling_weight(),
+                  p->with_color(m.color_at(at(u, 0.5f))).specular_sampling_weight());
     }
   }
   DiffuseParams mapped = diffuse;
   mapped.normal_map = other;
   ConductorParams rough = conductor;
   rough.roughness_texture = other;
-  PlasticParams plastic{Spectrum(0.5f, 0.3f, 0.2f), 1.5f, 0.3f};
-  plastic.color_texture = colour;
   MetallicRoughnessParams gltf{Spectrum(0.7f, 0.6f, 0.3f), 0.4f, 0.5f};
   gltf.color_texture = colour;
+  DielectricParams glass{1.5f, 0.2f};
   for (const MaterialParams& p : {MaterialParams(mapped), MaterialParams(rough),
-                                  MaterialParams(plastic), MaterialParams(gltf)})
+                                  MaterialParams(gltf), MaterialParams(glass)})
     EXPECT_FALSE(Material(p, &coatings).only_color_varies());
   EXPECT_FALSE(Material(DiffuseParams{Spectrum(0.5f)}, &coatings).only_color_varies());
 }
