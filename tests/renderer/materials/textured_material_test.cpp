@@ -252,15 +252,14 @@ TEST(TexturedMaterial, RoughnessAloneIsTheModelWithTheTexturesRoughness) {
       const float r = m->roughness_of_texel(m->roughness_image()->eval(q));
       const SurfaceBsdf b = m->bsdf_at(q);
       const float alpha = roughness_to_alpha(r);
-      if (m == &c) {
-        const auto& model = std::get<ConductorBsdf>(b.model());
+      auto check = [&](const auto& model) {
         EXPECT_EQ(model.smooth(), alpha < kMinMicrofacetAlpha);
         EXPECT_EQ(model.alpha(), GgxDistribution(alpha).alpha());
-      } else {
-        const auto& model = std::get<DielectricBsdf>(b.model());
-        EXPECT_EQ(model.smooth(), alpha < kMinMicrofacetAlpha);
-        EXPECT_EQ(model.alpha(), GgxDistribution(alpha).alpha());
-      }
+      };
+      if (m == &c)
+        check(std::get<ConductorBsdf>(b.model()));
+      else
+        check(std::get<DielectricBsdf>(b.model()));
     }
     // The factor times the texel: 0.7 x 0.6 and 0.9 x 0.6; 0 on the right texel (smooth).
     EXPECT_EQ(m->roughness_of_texel(0.6f), (m == &c ? 0.7f : 0.9f) * 0.6f);
