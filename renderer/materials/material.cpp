@@ -102,11 +102,11 @@ Material::Material(const MaterialParams& params, CoatingTableCache* coatings,
         using P = std::decay_t<decltype(p)>;
         if constexpr (std::is_same_v<P, DiffuseParams> || std::is_same_v<P, ConductorParams> ||
                       std::is_same_v<P, PlasticParams>) {
-          only_color_varies_ = m.color && !m.roughness && !m.metallic && !m.normal_map;
+          only_color_varies_ = m.color && !m.roughness && !m.metallic;
           color_factor_ = p.color;
         }
         if constexpr (std::is_same_v<P, ConductorParams> || std::is_same_v<P, DielectricParams>) {
-          only_roughness_varies_ = m.roughness && !m.color && !m.metallic && !m.normal_map;
+          only_roughness_varies_ = m.roughness && !m.color && !m.metallic;
           roughness_factor_ = p.roughness;
         }
       },

@@ -45,10 +45,11 @@ class Material {
   // Only the normal map varies (no parameter is textured): bsdf_at(q) is bsdf() with
   // mapped_normal_at(q) set, so a caller that holds bsdf()'s parameters needs only that normal.
   bool only_normal_varies() const { return varies_ && !parameters_vary_; }
-  // Only the colour is textured, on a diffuse, conductor or plastic model, and no normal map is
-  // set: bsdf_at(q) is bsdf() with the colour color_at(q) (for the plastic, with_color: its
-  // sampling weight follows the colour), every other parameter bsdf()'s, so a caller that holds
-  // bsdf()'s parameters needs only that colour (no BSDF built per hit).
+  // Of the parameters only the colour is textured, on a diffuse, conductor or plastic model (a
+  // normal map may be set too): bsdf_at(q) is bsdf() with the colour color_at(q) (for the
+  // plastic, with_color: its sampling weight follows the colour) and the normal
+  // mapped_normal_at(q), every other parameter bsdf()'s, so a caller that holds bsdf()'s
+  // parameters needs only that colour (no BSDF built per hit).
   bool only_color_varies() const { return only_color_varies_; }
   // The colour at q as bsdf_at sets it: the factor times the texture clamped to [0, 1].
   Spectrum color_at(const TextureQuery& q) const;
@@ -57,9 +58,9 @@ class Material {
   const ImageSpectrumTexture* color_image() const;
   // The colour of a looked-up texel: the factor times the texel clamped to [0, 1].
   Spectrum color_of_texel(const Spectrum& texel) const;
-  // Likewise for a conductor's or a dielectric's roughness as the only texture (no normal map):
-  // bsdf_at(q) is the model built with roughness_of_texel(roughness_image()->eval(q)), every
-  // other parameter bsdf()'s. roughness_image() is nullptr for any other material.
+  // Likewise for a conductor's or a dielectric's roughness as the only textured parameter:
+  // bsdf_at(q) is the model built with roughness_of_texel(roughness_image()->eval(q)) (and the
+  // map's normal), every other parameter bsdf()'s. nullptr for any other material.
   const ImageFloatTexture* roughness_image() const;
   float roughness_of_texel(float texel) const;
   // The normal map's normal at q as bsdf_at sets it (SurfaceBsdf::mapped_normal): 2 rgb - 1,

@@ -543,18 +543,19 @@ void SurfaceStage::add_textured(size_t i, const PathState& s, const SurfaceHit& 
   // path_scatter's lookup, at the same point: the same parameters to the bit.
   const Material& m = scene_.material(scene_.object(hit.object).material);
   const TextureQuery query{hit.p, hit.uv, s.ray.time};
+  vec3 mapped_normal;
   if (const int32_t k = texture_lookups_of_[hit.object]; k >= 0) {
-    // bsdf_at is bsdf() with the texture's colour or roughness: the object's parameters now,
-    // the texel looked up with the other hits on the material's image (look_up_textures).
+    // bsdf_at is bsdf() with the texture's colour or roughness (and the map's normal): the
+    // object's parameters now, the texel looked up with the other hits on the material's image
+    // (look_up_textures).
     write_params(i, params_[size_t(params_of_[hit.object])]);
     TextureLookups& l = texture_lookups_[size_t(k)];
     l.lanes.push_back(uint32_t(i));
     l.u.push_back(hit.uv.x);
     l.v.push_back(hit.uv.y);
-    return;
-  }
-  vec3 mapped_normal;
-  if (m.only_normal_varies()) {
+    if (!m.normal_mapped()) return;
+    mapped_normal = m.mapped_normal_at(query);
+  } else if (m.only_normal_varies()) {
     // bsdf_at is bsdf() with the map's normal: the object's parameters, and the normal alone
     // looked up (no BSDF built and taken apart per hit).
     write_params(i, params_[size_t(params_of_[hit.object])]);

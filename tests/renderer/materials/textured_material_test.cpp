@@ -184,10 +184,10 @@ TEST(TexturedMaterial, NormalMapAloneIsTheConstantBsdfWithTheMapsNormal) {
   }
 }
 
-// A material whose only texture is its colour, on a diffuse, conductor or plastic model, is its
-// constant BSDF with the colour looked up (the surface stages take only color_at, and the
-// plastic's sampling weight with it): the colour to the bit, with texels beyond [0, 1] clamped;
-// any other texture, a normal map or another model takes the general lookup.
+// A material whose only textured parameter is its colour, on a diffuse, conductor or plastic
+// model, is its constant BSDF with the colour looked up (the surface stages take only color_at,
+// the plastic's sampling weight with it, and the map's normal where there is one): the colour to
+// the bit, with texels beyond [0, 1] clamped; any other texture or model takes the general lookup.
 TEST(TexturedMaterial, ColourAloneIsTheConstantBsdfWithTheTexturesColour) {
   TempFolder dir("textured_colour_only");
   const ImageTextureDesc colour =
@@ -199,9 +199,13 @@ TEST(TexturedMaterial, ColourAloneIsTheConstantBsdfWithTheTexturesColour) {
   conductor.color_texture = colour;
   PlasticParams plastic{Spectrum(0.5f, 0.3f, 0.2f), 1.5f, 0.3f};
   plastic.color_texture = colour;
+  DiffuseParams mapped = diffuse;  // a normal map besides: the colour is still looked up alone
+  mapped.normal_map = other;
   CoatingTableCache coatings;
-  const std::pair<MaterialParams, Spectrum> cases[] = {
-      {diffuse, diffuse.color}, {conductor, conductor.color}, {plastic, plastic.color}};
+  const std::pair<MaterialParams, Spectrum> cases[] = {{diffuse, diffuse.color},
+                                                       {conductor, conductor.color},
+                                                       {plastic, plastic.color},
+                                                       {mapped, mapped.color}};
   for (const auto& [p, factor] : cases) {
     const Material m(p, &coatings);
     ASSERT_TRUE(m.only_color_varies());
@@ -212,22 +216,23 @@ TEST(TexturedMaterial, ColourAloneIsTheConstantBsdfWithTheTexturesColour) {
       const SurfaceBsdf b = m.bsdf_at(at(u, 0.5f));
       EXPECT_EQ(m.color_at(at(u, 0.5f)), b.albedo());
       EXPECT_EQ(b.lobes(), m.bsdf().lobes());
-      EXPECT_FALSE(b.normal_mapped());
+      ASSERT_EQ(b.normal_mapped(), m.normal_mapped());
+      if (m.normal_mapped()) EXPECT_EQ(b.mapped_normal(), m.mapped_normal_at(at(u, 0.5f)));
       // A plastic's sampling weight follows the colour: with_color on the constant BSDF.
       if (const auto* p = std::get_if<PlasticBsdf>(&m.bsdf().model()))
         EXPECT_EQ(std::get<PlasticBsdf>(b.model()).specular_sampling_weight(),
                   p->with_color(m.color_at(at(u, 0.5f))).specular_sampling_weight());
     }
   }
-  DiffuseParams mapped = diffuse;
-  mapped.normal_map = other;
   ConductorParams rough = conductor;
   rough.roughness_texture = other;
   MetallicRoughnessParams gltf{Spectrum(0.7f, 0.6f, 0.3f), 0.4f, 0.5f};
   gltf.color_texture = colour;
   DielectricParams glass{1.5f, 0.2f};
-  for (const MaterialParams& p : {MaterialParams(mapped), MaterialParams(rough),
-                                  MaterialParams(gltf), MaterialParams(glass)})
+  DiffuseParams normal_only{Spectrum(0.5f)};
+  normal_only.normal_map = other;
+  for (const MaterialParams& p : {MaterialParams(rough), MaterialParams(gltf),
+                                  MaterialParams(glass), MaterialParams(normal_only)})
     EXPECT_FALSE(Material(p, &coatings).only_color_varies());
   EXPECT_FALSE(Material(DiffuseParams{Spectrum(0.5f)}, &coatings).only_color_varies());
 }
@@ -243,8 +248,10 @@ TEST(TexturedMaterial, RoughnessAloneIsTheModelWithTheTexturesRoughness) {
   DielectricParams dielectric{1.5f, 0.9f};
   dielectric.roughness_texture = rough;
   CoatingTableCache coatings;
-  const Material c(conductor, &coatings), d(dielectric, &coatings);
-  for (const Material* m : {&c, &d}) {
+  DielectricParams mapped = dielectric;  // a normal map besides: the roughness still alone
+  mapped.normal_map = rough;
+  const Material c(conductor, &coatings), d(dielectric, &coatings), dm(mapped, &coatings);
+  for (const Material* m : {&c, &d, &dm}) {
     ASSERT_NE(m->roughness_image(), nullptr);
     EXPECT_EQ(m->color_image(), nullptr);
     for (const float u : {0.25f, 0.75f}) {
@@ -260,6 +267,8 @@ TEST(TexturedMaterial, RoughnessAloneIsTheModelWithTheTexturesRoughness) {
         check(std::get<ConductorBsdf>(b.model()));
       else
         check(std::get<DielectricBsdf>(b.model()));
+      ASSERT_EQ(b.normal_mapped(), m->normal_mapped());
+      if (m->normal_mapped()) EXPECT_EQ(b.mapped_normal(), m->mapped_normal_at(q));
     }
     // The factor times the texel: 0.7 x 0.6 and 0.9 x 0.6; 0 on the right texel (smooth).
     EXPECT_EQ(m->roughness_of_texel(0.6f), (m == &c ? 0.7f : 0.9f) * 0.6f);
@@ -267,12 +276,9 @@ TEST(TexturedMaterial, RoughnessAloneIsTheModelWithTheTexturesRoughness) {
   }
   ConductorParams with_colour = conductor;
   with_colour.color_texture = rough;
-  DielectricParams mapped = dielectric;
-  mapped.normal_map = rough;
   MetallicRoughnessParams gltf{Spectrum(0.7f, 0.6f, 0.3f), 0.4f, 0.5f};
   gltf.roughness_texture = rough;
-  for (const MaterialParams& p :
-       {MaterialParams(with_colour), MaterialParams(mapped), MaterialParams(gltf)})
+  for (const MaterialParams& p : {MaterialParams(with_colour), MaterialParams(gltf)})
     EXPECT_EQ(Material(p, &coatings).roughness_image(), nullptr);
 }
 

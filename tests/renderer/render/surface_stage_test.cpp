@@ -618,7 +618,18 @@ TEST(SurfaceStage, NormalMappedSurfacesArePathScatterToTheBit) {
   glass.normal_map = map;
   MetallicRoughnessParams gltf{Spectrum(0.7f, 0.6f, 0.3f), 0.4f, 0.5f};
   gltf.normal_map = map;
+  // A textured colour or roughness besides the map: the stages look those up in lanes
+  // (look_up_textures) and the normal per hit.
+  DiffuseParams wood = diffuse;
+  wood.color_texture = map;
+  PlasticParams tiles = coat;
+  tiles.color_texture = map;
+  DielectricParams etched = frosted;
+  etched.roughness_texture = map;
   const Case cases[] = {
+      {"diffuse, textured colour", StageModel::kLambert, wood},
+      {"rough plastic, textured colour", StageModel::kRoughPlastic, tiles},
+      {"rough dielectric, textured roughness", StageModel::kRoughDielectric, etched},
       {"diffuse", StageModel::kLambert, diffuse},
       {"rough conductor", StageModel::kRoughConductor, rough},
       {"mirror", StageModel::kSmoothConductor, mirror},
