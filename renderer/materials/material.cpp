@@ -125,10 +125,16 @@ Material::~Material() = default;
 Material::Material(Material&&) noexcept = default;
 Material& Material::operator=(Material&&) noexcept = default;
 
-vec3 Material::mapped_normal_at(const TextureQuery& q) const {
+vec3 Material::normal_of_texel(const Spectrum& texel) const {
   const float s = impl_->normal_scale;
-  return (2.f * impl_->normal_map->eval(q) - vec3(1.f)) * vec3(s, s, 1.f);
+  return (2.f * texel - vec3(1.f)) * vec3(s, s, 1.f);
 }
+
+vec3 Material::mapped_normal_at(const TextureQuery& q) const {
+  return normal_of_texel(impl_->normal_map->eval(q));
+}
+
+const ImageSpectrumTexture* Material::normal_image() const { return impl_->normal_map.get(); }
 
 Spectrum Material::color_of_texel(const Spectrum& texel) const {
   return color_factor_ * clamp01(texel);

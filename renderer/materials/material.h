@@ -66,6 +66,10 @@ class Material {
   // The normal map's normal at q as bsdf_at sets it (SurfaceBsdf::mapped_normal): 2 rgb - 1,
   // its x and y times glTF's normal scale. Only where normal_mapped().
   vec3 mapped_normal_at(const TextureQuery& q) const;
+  // The normal map's image texture (nullptr without one) and the normal of a looked-up texel:
+  // mapped_normal_at(q) is normal_of_texel(normal_image()->eval(q)).
+  const ImageSpectrumTexture* normal_image() const;
+  vec3 normal_of_texel(const Spectrum& texel) const;
 
   // bsdf()'s answers (tests and untextured materials).
   Spectrum eval(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;

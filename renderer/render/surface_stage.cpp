@@ -457,6 +457,7 @@ SurfaceStage::SurfaceStage(const Scene& scene, StageModel model)
   params_of_.assign(scene.object_count(), -1);
   textured_of_.assign(scene.object_count(), 0);
   texture_lookups_of_.assign(scene.object_count(), -1);
+  normal_lookups_of_.assign(scene.object_count(), -1);
   for (size_t o = 0; o < scene.object_count(); ++o) {
     const Material& m = scene.material(scene.object(uint32_t(o)).material);
     // A rough plastic's coating tables join the stage's list the first time a surface uses them.
@@ -480,15 +481,23 @@ SurfaceStage::SurfaceStage(const Scene& scene, StageModel model)
     const bool roughness_model =
         model == StageModel::kRoughConductor || model == StageModel::kSmoothConductor ||
         model == StageModel::kRoughDielectric || model == StageModel::kSmoothDielectric;
-    if (m.color_image() || (m.roughness_image() && roughness_model)) {
-      size_t k = 0;
-      while (k < texture_lookups_.size() && texture_lookups_[k].material != &m) ++k;
-      if (k == texture_lookups_.size())
-        texture_lookups_.push_back(TextureLookups{&m, m.color_image() == nullptr, {}, {}, {}});
-      texture_lookups_of_[o] = int32_t(k);
-    }
+    if (m.color_image())
+      texture_lookups_of_[o] = lookups_for(m, TextureLookups::kColour);
+    else if (m.roughness_image() && roughness_model)
+      texture_lookups_of_[o] = lookups_for(m, TextureLookups::kRoughness);
+    if (m.normal_mapped() && (texture_lookups_of_[o] >= 0 || m.only_normal_varies()))
+      normal_lookups_of_[o] = lookups_for(m, TextureLookups::kNormal);
   }
   if (model == StageModel::kMetallicRoughness) albedo_table_ = ggx_albedo_table();
+}
+
+int32_t SurfaceStage::lookups_for(const Material& m, TextureLookups::Kind kind) {
+  size_t k = 0;
+  while (k < texture_lookups_.size() &&
+         (texture_lookups_[k].material != &m || texture_lookups_[k].kind != kind))
+    ++k;
+  if (k == texture_lookups_.size()) texture_lookups_.push_back(TextureLookups{&m, kind, {}, {}, {}});
+  return int32_t(k);
 }
 
 void SurfaceStage::start(size_t paths) {
@@ -542,27 +551,27 @@ void SurfaceStage::write_params(size_t i, const SurfaceParams& q) {
 void SurfaceStage::add_textured(size_t i, const PathState& s, const SurfaceHit& hit) {
   // path_scatter's lookup, at the same point: the same parameters to the bit.
   const Material& m = scene_.material(scene_.object(hit.object).material);
-  const TextureQuery query{hit.p, hit.uv, s.ray.time};
-  vec3 mapped_normal;
+  auto defer = [&](int32_t k) {  // look up at (u, v) with the list's other hits
+    TextureLookups& l = texture_lookups_[size_t(k)];
+    l.lanes.push_back(uint32_t(i));
+    l.u.push_back(hit.uv.x);
+    l.v.push_back(hit.uv.y);
+  };
+  vec3 mapped_normal(0.f);  // (deferred to look_up_textures where the map is listed)
   if (const int32_t k = texture_lookups_of_[hit.object]; k >= 0) {
     // bsdf_at is bsdf() with the texture's colour or roughness (and the map's normal): the
     // object's parameters now, the texel looked up with the other hits on the material's image
     // (look_up_textures).
     write_params(i, params_[size_t(params_of_[hit.object])]);
-    TextureLookups& l = texture_lookups_[size_t(k)];
-    l.lanes.push_back(uint32_t(i));
-    l.u.push_back(hit.uv.x);
-    l.v.push_back(hit.uv.y);
+    defer(k);
     if (!m.normal_mapped()) return;
-    mapped_normal = m.mapped_normal_at(query);
   } else if (m.only_normal_varies()) {
     // bsdf_at is bsdf() with the map's normal: the object's parameters, and the normal alone
     // looked up (no BSDF built and taken apart per hit).
     write_params(i, params_[size_t(params_of_[hit.object])]);
-    mapped_normal = m.mapped_normal_at(query);
   } else {
     SurfaceParams q = params_[size_t(params_of_[hit.object])];
-    const SurfaceBsdf b = m.bsdf_at(query);
+    const SurfaceBsdf b = m.bsdf_at(TextureQuery{hit.p, hit.uv, s.ray.time});
     if (!fill_params(b, &q)) unfit_.push_back(uint32_t(i));
     write_params(i, q);
     if (!b.normal_mapped()) return;
@@ -575,8 +584,12 @@ void SurfaceStage::add_textured(size_t i, const PathState& s, const SurfaceHit& 
   for (int c = 0; c < 3; ++c) {
     frame_s_[c][i] = f.s[c];
     frame_t_[c][i] = f.t[c];
-    mapped_n_[c][i] = mapped_normal[c];
   }
+  // The map's normal: looked up with the other hits on it, or the BSDF's.
+  if (const int32_t k = normal_lookups_of_[hit.object]; k >= 0)
+    defer(k);
+  else
+    for (int c = 0; c < 3; ++c) mapped_n_[c][i] = mapped_normal[c];
 }
 
 void SurfaceStage::add(uint32_t slot, const PathState& s, const SurfaceHit& hit, const float* x,
@@ -618,7 +631,18 @@ void SurfaceStage::look_up_textures() {
     if (n == 0) continue;
     for (auto& a : looked_up_)
       if (a.size() < n) a.resize(n);
-    if (l.roughness) {
+    if (l.kind == TextureLookups::kNormal) {
+      l.material->normal_image()->eval_many(n, l.u.data(), l.v.data(), looked_up_[0].data(),
+                                            looked_up_[1].data(), looked_up_[2].data());
+      for (size_t j = 0; j < n; ++j) {
+        // Material::mapped_normal_at on the looked-up texel.
+        const vec3 normal = l.material->normal_of_texel(
+            Spectrum(looked_up_[0][j], looked_up_[1][j], looked_up_[2][j]));
+        for (int k = 0; k < 3; ++k) mapped_n_[k][l.lanes[j]] = normal[k];
+      }
+      continue;
+    }
+    if (l.kind == TextureLookups::kRoughness) {
       l.material->roughness_image()->eval_many(n, l.u.data(), l.v.data(), looked_up_[0].data());
       for (size_t j = 0; j < n; ++j) {
         // The model's constructor on the looked-up roughness (ConductorBsdf, DielectricBsdf):

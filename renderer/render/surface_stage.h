@@ -155,14 +155,21 @@ class SurfaceStage {
   // The hits on materials whose only texture is an image colour (Material::color_image) or a
   // conductor's or dielectric's roughness (roughness_image), one list per such material of the
   // scene, looked up together when the stage computes.
+  // Normal maps likewise, wherever the material's parameters are looked up without a BSDF
+  // (a textured colour or roughness, or no textured parameter).
   struct TextureLookups {
+    enum Kind : uint8_t { kColour, kRoughness, kNormal };
     const Material* material;
-    bool roughness;  // else the colour
+    Kind kind;
     std::vector<uint32_t> lanes;
     std::vector<float> u, v;
   };
   std::vector<TextureLookups> texture_lookups_;
-  std::vector<int32_t> texture_lookups_of_;  // per object: index into texture_lookups_, or -1
+  // Per object: index into texture_lookups_ of its colour or roughness, and of its normal map;
+  // -1 for none.
+  std::vector<int32_t> texture_lookups_of_, normal_lookups_of_;
+  // The list of `kind` for material m (made on first use).
+  int32_t lookups_for(const Material& m, TextureLookups::Kind kind);
   std::vector<float> looked_up_[3];
   // Each list's texels (eval_many), made the lanes' colours or GGX alphas as bsdf_at and
   // fill_params make them.
