@@ -152,11 +152,10 @@ class SurfaceStage {
   // normal-mapped lanes: their mask (set in compute, only when there are any: the kernels'
   // mapped case then costs the other batches nothing), tangent frames' s and t, mapped normals.
   std::vector<uint32_t> unfit_, mapped_lanes_;
-  // The hits on materials whose only texture is an image colour (Material::color_image) or a
-  // conductor's or dielectric's roughness (roughness_image), one list per such material of the
-  // scene, looked up together when the stage computes.
-  // Normal maps likewise, wherever the material's parameters are looked up without a BSDF
-  // (a textured colour or roughness, or no textured parameter).
+  // The hits on materials whose only textured parameter is an image colour
+  // (Material::color_image) or a conductor's or dielectric's roughness (roughness_image), and
+  // on the normal maps of materials whose parameters need no BSDF per hit (those, and a normal
+  // map alone): one list per material and kind, looked up together when the stage computes.
   struct TextureLookups {
     enum Kind : uint8_t { kColour, kRoughness, kNormal };
     const Material* material;
@@ -171,8 +170,8 @@ class SurfaceStage {
   // The list of `kind` for material m (made on first use).
   int32_t lookups_for(const Material& m, TextureLookups::Kind kind);
   std::vector<float> looked_up_[3];
-  // Each list's texels (eval_many), made the lanes' colours or GGX alphas as bsdf_at and
-  // fill_params make them.
+  // Each list's texels (eval_many), made the lanes' colours, GGX alphas or mapped normals as
+  // bsdf_at and fill_params make them.
   [[gnu::noinline]] void look_up_textures();
   std::vector<int32_t> mapped_;
   std::vector<float> frame_s_[3], frame_t_[3], mapped_n_[3];
