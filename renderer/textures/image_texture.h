@@ -31,7 +31,8 @@ class ImageLookup {
   void eval(const vec2& uv, int first, int count, float* out) const;
   // eval at (u[i], v[i]) for i < n, channel first + c into out[c][i]: the same values to the
   // bit, with the texel coordinates and the bilinear blend in SIMD lanes and the texel loads
-  // between them in one loop (docs/performance.md, levers, "textured colours and roughnesses in lanes").
+  // between them in one loop (docs/performance.md, levers: "textured colours and roughnesses
+  // in lanes").
   void eval_many(size_t n, const float* u, const float* v, int first, int count,
                  float* const* out) const;
   const TextureImage& image() const { return *image_; }
