@@ -15,10 +15,6 @@ namespace {
 // A non-finite uv (never produced by the shapes) reads texel 0 rather than overflowing.
 constexpr float kMaxTexelPosition = 1073741824.f;
 
-inline float finite_position(float p) {
-  return std::isfinite(p) ? std::clamp(p, -kMaxTexelPosition, kMaxTexelPosition) : 0.f;
-}
-
 inline int wrap_index(int i, int size, TextureWrap wrap) {
   if (unsigned(i) < unsigned(size)) return i;  // inside: most lookups, and no division
   if (wrap == TextureWrap::kClamp) return std::clamp(i, 0, size - 1);
@@ -26,13 +22,22 @@ inline int wrap_index(int i, int size, TextureWrap wrap) {
   return m < 0 ? m + size : m;
 }
 
-// finite_position on one lane: std::clamp's comparisons as selects, the finiteness test in
-// integer arithmetic (lane.h).
-[[gnu::always_inline]] inline float lane_finite_position(float p) {
+// The texel position p, clamped to +-kMaxTexelPosition, or 0 if not finite: std::clamp's
+// comparisons as selects and the finiteness test in integer arithmetic (lane.h), so that the
+// SIMD lanes below vectorise it and eval computes the same values with it.
+[[gnu::always_inline]] inline float finite_position(float p) {
   const float clamped =
       when(mask(p < -kMaxTexelPosition), -kMaxTexelPosition,
            when(mask(kMaxTexelPosition < p), kMaxTexelPosition, p));
   return when(lane::finite(p), clamped, 0.f);
+}
+
+// Texels t00 (upper left), t10 (right), t01 (below) and t11 weighted by (ax, ay).
+[[gnu::always_inline]] inline float bilinear(float ax, float ay, float t00, float t10, float t01,
+                                             float t11) {
+  const float top = (1.f - ax) * t00 + ax * t10;
+  const float bottom = (1.f - ax) * t01 + ax * t11;
+  return (1.f - ay) * top + ay * bottom;
 }
 
 constexpr size_t kChunk = 64;  // lanes per pass of eval_many (its arrays live on the stack)
@@ -44,8 +49,8 @@ void bilinear_coordinates(size_t n, const float* __restrict u, const float* __re
                           float h, float* __restrict ax, float* __restrict ay,
                           int32_t* __restrict ix, int32_t* __restrict iy) {
   for (size_t i = 0; i < n; ++i) {
-    const float px = lane_finite_position(u[i] * w - 0.5f);
-    const float py = lane_finite_position(v[i] * h - 0.5f);
+    const float px = finite_position(u[i] * w - 0.5f);
+    const float py = finite_position(v[i] * h - 0.5f);
     const float fx = std::floor(px), fy = std::floor(py);
     ax[i] = px - fx;
     ay[i] = py - fy;
@@ -59,8 +64,8 @@ PENUMBRA_SIMD_CLONES
 void nearest_coordinates(size_t n, const float* __restrict u, const float* __restrict v, float w,
                          float h, int32_t* __restrict ix, int32_t* __restrict iy) {
   for (size_t i = 0; i < n; ++i) {
-    ix[i] = int32_t(std::floor(lane_finite_position(u[i] * w)));
-    iy[i] = int32_t(std::floor(lane_finite_position(v[i] * h)));
+    ix[i] = int32_t(std::floor(finite_position(u[i] * w)));
+    iy[i] = int32_t(std::floor(finite_position(v[i] * h)));
   }
 }
 
@@ -71,9 +76,7 @@ void bilinear_blend(size_t n, const float* __restrict ax, const float* __restric
                     const float* __restrict t01, const float* __restrict t11,
                     float* __restrict out) {
   for (size_t i = 0; i < n; ++i) {
-    const float top = (1.f - ax[i]) * t00[i] + ax[i] * t10[i];
-    const float bottom = (1.f - ax[i]) * t01[i] + ax[i] * t11[i];
-    out[i] = (1.f - ay[i]) * top + ay[i] * bottom;
+    out[i] = bilinear(ax[i], ay[i], t00[i], t10[i], t01[i], t11[i]);
   }
 }
 
@@ -149,9 +152,7 @@ void ImageLookup::eval(const vec2& uv, int first, int count, float* out) const {
   image_->fetch(x0, y1, first, count, t01);
   image_->fetch(x1, y1, first, count, t11);
   for (int c = 0; c < count; ++c) {
-    const float top = (1.f - ax) * t00[c] + ax * t10[c];
-    const float bottom = (1.f - ax) * t01[c] + ax * t11[c];
-    out[c] = (1.f - ay) * top + ay * bottom;
+    out[c] = bilinear(ax, ay, t00[c], t10[c], t01[c], t11[c]);
   }
 }
 
