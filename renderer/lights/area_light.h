@@ -31,6 +31,9 @@ class AreaLight final : public Light {
   }
   const Shape& shape() const { return shape_; }
   bool textured() const { return texture_ != nullptr; }
+  // What radiance() multiplies: the constant, and the texture (null when untextured).
+  const Spectrum& radiance_factor() const { return radiance_; }
+  const SpectrumTexture* texture() const { return texture_.get(); }
 
  private:
   const Shape& shape_;

@@ -148,14 +148,18 @@ StagedLights::StagedLights(const Scene& scene) {
       continue;
     }
     const auto* area = dynamic_cast<const AreaLight*>(&light);
-    if (!area || area->textured()) continue;
+    if (!area) continue;
     const auto* quad = dynamic_cast<const Quad*>(&area->shape());
     if (!quad || quad->moving()) continue;
     StagedLights::QuadLight q;
+    if (area->textured()) {
+      q.texture = dynamic_cast<const ImageSpectrumTexture*>(area->texture());
+      if (!q.texture) continue;
+    }
     q.light = int32_t(l);
     const QuadDesc& d = quad->desc();
     const vec3 n = quad->normal();
-    const Spectrum r = area->radiance(TextureQuery{});
+    const Spectrum r = area->radiance_factor();
     for (int c = 0; c < 3; ++c) {
       q.origin[c] = d.origin[c];
       q.u[c] = d.u[c];

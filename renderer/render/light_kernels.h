@@ -2,12 +2,13 @@
 // Next-event light choices and light samples over arrays, for the wavefront driver's SIMD
 // stages: one path at a time a quad light's sample is a dependent chain of multiplies, a square
 // root and two divisions; over arrays eight or sixteen paths go at once. Static, untextured quad
-// lights (the emitters of most scenes), point and directional lights have kernels (the stages'
+// lights (the emitters of most scenes; an image texture's emission too, looked up for all the
+// lanes on the light at once), point and directional lights have kernels (the stages'
 // path integrator never chooses a constant environment: Light::left_to_bsdf_sampling). The
 // values are the scalar code's to the bit: the kernels are LightSampler::choose, Quad::sample
 // with AreaLight::sample, and PointLight::sample operation for operation, compiled without
 // contraction into fused multiply-adds (renderer/CMakeLists.txt). Every other light (spheres,
-// emitting meshes, textured or moving quads, spot lights, environment maps) is `kOwnCode`: the
+// emitting meshes, moving quads, spot lights, environment maps) is `kOwnCode`: the
 // stage calls its Light::sample lane by lane, with the lane's point, time and sampler values,
 // and the rest of the step stays in the lanes.
 #include <cstddef>
@@ -17,6 +18,7 @@
 #include "renderer/core/lane.h"
 #include "renderer/core/math.h"
 #include "renderer/scene/scene.h"
+#include "renderer/textures/image_texture.h"
 
 namespace penumbra {
 
@@ -26,10 +28,13 @@ struct StagedLights {
 
   // kOwnCode: no kernel; sampled lane by lane through Light::sample.
   enum Kind : int32_t { kOwnCode, kQuad, kPoint, kDirectional };
-  // A static, untextured quad light: what Quad::sample and AreaLight::sample read.
+  // A static quad light: what Quad::sample and AreaLight::sample read. A textured one's radiance
+  // is `radiance` times its image's texel at the sample's uv, which is the sample's (u_x, u_y)
+  // (Quad::sample); texture is null for an untextured one.
   struct QuadLight {
     int32_t light;
     float origin[3], u[3], v[3], n[3], area, radiance[3];
+    const ImageSpectrumTexture* texture = nullptr;
   };
   // A point light (PointLight::sample) and a directional one (DirectionalLight::sample: its
   // sample is the same everywhere).

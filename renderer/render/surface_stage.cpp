@@ -504,6 +504,7 @@ void SurfaceStage::start(size_t paths) {
   count_ = 0;
   unfit_.clear();
   own_code_lanes_.clear();
+  emission_lanes_.clear();
   mapped_lanes_.clear();
   for (TextureLookups& l : texture_lookups_) {
     l.lanes.clear();
@@ -718,6 +719,7 @@ void SurfaceStage::compute(const IntegratorSettings& settings, bool scene_next_e
             l_n_[c][i] = q.n[c];
             l_value_[c][i] = q.radiance[c];
           }
+          if (q.texture) emission_lanes_.push_back(uint32_t(i));
           break;
         }
         case StagedLights::kPoint:
@@ -746,6 +748,7 @@ void SurfaceStage::compute(const IntegratorSettings& settings, bool scene_next_e
           own_code_lanes_.push_back(uint32_t(i));
       }
     }
+    if (!emission_lanes_.empty()) look_up_emission();
   }
   if (!own_code_lanes_.empty()) sample_own_code_lights();
   Lanes L;
@@ -816,6 +819,37 @@ void SurfaceStage::compute(const IntegratorSettings& settings, bool scene_next_e
       smooth_dielectric_step_kernel, metallic_roughness_step_kernel};
   static_assert(std::size(kKernels) == std::size(kStageModels));
   kKernels[size_t(model_)](L, n, next_event, any_mapped, int32_t(settings.rr_depth));
+}
+
+void SurfaceStage::look_up_emission() {
+  // AreaLight::sample's radiance(TextureQuery{p, uv, time}) with Quad::sample's uv, the lane's
+  // (u_x, u_y): the light's constant times its texel, negative texels emitting nothing. Each
+  // textured quad's lanes looked up together.
+  for (const StagedLights::QuadLight& q : lights_.quads) {
+    if (!q.texture) continue;
+    emission_of_.clear();
+    emission_u_.clear();
+    emission_v_.clear();
+    for (const uint32_t i : emission_lanes_) {
+      if (light_[i] != q.light) continue;
+      emission_of_.push_back(i);
+      emission_u_.push_back(u_point_[0][i]);
+      emission_v_.push_back(u_point_[1][i]);
+    }
+    const size_t n = emission_of_.size();
+    if (n == 0) continue;
+    for (auto& a : looked_up_)
+      if (a.size() < n) a.resize(n);
+    q.texture->eval_many(n, emission_u_.data(), emission_v_.data(), looked_up_[0].data(),
+                         looked_up_[1].data(), looked_up_[2].data());
+    const Spectrum factor(q.radiance[0], q.radiance[1], q.radiance[2]);
+    for (size_t j = 0; j < n; ++j) {
+      const Spectrum value =
+          factor * glm::max(Spectrum(looked_up_[0][j], looked_up_[1][j], looked_up_[2][j]),
+                            Spectrum(0.f));
+      for (int c = 0; c < 3; ++c) l_value_[c][emission_of_[j]] = value[c];
+    }
+  }
 }
 
 void SurfaceStage::sample_own_code_lights() {

@@ -140,6 +140,11 @@ class SurfaceStage {
   std::vector<int32_t> light_, light_ok_, l_delta_;
   std::vector<float> l_wi_[3], l_distance_, l_pdf_, l_p_[3], l_error_[3], l_n_[3], l_value_[3], l_pmf_;
   std::vector<uint32_t> own_code_lanes_;  // lanes whose light is StagedLights::kOwnCode
+  // Lanes whose light is a textured quad, and one light's lanes and uvs: their radiance is
+  // looked up for all of them at once (look_up_emission, into looked_up_).
+  std::vector<uint32_t> emission_lanes_, emission_of_;
+  std::vector<float> emission_u_, emission_v_;
+  [[gnu::noinline]] void look_up_emission();
   // Those of them whose light is the environment, and their requests and samples for its
   // Light::sample_many.
   std::vector<uint32_t> environment_lanes_;

@@ -193,12 +193,14 @@ struct Coverage {
   int staged = 0, fallback = 0, alive = 0, dead = 0, shadows = 0, back = 0, ball = 0, delta = 0;
   int delta_lights = 0;  // staged lanes whose chosen light is a point or directional light
   int own_code_lights = 0;  // staged lanes whose chosen light has no kernel
+  int textured_lights = 0;  // staged lanes whose chosen light is a textured quad
 };
 
-Coverage expect_stage_matches_material(Lights which, uint32_t seed, StageModel model,
-                                       const MaterialParams& material) {
-  const bool lights = which != Lights::kNone;
-  const auto scene = Scene::build(floor_scene(which, material));
+// The stage on floor_hits of the scene `in` (its objects 0 and 1 the floor and the ball),
+// against path_scatter; `lights`: whether it has lights.
+Coverage expect_stage_matches_scene(const SceneInput& in, bool lights, uint32_t seed,
+                                    StageModel model) {
+  const auto scene = Scene::build(in);
   const StagedLights staged_lights(*scene);
   IntegratorSettings settings;
   settings.max_depth = 16;
@@ -261,6 +263,8 @@ Coverage expect_stage_matches_material(Lights which, uint32_t seed, StageModel m
       const Light& light = scene->light(chosen);
       cover.delta_lights += light.sample(hit.p, 0.f, vec2(0.5f), &ls) && ls.is_delta;
       cover.own_code_lights += staged_lights.kind[size_t(chosen)] == StagedLights::kOwnCode;
+      cover.textured_lights += staged_lights.kind[size_t(chosen)] == StagedLights::kQuad &&
+                               staged_lights.quads[size_t(staged_lights.index[size_t(chosen)])].texture;
     }
     cover.back += glm::dot(lanes[k].state.ray.direction, hit.ng) > 0.f;
     cover.ball += hit.object == 1;
@@ -299,6 +303,12 @@ Coverage expect_stage_matches_material(Lights which, uint32_t seed, StageModel m
   // The next-event rays the staged lanes counted, as path_scatter counts them.
   EXPECT_EQ(delivered_rays, scatter_rays);
   return cover;
+}
+
+Coverage expect_stage_matches_material(Lights which, uint32_t seed, StageModel model,
+                                       const MaterialParams& material) {
+  return expect_stage_matches_scene(floor_scene(which, material), which != Lights::kNone, seed,
+                                    model);
 }
 
 Coverage expect_stage_matches_material(bool lights, uint32_t seed, StageModel model,
@@ -344,6 +354,42 @@ TEST(SurfaceStage, LambertStepIsPathScatterToTheBitUnderAnEnvironmentMap) {
   EXPECT_GT(c.shadows, 500);
   EXPECT_GT(c.alive, 500);
   EXPECT_GT(c.back, 200);
+}
+
+// Quad lights with image textures (bilinear and nearest, negative and zero texels among random
+// ones; RGB and grey) beside the mixed lights: their radiance is looked up in lanes
+// (look_up_emission), and must be AreaLight::sample's to the bit.
+TEST(SurfaceStage, LambertStepIsPathScatterToTheBitWithTexturedQuadLights) {
+  TempFolder dir("surface_stage_emission");
+  std::mt19937 rng(53);
+  std::uniform_real_distribution<float> u(-0.3f, 2.f);
+  std::vector<float> rgb(8 * 8 * 3), grey(4 * 4);
+  for (float& c : rgb) c = u(rng);
+  for (float& c : grey) c = u(rng);
+  rgb[0] = rgb[1] = rgb[2] = 0.f;
+  write_test_image(dir.file("rgb.exr"), 8, 8, 3, rgb);
+  write_test_image(dir.file("grey.exr"), 4, 4, 1, grey);
+  SceneInput in = floor_scene(true, DiffuseParams{Spectrum(0.7f, 0.5f, 0.3f)});
+  auto textured = [&](ObjectDesc o, const std::string& name, TextureFilter filter) {
+    ImageTextureDesc d;
+    d.path = dir.file(name);
+    d.colorspace = TextureColorspace::kLinear;
+    d.filter = filter;
+    o.emission_texture = d;
+    return o;
+  };
+  in.objects.push_back(textured(quad_object({-1.5f, 2.2f, -0.5f}, {1.2f, 0, 0}, {0, 0.2f, 1.f}, 1,
+                                            Spectrum(3.f, 2.f, 1.f)),
+                                "rgb.exr", TextureFilter::kBilinear));
+  in.objects.push_back(textured(quad_object({0.5f, 1.8f, 1.5f}, {0, 0, -1.f}, {1.f, 0.3f, 0}, 1,
+                                            Spectrum(2.f)),
+                                "grey.exr", TextureFilter::kNearest));
+  const Coverage c = expect_stage_matches_scene(in, true, 57, StageModel::kLambert);
+  EXPECT_GT(c.staged, 1000);
+  EXPECT_EQ(c.fallback, 0);
+  EXPECT_GT(c.textured_lights, 200);
+  EXPECT_GT(c.shadows, 500);
+  EXPECT_GT(c.alive, 500);
 }
 
 TEST(SurfaceStage, LambertStepIsPathScatterToTheBitWithoutLights) {
