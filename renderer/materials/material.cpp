@@ -154,6 +154,10 @@ const ImageFloatTexture* Material::roughness_image() const {
 
 float Material::roughness_of_texel(float texel) const { return roughness_factor_ * clamp01(texel); }
 
+const ImageSpectrumTexture* Material::color_texture() const { return impl_->color.get(); }
+const ImageFloatTexture* Material::roughness_texture() const { return impl_->roughness.get(); }
+const ImageFloatTexture* Material::metallic_texture() const { return impl_->metallic.get(); }
+
 SurfaceBsdf Material::bsdf_at(const TextureQuery& q) const {
   const Impl& m = *impl_;
   if (!parameters_vary_) {
@@ -163,13 +167,24 @@ SurfaceBsdf Material::bsdf_at(const TextureQuery& q) const {
     if (m.normal_map) b.set_mapped_normal(mapped_normal_at(q));
     return b;
   }
+  SurfaceBsdf b = bsdf_of_texels(m.color ? m.color->eval(q) : Spectrum(0.f),
+                                 m.roughness ? m.roughness->eval(q) : 0.f,
+                                 m.metallic ? m.metallic->eval(q) : 0.f);
+  if (m.normal_map) b.set_mapped_normal(mapped_normal_at(q));
+  return b;
+}
+
+SurfaceBsdf Material::bsdf_of_texels(const Spectrum& color_texel, float roughness_texel,
+                                     float metallic_texel) const {
+  const Impl& m = *impl_;
+  if (!parameters_vary_) return *m.bsdf;
   auto color = [&](const Spectrum& factor) {
-    return m.color ? factor * clamp01(m.color->eval(q)) : factor;
+    return m.color ? factor * clamp01(color_texel) : factor;
   };
   auto roughness = [&](float factor) {
-    return m.roughness ? factor * clamp01(m.roughness->eval(q)) : factor;
+    return m.roughness ? factor * clamp01(roughness_texel) : factor;
   };
-  SurfaceBsdf b = std::visit(
+  return std::visit(
       [&](const auto& p) -> SurfaceBsdf {
         using P = std::decay_t<decltype(p)>;
         if constexpr (std::is_same_v<P, DiffuseParams>)
@@ -180,14 +195,12 @@ SurfaceBsdf Material::bsdf_at(const TextureQuery& q) const {
           return SurfaceBsdf(DielectricBsdf(p.ior, roughness(p.roughness), p.absorption));
         else if constexpr (std::is_same_v<P, MetallicRoughnessParams>)
           return SurfaceBsdf(MetallicRoughnessBsdf(
-              color(p.color), m.metallic ? p.metallic * clamp01(m.metallic->eval(q)) : p.metallic,
+              color(p.color), m.metallic ? p.metallic * clamp01(metallic_texel) : p.metallic,
               roughness(p.roughness)));
         else  // the coating (and its tables) as built; only the base colour varies
           return SurfaceBsdf(std::get<PlasticBsdf>(m.bsdf->model()).with_color(color(p.color)));
       },
       m.params);
-  if (m.normal_map) b.set_mapped_normal(mapped_normal_at(q));
-  return b;
 }
 
 Spectrum Material::eval(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const {

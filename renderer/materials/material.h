@@ -70,6 +70,15 @@ class Material {
   // mapped_normal_at(q) is normal_of_texel(normal_image()->eval(q)).
   const ImageSpectrumTexture* normal_image() const;
   vec3 normal_of_texel(const Spectrum& texel) const;
+  // Any textured parameters: their image textures (nullptr where the parameter is constant), and
+  // bsdf_at's BSDF built from their texels (those of absent textures unread), without the normal
+  // map: bsdf_at(q) is bsdf_of_texels(color_texture()->eval(q), roughness_texture()->eval(q),
+  // metallic_texture()->eval(q)) with the normal mapped_normal_at(q). So a caller can look up
+  // many points' texels at once (eval_many) and build each point's BSDF from them.
+  const ImageSpectrumTexture* color_texture() const;
+  const ImageFloatTexture* roughness_texture() const;
+  const ImageFloatTexture* metallic_texture() const;
+  SurfaceBsdf bsdf_of_texels(const Spectrum& color, float roughness, float metallic) const;
 
   // bsdf()'s answers (tests and untextured materials).
   Spectrum eval(const BsdfContext& ctx, const vec3& wi, const vec3& wo) const;

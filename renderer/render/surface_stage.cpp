@@ -485,6 +485,8 @@ SurfaceStage::SurfaceStage(const Scene& scene, StageModel model)
       texture_lookups_of_[o] = lookups_for(m, TextureLookups::kColour);
     else if (m.roughness_image() && roughness_model)
       texture_lookups_of_[o] = lookups_for(m, TextureLookups::kRoughness);
+    else if (m.varies() && !m.only_normal_varies())
+      texture_lookups_of_[o] = lookups_for(m, TextureLookups::kParameters);
     if (m.normal_mapped() && (texture_lookups_of_[o] >= 0 || m.only_normal_varies()))
       normal_lookups_of_[o] = lookups_for(m, TextureLookups::kNormal);
   }
@@ -496,7 +498,8 @@ int32_t SurfaceStage::lookups_for(const Material& m, TextureLookups::Kind kind) 
   while (k < texture_lookups_.size() &&
          (texture_lookups_[k].material != &m || texture_lookups_[k].kind != kind))
     ++k;
-  if (k == texture_lookups_.size()) texture_lookups_.push_back(TextureLookups{&m, kind, {}, {}, {}});
+  if (k == texture_lookups_.size())
+    texture_lookups_.push_back(TextureLookups{&m, kind, {}, {}, {}, {}});
   return int32_t(k);
 }
 
@@ -510,6 +513,7 @@ void SurfaceStage::start(size_t paths) {
     l.lanes.clear();
     l.u.clear();
     l.v.clear();
+    l.params.clear();
   }
   if (slot_.size() >= paths) return;
   slot_.resize(paths);
@@ -562,9 +566,12 @@ void SurfaceStage::add_textured(size_t i, const PathState& s, const SurfaceHit& 
   if (const int32_t k = texture_lookups_of_[hit.object]; k >= 0) {
     // bsdf_at is bsdf() with the texture's colour or roughness (and the map's normal): the
     // object's parameters now, the texel looked up with the other hits on the material's image
-    // (look_up_textures).
+    // (look_up_textures). Or (kParameters) the BSDF of all its parameter textures' texels,
+    // built from them when they are looked up.
     write_params(i, params_[size_t(params_of_[hit.object])]);
     defer(k);
+    TextureLookups& l = texture_lookups_[size_t(k)];
+    if (l.kind == TextureLookups::kParameters) l.params.push_back(params_of_[hit.object]);
     if (!m.normal_mapped()) return;
   } else if (m.only_normal_varies()) {
     // bsdf_at is bsdf() with the map's normal: the object's parameters, and the normal alone
@@ -640,6 +647,36 @@ void SurfaceStage::look_up_textures() {
         const vec3 normal = l.material->normal_of_texel(
             Spectrum(looked_up_[0][j], looked_up_[1][j], looked_up_[2][j]));
         for (int k = 0; k < 3; ++k) mapped_n_[k][l.lanes[j]] = normal[k];
+      }
+      continue;
+    }
+    if (l.kind == TextureLookups::kParameters) {
+      // bsdf_at without the normal (which its own list looks up): the BSDF of the hit's texels,
+      // taken apart as add takes apart a BSDF (fill_params), a hit whose BSDF leaves the model
+      // (a smooth texel) left to path_scatter.
+      const Material& m = *l.material;
+      const ImageSpectrumTexture* colour = m.color_texture();
+      const ImageFloatTexture* roughness = m.roughness_texture();
+      const ImageFloatTexture* metallic = m.metallic_texture();
+      if (colour)
+        colour->eval_many(n, l.u.data(), l.v.data(), looked_up_[0].data(), looked_up_[1].data(),
+                          looked_up_[2].data());
+      if (roughness) {
+        if (looked_up_roughness_.size() < n) looked_up_roughness_.resize(n);
+        roughness->eval_many(n, l.u.data(), l.v.data(), looked_up_roughness_.data());
+      }
+      if (metallic) {
+        if (looked_up_metallic_.size() < n) looked_up_metallic_.resize(n);
+        metallic->eval_many(n, l.u.data(), l.v.data(), looked_up_metallic_.data());
+      }
+      for (size_t j = 0; j < n; ++j) {
+        const SurfaceBsdf b = m.bsdf_of_texels(
+            colour ? Spectrum(looked_up_[0][j], looked_up_[1][j], looked_up_[2][j]) : Spectrum(0.f),
+            roughness ? looked_up_roughness_[j] : 0.f, metallic ? looked_up_metallic_[j] : 0.f);
+        const uint32_t i = l.lanes[j];
+        SurfaceParams q = params_[size_t(l.params[j])];
+        if (!fill_params(b, &q)) unfit_.push_back(i);
+        write_params(i, q);
       }
       continue;
     }

@@ -161,12 +161,16 @@ class SurfaceStage {
   // (Material::color_image) or a conductor's or dielectric's roughness (roughness_image), and
   // on the normal maps of materials whose parameters need no BSDF per hit (those, and a normal
   // map alone): one list per material and kind, looked up together when the stage computes.
+  // kParameters: the hits on any other material with textured parameters (several of them, a
+  // metallic-roughness material's): all its parameter textures looked up together, each hit's
+  // BSDF built from its texels (Material::bsdf_of_texels) and taken apart by fill_params.
   struct TextureLookups {
-    enum Kind : uint8_t { kColour, kRoughness, kNormal };
+    enum Kind : uint8_t { kColour, kRoughness, kNormal, kParameters };
     const Material* material;
     Kind kind;
     std::vector<uint32_t> lanes;
     std::vector<float> u, v;
+    std::vector<int32_t> params;  // kParameters: each hit's index into params_
   };
   std::vector<TextureLookups> texture_lookups_;
   // Per object: index into texture_lookups_ of its colour or roughness, and of its normal map;
@@ -174,7 +178,7 @@ class SurfaceStage {
   std::vector<int32_t> texture_lookups_of_, normal_lookups_of_;
   // The list of `kind` for material m (made on first use).
   int32_t lookups_for(const Material& m, TextureLookups::Kind kind);
-  std::vector<float> looked_up_[3];
+  std::vector<float> looked_up_[3], looked_up_roughness_, looked_up_metallic_;
   // Each list's texels (eval_many), made the lanes' colours, GGX alphas or mapped normals as
   // bsdf_at and fill_params make them.
   [[gnu::noinline]] void look_up_textures();
