@@ -1,9 +1,9 @@
 #pragma once
 // Next-event light choices and light samples over arrays, for the wavefront driver's SIMD
 // stages: one path at a time a quad light's sample is a dependent chain of multiplies, a square
-// root and two divisions; over arrays eight or sixteen paths go at once. Static, untextured quad
-// lights (the emitters of most scenes; an image texture's emission too, looked up for all the
-// lanes on the light at once), point and directional lights have kernels (the stages'
+// root and two divisions; over arrays eight or sixteen paths go at once. Static quad lights (the
+// emitters of most scenes; an image-textured one's radiance is then looked up for all the lanes
+// on the light at once), point and directional lights have kernels (the stages'
 // path integrator never chooses a constant environment: Light::left_to_bsdf_sampling). The
 // values are the scalar code's to the bit: the kernels are LightSampler::choose, Quad::sample
 // with AreaLight::sample, and PointLight::sample operation for operation, compiled without
