@@ -79,13 +79,6 @@ class SurfaceStage {
     if (needs_lobe_choice()) bits |= light ? 0b100u : 0b001u;
     return bits;
   }
-  // The dimensions (bit j: dimension j of the layout) whose get_1d/get_2d values add reads: the
-  // light point's (or, where the model estimates no light, the direction's) and the direction's,
-  // and the roulette's where the path is deep enough for it (`roulette`).
-  uint32_t dims_read(bool next_event, bool roulette) const {
-    const int d = estimates_light(next_event) ? 2 : 0;
-    return 0b10u | (1u << (d + 1)) | (roulette ? 1u << (d + 2) : 0u);
-  }
   // Takes every queued path's step (`next_event` as for add).
   void compute(const IntegratorSettings& settings, bool next_event);
   // (With next_event, the step estimates direct light unless the model's lobes are all Dirac

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <array>
-#include <climits>
 #include <iterator>
 #include <numeric>
 
@@ -109,34 +108,22 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
       samples.start(hit_count, BounceSamples::kBounceWithoutLight,
                     BounceSamples::kBounceWithoutLightPairs, lobe_pairs ? 0b001u : 0u);
     }
-    // A staged path's values: only those its stage reads (a Lambertian or conductor surface reads
-    // no lobe pair's 1D value, nor a light pair's with one light; a path before the roulette's
-    // depth no roulette value); every value for the others (path_hit takes them through
-    // PrefetchedSampler, which falls back to the sampler for one not computed, as a staged path
-    // left to path_scatter does). A path at the last depth takes no step: none.
-    std::array<uint32_t, std::size(kStageModels)> stage_pairs{}, stage_dims{}, stage_dims_rr{};
+    // A staged path's pairs: only those its stage reads (a Lambertian or conductor surface reads
+    // no lobe pair's 1D value, nor a light pair's with one light); every pair for the others
+    // (path_hit takes them through PrefetchedSampler, which falls back to the sampler for a
+    // pair not computed, as a staged path left to path_scatter does).
+    std::array<uint32_t, std::size(kStageModels)> stage_pairs{};
     if (kStages) {
       const bool several_lights =
           next_event && next_event_lights<kDistributed>(scene).cdf().size() > 1;
-      for (size_t st = 0; st < b.stages_.size(); ++st) {
+      for (size_t st = 0; st < b.stages_.size(); ++st)
         stage_pairs[st] = b.stages_[st]->pairs_read(next_event, several_lights);
-        stage_dims[st] = b.stages_[st]->dims_read(next_event, false);
-        stage_dims_rr[st] = b.stages_[st]->dims_read(next_event, true);
-      }
     }
-    const int max_depth = settings.max_depth < 0 ? INT_MAX : settings.max_depth;
     for (size_t j = 0; j < hit_count; ++j) {
       const size_t k = hit_slots[j];
       const uint32_t p = live[k];
-      const int depth = b.states_[p].depth;
       const int stage = kStages ? b.stage_of_[b.hits_[k].object] : -1;
-      if (depth >= max_depth)
-        samples.add(*b.samplers_[p], b.cursors_[p], 0u, 0u);
-      else if (stage >= 0)
-        samples.add(*b.samplers_[p], b.cursors_[p], stage_pairs[size_t(stage)],
-                    depth >= settings.rr_depth ? stage_dims_rr[size_t(stage)] : stage_dims[size_t(stage)]);
-      else
-        samples.add(*b.samplers_[p], b.cursors_[p]);
+      samples.add(*b.samplers_[p], b.cursors_[p], stage >= 0 ? stage_pairs[size_t(stage)] : ~0u);
     }
     samples.compute();
 

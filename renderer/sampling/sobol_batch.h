@@ -75,7 +75,6 @@ class BounceSamples {
     if (path_index_.size() < paths) {
       path_index_.resize(paths);
       path_computed_.resize(paths);
-      path_dims_.resize(paths);
     }
     const size_t n = paths * size_t(per_path);
     if (index_.size() < n) {
@@ -85,32 +84,17 @@ class BounceSamples {
       seed_y_.resize(n);
       x_.resize(n);
       y_.resize(n);
-      c_index_.resize(n);
-      c_seed_index_.resize(n);
-      c_seed_x_.resize(n);
-      c_seed_y_.resize(n);
-      c_dest_.resize(n);
-      c_x_.resize(n);
-      c_y_.resize(n);
     }
     paths_ = 0;
-    listed_ = 0;
-    every_dim_ = true;
   }
   // Queues the next path's next per_path dimensions: `sampler` on the path's pixel, at `cursor`.
   // `wanted`: of the computed pairs, those whose 1D value this path may read (a path on a surface
-  // without a lobe choice reads no lobe pair's); `dims`: the dimensions whose get_1d/get_2d
-  // values it may read (bit j: dimension j; a path before the roulette's depth reads none of
-  // the roulette's). The others are left to its sampler.
-  void add(Sampler& sampler, const Sampler::Cursor& cursor, uint32_t wanted = ~0u,
-           uint32_t dims = ~0u) {
+  // without a lobe choice reads no lobe pair's); the others are left to its sampler.
+  void add(Sampler& sampler, const Sampler::Cursor& cursor, uint32_t wanted = ~0u) {
     const size_t e = paths_++ * size_t(per_path_);
     for (int j = 0; j < per_path_; ++j) index_[e + j] = cursor.index;
     path_index_[paths_ - 1] = cursor.index;
     path_computed_[paths_ - 1] = computed_ & wanted;
-    const uint32_t all = (uint32_t(1) << per_path_) - 1u;
-    path_dims_[paths_ - 1] = dims & all;
-    if ((dims & all) != all) every_dim_ = false;
     if (per_path_ == kBounce)
       sampler.scrambles<kBounce>(cursor.dimension, &seed_index_[e], &seed_x_[e], &seed_y_[e]);
     else if (per_path_ == kBounceWithoutLight)
@@ -128,30 +112,11 @@ class BounceSamples {
       z_seed_[q] = seed_x_[e + size_t(j)];
       z_path_[q] = uint32_t(paths_ - 1);
     }
-    // The wanted dimensions listed too, for when some path wants fewer than all (compute).
-    for (uint32_t bits = path_dims_[paths_ - 1]; bits; bits &= bits - 1) {
-      const size_t j = size_t(std::countr_zero(bits)), c = listed_++;
-      c_index_[c] = cursor.index;
-      c_seed_index_[c] = seed_index_[e + j];
-      c_seed_x_[c] = seed_x_[e + j];
-      c_seed_y_[c] = seed_y_[e + j];
-      c_dest_[c] = uint32_t(e + j);
-    }
   }
   // Computes every queued value.
   void compute() {
-    if (every_dim_) {
-      scrambled_sobol_batch(paths_ * size_t(per_path_), index_.data(), seed_index_.data(),
-                            seed_x_.data(), seed_y_.data(), x_.data(), y_.data());
-    } else {
-      // Only the listed dimensions, then each to its place (the others hold stale values).
-      scrambled_sobol_batch(listed_, c_index_.data(), c_seed_index_.data(), c_seed_x_.data(),
-                            c_seed_y_.data(), c_x_.data(), c_y_.data());
-      for (size_t c = 0; c < listed_; ++c) {
-        x_[c_dest_[c]] = c_x_[c];
-        y_[c_dest_[c]] = c_y_[c];
-      }
-    }
+    scrambled_sobol_batch(paths_ * size_t(per_path_), index_.data(), seed_index_.data(), seed_x_.data(),
+                          seed_y_.data(), x_.data(), y_.data());
     // The listed 1D values, then each to its path's place (pair k of path p at k * paths + p).
     // data() + q, not &v[q]: a step with no paths has empty vectors (q = 0).
     for (uint32_t bits = computed_; bits; bits &= bits - 1) {
@@ -171,10 +136,8 @@ class BounceSamples {
   int per_path() const { return per_path_; }
   uint32_t pairs() const { return pairs_; }
   uint32_t computed_pairs() const { return computed_; }
-  // The pairs whose 1D values were computed for this path (computed_pairs() it wanted), and the
-  // dimensions whose values were (bit j: dimension j).
+  // The pairs whose 1D values were computed for this path (computed_pairs() it wanted).
   uint32_t computed_pairs(size_t path) const { return path_computed_[path]; }
-  uint32_t computed_dims(size_t path) const { return path_dims_[path]; }
   // Which pair starts at dimension j (j a bit of pairs).
   int pair_index(int j) const { return pairs_below(pairs_, j); }
 
@@ -184,13 +147,7 @@ class BounceSamples {
   size_t paths_ = 0, stride_ = 0;
   std::vector<uint32_t> index_, seed_index_, seed_x_, seed_y_;
   std::vector<float> x_, y_;
-  std::vector<uint32_t> path_index_, path_computed_, path_dims_;
-  // The wanted dimensions' inputs, results and places in x_ and y_, listed_ of them; every_dim_:
-  // every path wants every dimension (no list needed).
-  size_t listed_ = 0;
-  bool every_dim_ = true;
-  std::vector<uint32_t> c_index_, c_seed_index_, c_seed_x_, c_seed_y_, c_dest_;
-  std::vector<float> c_x_, c_y_;
+  std::vector<uint32_t> path_index_, path_computed_;
   // The 1D values' inputs and results, pair k's listed from k * paths (z_count_[k] of them), and
   // each one's path; z_ holds them in path order.
   std::array<size_t, 32> z_count_{};
@@ -212,31 +169,28 @@ class PrefetchedSampler {
         z_stride_(samples.z_stride()),
         count_(samples.per_path()),
         pairs_(samples.pairs()),
-        computed_(samples.computed_pairs(path)),
-        dims_(samples.computed_dims(path)) {}
+        computed_(samples.computed_pairs(path)) {}
 
   // The prefetched values inline, the rare rest out of line: inlined whole, the fallback's
   // sampler code made GCC call these from the bounce step instead.
-  // A prefetched dimension where it was computed, else the sampler's.
   [[gnu::always_inline]] float get_1d() {
-    if (used_ < count_ && ((dims_ >> used_) & 1u)) {
+    if (used_ < count_) {
       ++cursor_.dimension;
       return x_[used_++];
     }
     return fallback_1d();
   }
   [[gnu::always_inline]] vec2 get_2d() {
-    if (used_ < count_ && ((dims_ >> used_) & 1u)) {
+    if (used_ < count_) {
       ++cursor_.dimension;
       const int j = used_++;
       return vec2(x_[j], y_[j]);
     }
     return fallback_2d();
   }
-  // Sampler::get_1d_2d: prefetched where a pair was computed to start here (and its 2D
-  // dimension), else the sampler's.
+  // Sampler::get_1d_2d: prefetched where a pair was computed to start here, else the sampler's.
   [[gnu::always_inline]] void get_1d_2d(float* u1, vec2* u2) {
-    if (used_ < count_ && ((computed_ >> used_) & 1u) && ((dims_ >> (used_ + 1)) & 1u)) {
+    if (used_ < count_ && ((computed_ >> used_) & 1u)) {
       const int j = used_;
       *u1 = z_[size_t(pairs_below(pairs_, j)) * z_stride_];
       *u2 = vec2(x_[j + 1], y_[j + 1]);
@@ -259,14 +213,12 @@ class PrefetchedSampler {
     sampler_.resume(cursor_);
     const float u = sampler_.get_1d();
     cursor_ = sampler_.cursor();
-    ++used_;
     return u;
   }
   [[gnu::noinline]] vec2 fallback_2d() {
     sampler_.resume(cursor_);
     const vec2 u = sampler_.get_2d();
     cursor_ = sampler_.cursor();
-    ++used_;
     return u;
   }
 
@@ -277,7 +229,7 @@ class PrefetchedSampler {
   const float* z_;
   size_t z_stride_;
   int count_;
-  uint32_t pairs_, computed_, dims_;
+  uint32_t pairs_, computed_;
   int used_ = 0;
 };
 

@@ -147,12 +147,11 @@ TEST(SobolBatch, PrefetchedPairsSeeTheSamplersSequence) {
   }
 }
 
-// The same with each path wanting only some of the computed pairs and of the dimensions
-// (BounceSamples::add's `wanted` and `dims`: a staged surface reads no lobe pair's 1D value, nor
-// the light pair's with one light, nor the roulette's value before its depth): the others'
-// values come from the sampler, and the wanted ones, computed for fewer paths and dimensions
-// than the batch holds, land at their own places.
-TEST(SobolBatch, PrefetchedValuesWantedBySomePathsSeeTheSamplersSequence) {
+// The same with each path wanting only some of the computed pairs (BounceSamples::add's
+// `wanted`: a staged surface reads no lobe pair's 1D value, nor the light pair's with one light):
+// the others' values come from the sampler, and the wanted ones, computed for fewer paths than
+// the batch holds, land at their own paths.
+TEST(SobolBatch, PrefetchedPairsWantedBySomePathsSeeTheSamplersSequence) {
   constexpr int kPaths = 7;
   const int patterns[3][4] = {{3, 3, 1, 0}, {3, 1, 1, 2}, {1, 3, 2, 1}};
   const int takes[3] = {3, 4, 4};
@@ -169,16 +168,13 @@ TEST(SobolBatch, PrefetchedValuesWantedBySomePathsSeeTheSamplersSequence) {
       }
       BounceSamples samples;
       samples.start(kPaths, BounceSamples::kBounce, BounceSamples::kBouncePairs, computed);
-      // Paths 2 and 5 want every pair and dimension, the others a subset each.
+      // Paths 2 and 5 want every pair, the others a subset each.
       auto wants = [&](int p) { return p % 3 == 2 ? ~0u : wanted[(p * 3) % 4]; };
-      const uint32_t dim_sets[5] = {0b11111u, 0b01010u, 0b11010u, 0b00000u, 0b10101u};
-      auto dims = [&](int p) { return p % 3 == 2 ? ~0u : dim_sets[(p + which) % 5]; };
-      for (int p = 0; p < kPaths; ++p) samples.add(shared, cursors[p], wants(p), dims(p));
+      for (int p = 0; p < kPaths; ++p) samples.add(shared, cursors[p], wants(p));
       samples.compute();
       for (int p = 0; p < kPaths; ++p) {
         EXPECT_EQ(samples.computed_pairs(size_t(p)),
                   computed & BounceSamples::kBouncePairs & wants(p));
-        EXPECT_EQ(samples.computed_dims(size_t(p)), dims(p) & 0b11111u);
         std::vector<float> got, expected;
         PrefetchedSampler s(shared, cursors[p], samples, size_t(p));
         take(s, patterns[which], takes[which], &got);
