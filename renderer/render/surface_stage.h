@@ -70,15 +70,6 @@ class SurfaceStage {
     return model_ != StageModel::kLambert && model_ != StageModel::kRoughConductor &&
            model_ != StageModel::kSmoothConductor;
   }
-  // The get_1d_2d pairs (bits of the layout add is given) whose 1D values add reads: the light
-  // pair's where the model estimates light among several lights, the lobe pair's where it picks
-  // a lobe. The caller need compute no other pair's 1D value for the stage's paths.
-  uint32_t pairs_read(bool next_event, bool several_lights) const {
-    const bool light = estimates_light(next_event);
-    uint32_t bits = light && several_lights ? 0b001u : 0u;
-    if (needs_lobe_choice()) bits |= light ? 0b100u : 0b001u;
-    return bits;
-  }
   // Takes every queued path's step (`next_event` as for add).
   void compute(const IntegratorSettings& settings, bool next_event);
   // (With next_event, the step estimates direct light unless the model's lobes are all Dirac

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <array>
-#include <iterator>
 #include <numeric>
 
 #include "renderer/render/integrator.h"
@@ -108,22 +107,9 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
       samples.start(hit_count, BounceSamples::kBounceWithoutLight,
                     BounceSamples::kBounceWithoutLightPairs, lobe_pairs ? 0b001u : 0u);
     }
-    // A staged path's pairs: only those its stage reads (a Lambertian or conductor surface reads
-    // no lobe pair's 1D value, nor a light pair's with one light); every pair for the others
-    // (path_hit takes them through PrefetchedSampler, which falls back to the sampler for a
-    // pair not computed, as a staged path left to path_scatter does).
-    std::array<uint32_t, std::size(kStageModels)> stage_pairs{};
-    if (kStages) {
-      const bool several_lights =
-          next_event && next_event_lights<kDistributed>(scene).cdf().size() > 1;
-      for (size_t st = 0; st < b.stages_.size(); ++st)
-        stage_pairs[st] = b.stages_[st]->pairs_read(next_event, several_lights);
-    }
     for (size_t j = 0; j < hit_count; ++j) {
-      const size_t k = hit_slots[j];
-      const uint32_t p = live[k];
-      const int stage = kStages ? b.stage_of_[b.hits_[k].object] : -1;
-      samples.add(*b.samplers_[p], b.cursors_[p], stage >= 0 ? stage_pairs[size_t(stage)] : ~0u);
+      const uint32_t p = live[hit_slots[j]];
+      samples.add(*b.samplers_[p], b.cursors_[p]);
     }
     samples.compute();
 

@@ -5,7 +5,6 @@
 // waiting on. Over arrays the same operations run in SIMD lanes (eight or sixteen entries per
 // instruction where the CPU has AVX2 or AVX-512, chosen at run time). The values are those of
 // Sampler::get_1d/get_2d/get_1d_2d to the bit: integer operations and an exact conversion.
-#include <array>
 #include <bit>
 #include <cstddef>
 #include <cstdint>
@@ -66,16 +65,9 @@ class BounceSamples {
     if (z_seed_index_.size() < nz) {
       z_seed_index_.resize(nz);
       z_seed_.resize(nz);
-      z_index_.resize(nz);
-      z_path_.resize(nz);
-      z_compact_.resize(nz);
       z_.resize(nz);
     }
-    z_count_.fill(0);
-    if (path_index_.size() < paths) {
-      path_index_.resize(paths);
-      path_computed_.resize(paths);
-    }
+    if (path_index_.size() < paths) path_index_.resize(paths);
     const size_t n = paths * size_t(per_path);
     if (index_.size() < n) {
       index_.resize(n);
@@ -88,43 +80,34 @@ class BounceSamples {
     paths_ = 0;
   }
   // Queues the next path's next per_path dimensions: `sampler` on the path's pixel, at `cursor`.
-  // `wanted`: of the computed pairs, those whose 1D value this path may read (a path on a surface
-  // without a lobe choice reads no lobe pair's); the others are left to its sampler.
-  void add(Sampler& sampler, const Sampler::Cursor& cursor, uint32_t wanted = ~0u) {
+  void add(Sampler& sampler, const Sampler::Cursor& cursor) {
     const size_t e = paths_++ * size_t(per_path_);
     for (int j = 0; j < per_path_; ++j) index_[e + j] = cursor.index;
     path_index_[paths_ - 1] = cursor.index;
-    path_computed_[paths_ - 1] = computed_ & wanted;
     if (per_path_ == kBounce)
       sampler.scrambles<kBounce>(cursor.dimension, &seed_index_[e], &seed_x_[e], &seed_y_[e]);
     else if (per_path_ == kBounceWithoutLight)
       sampler.scrambles<kBounceWithoutLight>(cursor.dimension, &seed_index_[e], &seed_x_[e], &seed_y_[e]);
     else
       sampler.scrambles(cursor.dimension, per_path_, &seed_index_[e], &seed_x_[e], &seed_y_[e]);
-    // Each wanted pair's 1D value: its 2D dimension's index shuffle, its own dimension's x seed,
-    // listed for pair k from k * paths on with the path it is for.
-    for (uint32_t bits = path_computed_[paths_ - 1]; bits; bits &= bits - 1) {
+    // Each computed pair's 1D value: its 2D dimension's index shuffle, its own dimension's x
+    // seed (pair k of path p at k * paths + p).
+    for (uint32_t bits = computed_; bits; bits &= bits - 1) {
       const int j = std::countr_zero(bits);
-      const size_t k = size_t(pair_index(j));
-      const size_t q = k * stride_ + z_count_[k]++;
-      z_index_[q] = cursor.index;
+      const size_t q = size_t(pair_index(j)) * stride_ + (paths_ - 1);
       z_seed_index_[q] = seed_index_[e + size_t(j) + 1];
       z_seed_[q] = seed_x_[e + size_t(j)];
-      z_path_[q] = uint32_t(paths_ - 1);
     }
   }
   // Computes every queued value.
   void compute() {
     scrambled_sobol_batch(paths_ * size_t(per_path_), index_.data(), seed_index_.data(), seed_x_.data(),
                           seed_y_.data(), x_.data(), y_.data());
-    // The listed 1D values, then each to its path's place (pair k of path p at k * paths + p).
     // data() + q, not &v[q]: a step with no paths has empty vectors (q = 0).
     for (uint32_t bits = computed_; bits; bits &= bits - 1) {
-      const size_t k = size_t(pair_index(std::countr_zero(bits)));
-      const size_t q = k * stride_, n = z_count_[k];
-      scrambled_sobol_z_batch(n, z_index_.data() + q, z_seed_index_.data() + q, z_seed_.data() + q,
-                              z_compact_.data() + q);
-      for (size_t i = 0; i < n; ++i) z_[q + z_path_[q + i]] = z_compact_[q + i];
+      const size_t q = size_t(pair_index(std::countr_zero(bits))) * stride_;
+      scrambled_sobol_z_batch(paths_, path_index_.data(), z_seed_index_.data() + q, z_seed_.data() + q,
+                              z_.data() + q);
     }
   }
   const float* x(size_t path) const { return x_.data() + path * size_t(per_path_); }
@@ -136,8 +119,6 @@ class BounceSamples {
   int per_path() const { return per_path_; }
   uint32_t pairs() const { return pairs_; }
   uint32_t computed_pairs() const { return computed_; }
-  // The pairs whose 1D values were computed for this path (computed_pairs() it wanted).
-  uint32_t computed_pairs(size_t path) const { return path_computed_[path]; }
   // Which pair starts at dimension j (j a bit of pairs).
   int pair_index(int j) const { return pairs_below(pairs_, j); }
 
@@ -147,12 +128,8 @@ class BounceSamples {
   size_t paths_ = 0, stride_ = 0;
   std::vector<uint32_t> index_, seed_index_, seed_x_, seed_y_;
   std::vector<float> x_, y_;
-  std::vector<uint32_t> path_index_, path_computed_;
-  // The 1D values' inputs and results, pair k's listed from k * paths (z_count_[k] of them), and
-  // each one's path; z_ holds them in path order.
-  std::array<size_t, 32> z_count_{};
-  std::vector<uint32_t> z_index_, z_seed_index_, z_seed_, z_path_;
-  std::vector<float> z_compact_, z_;
+  std::vector<uint32_t> path_index_, z_seed_index_, z_seed_;
+  std::vector<float> z_;
 };
 
 // One path's sampler during a bounce: the prefetched values first, then its own sampler (a
@@ -169,7 +146,7 @@ class PrefetchedSampler {
         z_stride_(samples.z_stride()),
         count_(samples.per_path()),
         pairs_(samples.pairs()),
-        computed_(samples.computed_pairs(path)) {}
+        computed_(samples.computed_pairs()) {}
 
   // The prefetched values inline, the rare rest out of line: inlined whole, the fallback's
   // sampler code made GCC call these from the bounce step instead.

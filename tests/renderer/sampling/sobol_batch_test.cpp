@@ -147,48 +147,5 @@ TEST(SobolBatch, PrefetchedPairsSeeTheSamplersSequence) {
   }
 }
 
-// The same with each path wanting only some of the computed pairs (BounceSamples::add's
-// `wanted`: a staged surface reads no lobe pair's 1D value, nor the light pair's with one light):
-// the others' values come from the sampler, and the wanted ones, computed for fewer paths than
-// the batch holds, land at their own paths.
-TEST(SobolBatch, PrefetchedPairsWantedBySomePathsSeeTheSamplersSequence) {
-  constexpr int kPaths = 7;
-  const int patterns[3][4] = {{3, 3, 1, 0}, {3, 1, 1, 2}, {1, 3, 2, 1}};
-  const int takes[3] = {3, 4, 4};
-  const uint32_t wanted[4] = {0b000u, 0b001u, 0b100u, 0b101u};
-  for (uint32_t computed = 0; computed < 8; ++computed) {
-    for (int which = 0; which < 3; ++which) {
-      SCOPED_TRACE(testing::Message() << "computed " << computed << ", pattern " << which);
-      Sampler shared(13), alone(13);
-      std::vector<Sampler::Cursor> cursors;
-      for (int p = 0; p < kPaths; ++p) {
-        shared.start_pixel_sample(2, 6, uint32_t(p * 5 + 3));
-        for (int d = 0; d < p % 3; ++d) shared.get_1d();
-        cursors.push_back(shared.cursor());
-      }
-      BounceSamples samples;
-      samples.start(kPaths, BounceSamples::kBounce, BounceSamples::kBouncePairs, computed);
-      // Paths 2 and 5 want every pair, the others a subset each.
-      auto wants = [&](int p) { return p % 3 == 2 ? ~0u : wanted[(p * 3) % 4]; };
-      for (int p = 0; p < kPaths; ++p) samples.add(shared, cursors[p], wants(p));
-      samples.compute();
-      for (int p = 0; p < kPaths; ++p) {
-        EXPECT_EQ(samples.computed_pairs(size_t(p)),
-                  computed & BounceSamples::kBouncePairs & wants(p));
-        std::vector<float> got, expected;
-        PrefetchedSampler s(shared, cursors[p], samples, size_t(p));
-        take(s, patterns[which], takes[which], &got);
-        alone.start_pixel_sample(2, 6, uint32_t(p * 5 + 3));
-        for (int d = 0; d < p % 3; ++d) alone.get_1d();
-        take(alone, patterns[which], takes[which], &expected);
-        EXPECT_EQ(s.cursor().dimension, alone.cursor().dimension);
-        ASSERT_EQ(got.size(), expected.size());
-        for (size_t i = 0; i < got.size(); ++i)
-          ASSERT_EQ(float_bits(got[i]), float_bits(expected[i])) << "path " << p << " value " << i;
-      }
-    }
-  }
-}
-
 }  // namespace
 }  // namespace penumbra::test
