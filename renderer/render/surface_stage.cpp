@@ -487,8 +487,7 @@ SurfaceStage::SurfaceStage(const Scene& scene, StageModel model)
       texture_lookups_of_[o] = lookups_for(m, TextureLookups::kRoughness);
     else if (m.varies() && !m.only_normal_varies())
       texture_lookups_of_[o] = lookups_for(m, TextureLookups::kParameters);
-    if (m.normal_mapped() && (texture_lookups_of_[o] >= 0 || m.only_normal_varies()))
-      normal_lookups_of_[o] = lookups_for(m, TextureLookups::kNormal);
+    if (m.normal_mapped()) normal_lookups_of_[o] = lookups_for(m, TextureLookups::kNormal);
   }
   if (model == StageModel::kMetallicRoughness) albedo_table_ = ggx_albedo_table();
 }
@@ -562,29 +561,17 @@ void SurfaceStage::add_textured(size_t i, const PathState& s, const SurfaceHit& 
     l.u.push_back(hit.uv.x);
     l.v.push_back(hit.uv.y);
   };
-  vec3 mapped_normal(0.f);  // (deferred to look_up_textures where the map is listed)
+  // The object's parameters now; a textured parameter's texel looked up with the other hits on
+  // the material's images (look_up_textures): bsdf_at is bsdf() with the texture's colour or
+  // roughness, or (kParameters) the BSDF of all its parameter textures' texels. Where only the
+  // normal map varies, bsdf_at is bsdf() with the map's normal: no list but the normal's.
+  write_params(i, params_[size_t(params_of_[hit.object])]);
   if (const int32_t k = texture_lookups_of_[hit.object]; k >= 0) {
-    // bsdf_at is bsdf() with the texture's colour or roughness (and the map's normal): the
-    // object's parameters now, the texel looked up with the other hits on the material's image
-    // (look_up_textures). Or (kParameters) the BSDF of all its parameter textures' texels,
-    // built from them when they are looked up.
-    write_params(i, params_[size_t(params_of_[hit.object])]);
     defer(k);
     TextureLookups& l = texture_lookups_[size_t(k)];
     if (l.kind == TextureLookups::kParameters) l.params.push_back(params_of_[hit.object]);
-    if (!m.normal_mapped()) return;
-  } else if (m.only_normal_varies()) {
-    // bsdf_at is bsdf() with the map's normal: the object's parameters, and the normal alone
-    // looked up (no BSDF built and taken apart per hit).
-    write_params(i, params_[size_t(params_of_[hit.object])]);
-  } else {
-    SurfaceParams q = params_[size_t(params_of_[hit.object])];
-    const SurfaceBsdf b = m.bsdf_at(TextureQuery{hit.p, hit.uv, s.ray.time});
-    if (!fill_params(b, &q)) unfit_.push_back(uint32_t(i));
-    write_params(i, q);
-    if (!b.normal_mapped()) return;
-    mapped_normal = b.mapped_normal();
   }
+  if (!m.normal_mapped()) return;
   // path_scatter's frame for a normal map, along dp/du (its n is the hit's ns).
   SurfaceHit h = hit;
   const Frame f = path_step_detail::tangent_frame(scene_, s.ray.time, &h);
@@ -593,11 +580,8 @@ void SurfaceStage::add_textured(size_t i, const PathState& s, const SurfaceHit& 
     frame_s_[c][i] = f.s[c];
     frame_t_[c][i] = f.t[c];
   }
-  // The map's normal: looked up with the other hits on it, or the BSDF's.
-  if (const int32_t k = normal_lookups_of_[hit.object]; k >= 0)
-    defer(k);
-  else
-    for (int c = 0; c < 3; ++c) mapped_n_[c][i] = mapped_normal[c];
+  // The map's normal, looked up with the other hits on it.
+  defer(normal_lookups_of_[hit.object]);
 }
 
 void SurfaceStage::add(uint32_t slot, const PathState& s, const SurfaceHit& hit, const float* x,

@@ -157,13 +157,13 @@ class SurfaceStage {
   // normal-mapped lanes: their mask (set in compute, only when there are any: the kernels'
   // mapped case then costs the other batches nothing), tangent frames' s and t, mapped normals.
   std::vector<uint32_t> unfit_, mapped_lanes_;
-  // The hits on materials whose only textured parameter is an image colour
-  // (Material::color_image) or a conductor's or dielectric's roughness (roughness_image), and
-  // on the normal maps of materials whose parameters need no BSDF per hit (those, and a normal
-  // map alone): one list per material and kind, looked up together when the stage computes.
-  // kParameters: the hits on any other material with textured parameters (several of them, a
-  // metallic-roughness material's): all its parameter textures looked up together, each hit's
-  // BSDF built from its texels (Material::bsdf_of_texels) and taken apart by fill_params.
+  // The hits on every textured material, one list per material and kind, looked up together
+  // when the stage computes: an image colour as the only textured parameter
+  // (Material::color_image) or a conductor's or dielectric's roughness (roughness_image), the
+  // lanes' parameter replaced; any other textured parameters (kParameters: several of them, a
+  // metallic-roughness material's), all its parameter textures looked up together and each
+  // hit's BSDF built from its texels (Material::bsdf_of_texels) and taken apart by fill_params;
+  // and every normal map (kNormal).
   struct TextureLookups {
     enum Kind : uint8_t { kColour, kRoughness, kNormal, kParameters };
     const Material* material;
@@ -173,7 +173,7 @@ class SurfaceStage {
     std::vector<int32_t> params;  // kParameters: each hit's index into params_
   };
   std::vector<TextureLookups> texture_lookups_;
-  // Per object: index into texture_lookups_ of its colour or roughness, and of its normal map;
+  // Per object: index into texture_lookups_ of its parameters' list, and of its normal map's;
   // -1 for none.
   std::vector<int32_t> texture_lookups_of_, normal_lookups_of_;
   // The list of `kind` for material m (made on first use).
