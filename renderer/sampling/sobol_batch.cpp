@@ -1,6 +1,7 @@
 #include "renderer/sampling/sobol_batch.h"
 
 #include "renderer/core/simd_clones.h"
+#include "renderer/sampling/sobol_gfni.h"
 
 namespace penumbra {
 
@@ -30,13 +31,25 @@ void scrambled_sobol_z_kernel(size_t n, const uint32_t* __restrict index,
 
 }  // namespace
 
+void scrambled_sobol_z_batch_portable(size_t n, const uint32_t* index, const uint32_t* seed_index,
+                                      const uint32_t* seed_z, float* z) {
+  scrambled_sobol_z_kernel(n, index, seed_index, seed_z, z);
+}
+
+void scrambled_sobol_batch_portable(size_t n, const uint32_t* index, const uint32_t* seed_index,
+                                    const uint32_t* seed_x, const uint32_t* seed_y, float* x, float* y) {
+  scrambled_sobol_kernel(n, index, seed_index, seed_x, seed_y, x, y);
+}
+
 void scrambled_sobol_z_batch(size_t n, const uint32_t* index, const uint32_t* seed_index,
                              const uint32_t* seed_z, float* z) {
+  if (sobol_gfni_available()) return scrambled_sobol_z_batch_gfni(n, index, seed_index, seed_z, z);
   scrambled_sobol_z_kernel(n, index, seed_index, seed_z, z);
 }
 
 void scrambled_sobol_batch(size_t n, const uint32_t* index, const uint32_t* seed_index,
                            const uint32_t* seed_x, const uint32_t* seed_y, float* x, float* y) {
+  if (sobol_gfni_available()) return scrambled_sobol_batch_gfni(n, index, seed_index, seed_x, seed_y, x, y);
   scrambled_sobol_kernel(n, index, seed_index, seed_x, seed_y, x, y);
 }
 

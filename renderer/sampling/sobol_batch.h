@@ -23,6 +23,12 @@ void scrambled_sobol_batch(size_t n, const uint32_t* index, const uint32_t* seed
 // whose own dimension has x seed seed_z[i] (scrambled_sobol_z of the shared shuffled index).
 void scrambled_sobol_z_batch(size_t n, const uint32_t* index, const uint32_t* seed_index,
                              const uint32_t* seed_z, float* z);
+// The two run sobol_gfni.h's kernels where the CPU has them, else these: loops that GCC
+// compiles for baseline x86-64, AVX2 and AVX-512 (the same values; named for the tests).
+void scrambled_sobol_batch_portable(size_t n, const uint32_t* index, const uint32_t* seed_index,
+                                    const uint32_t* seed_x, const uint32_t* seed_y, float* x, float* y);
+void scrambled_sobol_z_batch_portable(size_t n, const uint32_t* index, const uint32_t* seed_index,
+                                      const uint32_t* seed_z, float* z);
 
 // How many pairs start below dimension j: the bits of `pairs` under bit j. Shifts and adds
 // rather than std::popcount, which a baseline x86-64 build (no POPCNT) makes a call into

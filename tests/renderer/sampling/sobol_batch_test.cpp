@@ -1,4 +1,5 @@
 #include "renderer/sampling/sobol_batch.h"
+#include "renderer/sampling/sobol_gfni.h"
 
 #include <gtest/gtest.h>
 
@@ -31,41 +32,61 @@ void take(S& sampler, const int* pattern, int count, std::vector<float>* out) {
   }
 }
 
-// The batch kernel runs whichever SIMD clone this CPU selects; its values must be the scalar
-// sampler's to the bit, for any index and seeds (sizes not a multiple of any vector width).
+// Every implementation of the batch kernels this CPU runs -- the one scrambled_sobol_batch
+// selects, the portable SIMD clones, the GFNI kernels where the CPU has them -- must give the
+// values of the definitions to the bit, for any index and seeds (sizes not a multiple of any
+// vector width).
+struct SobolKernels {
+  const char* name;
+  void (*xy)(size_t, const uint32_t*, const uint32_t*, const uint32_t*, const uint32_t*, float*, float*);
+  void (*z)(size_t, const uint32_t*, const uint32_t*, const uint32_t*, float*);
+};
+std::vector<SobolKernels> sobol_kernels_here() {
+  std::vector<SobolKernels> kernels = {{"selected", scrambled_sobol_batch, scrambled_sobol_z_batch},
+                                       {"portable", scrambled_sobol_batch_portable, scrambled_sobol_z_batch_portable}};
+  if (sobol_gfni_available()) kernels.push_back({"gfni", scrambled_sobol_batch_gfni, scrambled_sobol_z_batch_gfni});
+  return kernels;
+}
+
 TEST(SobolBatch, KernelIsTheScalarSamplerToTheBit) {
-  for (size_t n : {1u, 7u, 16u, 37u, 1280u}) {
-    std::vector<uint32_t> index(n), si(n), sx(n), sy(n);
-    XorShift32 random{2463534242u + uint32_t(n)};
-    auto next = [&random] { return random.next(); };
-    for (size_t i = 0; i < n; ++i) {
-      index[i] = i % 3 == 0 ? uint32_t(i) : next();
-      si[i] = next();
-      sx[i] = next();
-      sy[i] = next();
-    }
-    std::vector<float> x(n), y(n);
-    scrambled_sobol_batch(n, index.data(), si.data(), sx.data(), sy.data(), x.data(), y.data());
-    for (size_t i = 0; i < n; ++i) {
-      const uint32_t shuffled = nested_uniform_scramble(index[i], si[i]);
-      // The definitions: Burley's nested uniform scramble of each Sobol coordinate.
-      const float ex = fixed_to_unit_float(nested_uniform_scramble(sobol_dimension0(shuffled), sx[i]));
-      const float ey = fixed_to_unit_float(nested_uniform_scramble(sobol_dimension1_reference(shuffled), sy[i]));
-      ASSERT_EQ(float_bits(x[i]), float_bits(ex)) << "n " << n << " entry " << i;
-      ASSERT_EQ(float_bits(y[i]), float_bits(ey)) << "n " << n << " entry " << i;
-    }
-    // The 1D value of a get_1d_2d pair: Sobol's third dimension of the shared shuffled index
-    // (its generator matrix column by column, as Joe and Kuo define it), scrambled.
-    std::vector<float> z(n);
-    scrambled_sobol_z_batch(n, index.data(), si.data(), sx.data(), z.data());
-    for (size_t i = 0; i < n; ++i) {
-      const uint32_t shuffled = nested_uniform_scramble(index[i], si[i]);
-      uint32_t m[33] = {0, 1, 3}, sobol2 = 0;
-      for (int k = 3; k <= 32; ++k) m[k] = (2 * m[k - 1]) ^ (4 * m[k - 2]) ^ m[k - 2];
-      for (int k = 0; k < 32; ++k)
-        if ((shuffled >> k) & 1u) sobol2 ^= uint32_t(uint64_t(m[k + 1]) << (31 - k));
-      const float ez = fixed_to_unit_float(nested_uniform_scramble(sobol2, sx[i]));
-      ASSERT_EQ(float_bits(z[i]), float_bits(ez)) << "n " << n << " entry " << i;
+  for (const SobolKernels& kernels : sobol_kernels_here()) {
+    for (size_t n : {1u, 7u, 15u, 16u, 17u, 37u, 1280u}) {
+      std::vector<uint32_t> index(n), si(n), sx(n), sy(n);
+      XorShift32 random{2463534242u + uint32_t(n)};
+      auto next = [&random] { return random.next(); };
+      for (size_t i = 0; i < n; ++i) {
+        index[i] = i % 3 == 0 ? uint32_t(i) : next();
+        si[i] = next();
+        sx[i] = next();
+        sy[i] = next();
+      }
+      // Entries past n are left as they were (a tail written past the end would show here).
+      std::vector<float> x(n + 16, -1.0f), y(n + 16, -1.0f);
+      kernels.xy(n, index.data(), si.data(), sx.data(), sy.data(), x.data(), y.data());
+      for (size_t i = 0; i < n; ++i) {
+        const uint32_t shuffled = nested_uniform_scramble(index[i], si[i]);
+        // The definitions: Burley's nested uniform scramble of each Sobol coordinate.
+        const float ex = fixed_to_unit_float(nested_uniform_scramble(sobol_dimension0(shuffled), sx[i]));
+        const float ey = fixed_to_unit_float(nested_uniform_scramble(sobol_dimension1_reference(shuffled), sy[i]));
+        ASSERT_EQ(float_bits(x[i]), float_bits(ex)) << kernels.name << " n " << n << " entry " << i;
+        ASSERT_EQ(float_bits(y[i]), float_bits(ey)) << kernels.name << " n " << n << " entry " << i;
+      }
+      for (size_t i = n; i < n + 16; ++i) ASSERT_EQ(x[i], -1.0f) << kernels.name << " wrote past n " << n;
+      for (size_t i = n; i < n + 16; ++i) ASSERT_EQ(y[i], -1.0f) << kernels.name << " wrote past n " << n;
+      // The 1D value of a get_1d_2d pair: Sobol's third dimension of the shared shuffled index
+      // (its generator matrix column by column, as Joe and Kuo define it), scrambled.
+      std::vector<float> z(n + 16, -1.0f);
+      kernels.z(n, index.data(), si.data(), sx.data(), z.data());
+      for (size_t i = 0; i < n; ++i) {
+        const uint32_t shuffled = nested_uniform_scramble(index[i], si[i]);
+        uint32_t m[33] = {0, 1, 3}, sobol2 = 0;
+        for (int k = 3; k <= 32; ++k) m[k] = (2 * m[k - 1]) ^ (4 * m[k - 2]) ^ m[k - 2];
+        for (int k = 0; k < 32; ++k)
+          if ((shuffled >> k) & 1u) sobol2 ^= uint32_t(uint64_t(m[k + 1]) << (31 - k));
+        const float ez = fixed_to_unit_float(nested_uniform_scramble(sobol2, sx[i]));
+        ASSERT_EQ(float_bits(z[i]), float_bits(ez)) << kernels.name << " n " << n << " entry " << i;
+      }
+      for (size_t i = n; i < n + 16; ++i) ASSERT_EQ(z[i], -1.0f) << kernels.name << " wrote past n " << n;
     }
   }
 }
