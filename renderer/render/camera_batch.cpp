@@ -6,9 +6,9 @@
 // thin_lens_camera.cpp are compiled without contraction into fused multiply-adds
 // (-ffp-contract=off, renderer/CMakeLists.txt), so the rays are the scalar ones to the bit.
 #include <cmath>
-#include <vector>
 
 #include "renderer/core/simd_clones.h"
+#include "renderer/materials/lane_microfacet.h"
 #include "renderer/render/thin_lens_camera.h"
 #include "renderer/sampling/sampling.h"
 
@@ -50,22 +50,27 @@ void pinhole_rays(const CameraFrame& c, size_t n, const float* __restrict film_x
   }
 }
 
-// Thin lens: the lens points (disk_x, disk_y, already scaled by the aperture) come in; the ray
-// runs from there through the point of focus.
+// Thin lens: the lens sample (lens_x, lens_y) goes to the disk by the concentric map (its two
+// wedges as selects, lane::disk_concentric) scaled by the aperture, as generate_ray takes it; the
+// ray runs from there through the point of focus.
 PENUMBRA_SIMD_CLONES
-void lens_rays(const CameraFrame& c, float focus_distance, size_t n, const float* __restrict film_x,
-               const float* __restrict film_y, const float* __restrict disk_x,
-               const float* __restrict disk_y, float* __restrict ox, float* __restrict oy,
-               float* __restrict oz, float* __restrict dx, float* __restrict dy,
+void lens_rays(const CameraFrame& c, float focus_distance, float aperture_radius, size_t n,
+               const float* __restrict film_x, const float* __restrict film_y,
+               const float* __restrict lens_x, const float* __restrict lens_y, float* __restrict ox,
+               float* __restrict oy, float* __restrict oz, float* __restrict dx, float* __restrict dy,
                float* __restrict dz) {
   for (size_t i = 0; i < n; ++i) {
     float x, y, z;
     plane_direction(c, film_x[i], film_y[i], &x, &y, &z);
+    float disk_x, disk_y;
+    lane::disk_concentric(lens_x[i], lens_y[i], &disk_x, &disk_y);
+    disk_x *= aperture_radius;
+    disk_y *= aperture_radius;
     const float focus_x = c.px + x * focus_distance, focus_y = c.py + y * focus_distance,
                 focus_z = c.pz + z * focus_distance;
-    const float o_x = (c.px + disk_x[i] * c.rx) + disk_y[i] * c.ux;
-    const float o_y = (c.py + disk_x[i] * c.ry) + disk_y[i] * c.uy;
-    const float o_z = (c.pz + disk_x[i] * c.rz) + disk_y[i] * c.uz;
+    const float o_x = (c.px + disk_x * c.rx) + disk_y * c.ux;
+    const float o_y = (c.py + disk_x * c.ry) + disk_y * c.uy;
+    const float o_z = (c.pz + disk_x * c.rz) + disk_y * c.uz;
     ox[i] = o_x;
     oy[i] = o_y;
     oz[i] = o_z;
@@ -90,16 +95,8 @@ void ThinLensCamera::generate_rays(size_t n, const float* film_x, const float* f
     pinhole_rays(c, n, film_x, film_y, out[3], out[4], out[5]);
     return;
   }
-  // The concentric map per sample, as generate_ray takes it (its polynomial sine and cosine
-  // round the same in a lane, but its two wedges branch).
-  std::vector<float> disk(2 * n);
-  for (size_t i = 0; i < n; ++i) {
-    const vec2 d = square_to_disk_concentric(vec2(lens_x[i], lens_y[i])) * aperture_radius_;
-    disk[i] = d.x;
-    disk[n + i] = d.y;
-  }
-  lens_rays(c, focus_distance_, n, film_x, film_y, disk.data(), disk.data() + n, out[0], out[1],
-            out[2], out[3], out[4], out[5]);
+  lens_rays(c, focus_distance_, aperture_radius_, n, film_x, film_y, lens_x, lens_y, out[0], out[1], out[2],
+            out[3], out[4], out[5]);
 }
 
 }  // namespace penumbra
