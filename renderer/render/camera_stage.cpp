@@ -1,5 +1,7 @@
 #include "renderer/render/camera_stage.h"
 
+#include <algorithm>
+
 namespace penumbra {
 
 CameraStage::CameraStage(const ThinLensCamera& camera, bool sample_lens, bool sample_time,
@@ -22,17 +24,26 @@ void CameraStage::generate(PathBatch& batch) {
   for (const Queued& q : queued_) samples_.add(*q.sampler, Sampler::Cursor{q.index, 0});
   samples_.compute();
   const int film_dim = camera_film_dimension(sample_time_), lens_dim = camera_lens_dimension(sample_time_);
+  // Each dimension's values for all paths are contiguous (BounceSamples' layout).
+  const float* film_u = samples_.x(0) + size_t(film_dim) * samples_.stride();
+  const float* film_v = samples_.y(0) + size_t(film_dim) * samples_.stride();
   for (size_t i = 0; i < n; ++i) {
     const Queued& q = queued_[i];
-    const float* x = samples_.x(i);
-    const float* y = samples_.y(i);
-    const vec2 film = vec2(float(q.x), float(q.y)) + vec2(x[film_dim], y[film_dim]);
+    const vec2 film = vec2(float(q.x), float(q.y)) + vec2(film_u[i], film_v[i]);
     film_x_[i] = film.x;
     film_y_[i] = film.y;
-    lens_x_[i] = sample_lens_ ? x[lens_dim] : 0.5f;
-    lens_y_[i] = sample_lens_ ? y[lens_dim] : 0.5f;
-    time_[i] = sample_time_ ? samples_.z(i)[0] : 0.f;
   }
+  if (sample_lens_) {
+    std::copy_n(samples_.x(0) + size_t(lens_dim) * samples_.stride(), n, lens_x_.data());
+    std::copy_n(samples_.y(0) + size_t(lens_dim) * samples_.stride(), n, lens_y_.data());
+  } else {
+    std::fill_n(lens_x_.data(), n, 0.5f);
+    std::fill_n(lens_y_.data(), n, 0.5f);
+  }
+  if (sample_time_)
+    std::copy_n(samples_.z(0), n, time_.data());
+  else
+    std::fill_n(time_.data(), n, 0.f);
   float* const out[6] = {rays_[0].data(), rays_[1].data(), rays_[2].data(),
                          rays_[3].data(), rays_[4].data(), rays_[5].data()};
   camera_.generate_rays(n, film_x_.data(), film_y_.data(), lens_x_.data(), lens_y_.data(), out);

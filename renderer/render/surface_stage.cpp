@@ -585,7 +585,7 @@ void SurfaceStage::add_textured(size_t i, const PathState& s, const SurfaceHit& 
 }
 
 void SurfaceStage::add(uint32_t slot, const PathState& s, const SurfaceHit& hit, const float* x,
-                       const float* y, const float* z, size_t z_stride, bool next_event) {
+                       const float* y, const float* z, size_t stride, bool next_event) {
   const size_t i = count_++;
   slot_[i] = slot;
   if (textured_of_[hit.object])
@@ -607,12 +607,12 @@ void SurfaceStage::add(uint32_t slot, const PathState& s, const SurfaceHit& hit,
   // event estimation; one get_1d_2d pair), lobe and direction (the next pair), roulette.
   const int d = estimates_light(next_event) ? 2 : 0;
   u_light_[i] = z[0];
-  u_point_[0][i] = x[1];
-  u_point_[1][i] = y[1];
-  u_lobe_[i] = z[size_t(d / 2) * z_stride];
-  u_dir_[0][i] = x[d + 1];
-  u_dir_[1][i] = y[d + 1];
-  u_rr_[i] = x[d + 2];
+  u_point_[0][i] = x[stride];
+  u_point_[1][i] = y[stride];
+  u_lobe_[i] = z[size_t(d / 2) * stride];
+  u_dir_[0][i] = x[size_t(d + 1) * stride];
+  u_dir_[1][i] = y[size_t(d + 1) * stride];
+  u_rr_[i] = x[size_t(d + 2) * stride];
 }
 
 void SurfaceStage::look_up_textures() {

@@ -57,14 +57,15 @@ class SurfaceStage {
   // Empty, with room for `paths` lanes.
   void start(size_t paths);
   // Queues a path after path_arrive: its state, hit, and the step's prefetched sampler values
-  // x[0..4], y[0..4] and its get_1d_2d pairs' 1D values z[0] and z[z_stride] (BounceSamples,
+  // x[j * stride], y[j * stride] for j = 0..4 and its get_1d_2d pairs' 1D values z[0] and
+  // z[stride] (BounceSamples' dimension-major layout,
   // with kBouncePairs or kBounceWithoutLightPairs; the stage reads the light pair's only with
   // more than one light, the lobe pair's only for models with a lobe choice, which the caller
   // computes: needs_lobe_choice); `slot` is the caller's index for it. `next_event`: whether
   // the step estimates direct light (path_scatter's condition for a surface with a diffuse
   // lobe: the scene has lights), which decides which values are whose.
   void add(uint32_t slot, const PathState& s, const SurfaceHit& hit, const float* x,
-           const float* y, const float* z, size_t z_stride, bool next_event);
+           const float* y, const float* z, size_t stride, bool next_event);
   // Whether the stage's model picks among lobes with the step's 1D lobe value.
   bool needs_lobe_choice() const {
     return model_ != StageModel::kLambert && model_ != StageModel::kRoughConductor &&

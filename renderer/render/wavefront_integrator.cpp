@@ -151,7 +151,7 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
       if (stage >= 0) {
         if (path_arrive<kDistributed, kFeatures>(scene, settings, s, hit, first))
           b.stages_[size_t(stage)]->add(uint32_t(k), s, hit, samples.x(j), samples.y(j),
-                                        samples.z(j), samples.z_stride(), next_event);
+                                        samples.z(j), samples.stride(), next_event);
         continue;
       }
       PrefetchedSampler sampler(*b.samplers_[p], b.cursors_[p], samples, j);

@@ -154,6 +154,8 @@ class Sampler {
     uint64_t dimension;
   };
   Cursor cursor() const { return Cursor{index_, dimension_}; }
+  // What the scrambling seeds depend on besides the dimension: the seed and the pixel.
+  uint64_t pixel_key() const { return pixel_seed_; }
   void resume(const Cursor& c) {
     index_ = c.index;
     dimension_ = c.dimension;

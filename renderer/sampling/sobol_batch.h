@@ -5,6 +5,7 @@
 // waiting on. Over arrays the same operations run in SIMD lanes (eight or sixteen entries per
 // instruction where the CPU has AVX2 or AVX-512, chosen at run time). The values are those of
 // Sampler::get_1d/get_2d/get_1d_2d to the bit: integer operations and an exact conversion.
+#include <algorithm>
 #include <bit>
 #include <cstddef>
 #include <cstdint>
@@ -41,9 +42,17 @@ void scrambled_sobol_z_batch_portable(size_t n, const uint32_t* index, const uin
 }
 
 // The values a step of many paths will take, computed together, and each path's view of them.
-// Entry block k holds path k's next per_path dimensions (a bounce takes at most five: light
-// choice, light point, lobe, direction, Russian roulette; the camera one to three); a path that
-// takes more than were prefetched falls back to its sampler.
+// Path k's next per_path dimensions (a bounce takes at most five: light choice, light point,
+// lobe, direction, Russian roulette; the camera one to three) are entries k, k + stride, ...,
+// k + (per_path - 1) stride: dimension-major, so that each dimension's values for all paths are
+// one kernel call over contiguous arrays. A path that takes more than were prefetched falls back
+// to its sampler.
+//
+// The scrambling seeds depend on the pixel and the dimension alone, and consecutive paths of a
+// batch are mostly one pixel's samples at one depth: a run of paths on the same pixel (of the
+// same seed: Sampler::pixel_key) at the same dimension takes its seeds from the sampler once
+// (`add` starts a run when either changes), and `compute` spreads them over the run's entries
+// before the kernels.
 class BounceSamples {
  public:
   static constexpr int kBounce = 5;
@@ -75,8 +84,7 @@ class BounceSamples {
     }
     if (path_index_.size() < paths) path_index_.resize(paths);
     const size_t n = paths * size_t(per_path);
-    if (index_.size() < n) {
-      index_.resize(n);
+    if (seed_index_.size() < n) {
       seed_index_.resize(n);
       seed_x_.resize(n);
       seed_y_.resize(n);
@@ -84,44 +92,73 @@ class BounceSamples {
       y_.resize(n);
     }
     paths_ = 0;
+    runs_.clear();
+    run_seed_index_.clear();
+    run_seed_x_.clear();
+    run_seed_y_.clear();
   }
   // Queues the next path's next per_path dimensions: `sampler` on the path's pixel, at `cursor`.
   void add(Sampler& sampler, const Sampler::Cursor& cursor) {
-    const size_t e = paths_++ * size_t(per_path_);
-    for (int j = 0; j < per_path_; ++j) index_[e + j] = cursor.index;
-    path_index_[paths_ - 1] = cursor.index;
-    if (per_path_ == kBounce)
-      sampler.scrambles<kBounce>(cursor.dimension, &seed_index_[e], &seed_x_[e], &seed_y_[e]);
-    else if (per_path_ == kBounceWithoutLight)
-      sampler.scrambles<kBounceWithoutLight>(cursor.dimension, &seed_index_[e], &seed_x_[e], &seed_y_[e]);
-    else
-      sampler.scrambles(cursor.dimension, per_path_, &seed_index_[e], &seed_x_[e], &seed_y_[e]);
-    // Each computed pair's 1D value: its 2D dimension's index shuffle, its own dimension's x
-    // seed (pair k of path p at k * paths + p).
-    for (uint32_t bits = computed_; bits; bits &= bits - 1) {
-      const int j = std::countr_zero(bits);
-      const size_t q = size_t(pair_index(j)) * stride_ + (paths_ - 1);
-      z_seed_index_[q] = seed_index_[e + size_t(j) + 1];
-      z_seed_[q] = seed_x_[e + size_t(j)];
+    const size_t k = paths_++;
+    path_index_[k] = cursor.index;
+    if (!runs_.empty() && runs_.back().pixel == sampler.pixel_key() && runs_.back().dimension == cursor.dimension) {
+      ++runs_.back().count;
+      return;
     }
+    // A new run: its dimensions' seeds from the sampler, now (it may move to another pixel
+    // before compute).
+    runs_.push_back(Run{sampler.pixel_key(), cursor.dimension, k, 1});
+    const size_t r = run_seed_index_.size();
+    run_seed_index_.resize(r + size_t(per_path_));
+    run_seed_x_.resize(r + size_t(per_path_));
+    run_seed_y_.resize(r + size_t(per_path_));
+    if (per_path_ == kBounce)
+      sampler.scrambles<kBounce>(cursor.dimension, &run_seed_index_[r], &run_seed_x_[r], &run_seed_y_[r]);
+    else if (per_path_ == kBounceWithoutLight)
+      sampler.scrambles<kBounceWithoutLight>(cursor.dimension, &run_seed_index_[r], &run_seed_x_[r],
+                                             &run_seed_y_[r]);
+    else
+      sampler.scrambles(cursor.dimension, per_path_, &run_seed_index_[r], &run_seed_x_[r], &run_seed_y_[r]);
   }
   // Computes every queued value.
   void compute() {
-    scrambled_sobol_batch(paths_ * size_t(per_path_), index_.data(), seed_index_.data(), seed_x_.data(),
-                          seed_y_.data(), x_.data(), y_.data());
-    // data() + q, not &v[q]: a step with no paths has empty vectors (q = 0).
+    // Each run's seeds over its entries: dimension j's (x and y) and, for a computed pair
+    // starting at j, its 2D dimension's index shuffle and its own dimension's x seed (z).
+    for (size_t r = 0; r < runs_.size(); ++r) {
+      const Run& run = runs_[r];
+      const size_t seeds = r * size_t(per_path_);
+      for (int j = 0; j < per_path_; ++j) {
+        const size_t e = size_t(j) * stride_ + run.first;
+        std::fill_n(seed_index_.data() + e, run.count, run_seed_index_[seeds + size_t(j)]);
+        std::fill_n(seed_x_.data() + e, run.count, run_seed_x_[seeds + size_t(j)]);
+        std::fill_n(seed_y_.data() + e, run.count, run_seed_y_[seeds + size_t(j)]);
+      }
+      for (uint32_t bits = computed_; bits; bits &= bits - 1) {
+        const int j = std::countr_zero(bits);
+        const size_t q = size_t(pair_index(j)) * stride_ + run.first;
+        std::fill_n(z_seed_index_.data() + q, run.count, run_seed_index_[seeds + size_t(j) + 1]);
+        std::fill_n(z_seed_.data() + q, run.count, run_seed_x_[seeds + size_t(j)]);
+      }
+    }
+    // data() + e, not &v[e]: a step with no paths has empty vectors (e = 0).
+    for (int j = 0; j < per_path_; ++j) {
+      const size_t e = size_t(j) * stride_;
+      scrambled_sobol_batch(paths_, path_index_.data(), seed_index_.data() + e, seed_x_.data() + e,
+                            seed_y_.data() + e, x_.data() + e, y_.data() + e);
+    }
     for (uint32_t bits = computed_; bits; bits &= bits - 1) {
       const size_t q = size_t(pair_index(std::countr_zero(bits))) * stride_;
       scrambled_sobol_z_batch(paths_, path_index_.data(), z_seed_index_.data() + q, z_seed_.data() + q,
                               z_.data() + q);
     }
   }
-  const float* x(size_t path) const { return x_.data() + path * size_t(per_path_); }
-  const float* y(size_t path) const { return y_.data() + path * size_t(per_path_); }
-  // The path's pairs' 1D values: pair k (the k-th of `pairs` from the lowest dimension) at
-  // z(path)[k * z_stride()]; a pair that was not computed holds a stale value.
+  // Path k's dimension j: x(k)[j * stride()] (its 1D value, or its 2D value's first
+  // coordinate), y(k)[j * stride()]; its pairs' 1D values: pair i (the i-th of `pairs` from the
+  // lowest dimension) at z(k)[i * stride()], a pair that was not computed holding a stale value.
+  const float* x(size_t path) const { return x_.data() + path; }
+  const float* y(size_t path) const { return y_.data() + path; }
   const float* z(size_t path) const { return z_.data() + path; }
-  size_t z_stride() const { return stride_; }
+  size_t stride() const { return stride_; }
   int per_path() const { return per_path_; }
   uint32_t pairs() const { return pairs_; }
   uint32_t computed_pairs() const { return computed_; }
@@ -129,10 +166,16 @@ class BounceSamples {
   int pair_index(int j) const { return pairs_below(pairs_, j); }
 
  private:
+  struct Run {
+    uint64_t pixel, dimension;  // Sampler::pixel_key(), and the run's first dimension
+    size_t first, count;
+  };
   int per_path_ = kBounce;
   uint32_t pairs_ = 0, computed_ = 0;
   size_t paths_ = 0, stride_ = 0;
-  std::vector<uint32_t> index_, seed_index_, seed_x_, seed_y_;
+  std::vector<Run> runs_;
+  std::vector<uint32_t> run_seed_index_, run_seed_x_, run_seed_y_;  // per_path per run
+  std::vector<uint32_t> seed_index_, seed_x_, seed_y_;
   std::vector<float> x_, y_;
   std::vector<uint32_t> path_index_, z_seed_index_, z_seed_;
   std::vector<float> z_;
@@ -149,7 +192,7 @@ class PrefetchedSampler {
         x_(samples.x(path)),
         y_(samples.y(path)),
         z_(samples.z(path)),
-        z_stride_(samples.z_stride()),
+        stride_(samples.stride()),
         count_(samples.per_path()),
         pairs_(samples.pairs()),
         computed_(samples.computed_pairs()) {}
@@ -159,15 +202,15 @@ class PrefetchedSampler {
   [[gnu::always_inline]] float get_1d() {
     if (used_ < count_) {
       ++cursor_.dimension;
-      return x_[used_++];
+      return x_[size_t(used_++) * stride_];
     }
     return fallback_1d();
   }
   [[gnu::always_inline]] vec2 get_2d() {
     if (used_ < count_) {
       ++cursor_.dimension;
-      const int j = used_++;
-      return vec2(x_[j], y_[j]);
+      const size_t e = size_t(used_++) * stride_;
+      return vec2(x_[e], y_[e]);
     }
     return fallback_2d();
   }
@@ -175,8 +218,9 @@ class PrefetchedSampler {
   [[gnu::always_inline]] void get_1d_2d(float* u1, vec2* u2) {
     if (used_ < count_ && ((computed_ >> used_) & 1u)) {
       const int j = used_;
-      *u1 = z_[size_t(pairs_below(pairs_, j)) * z_stride_];
-      *u2 = vec2(x_[j + 1], y_[j + 1]);
+      *u1 = z_[size_t(pairs_below(pairs_, j)) * stride_];
+      const size_t e = size_t(j + 1) * stride_;
+      *u2 = vec2(x_[e], y_[e]);
       used_ += 2;
       cursor_.dimension += 2;
       return;
@@ -210,7 +254,7 @@ class PrefetchedSampler {
   const float* x_;
   const float* y_;
   const float* z_;
-  size_t z_stride_;
+  size_t stride_;
   int count_;
   uint32_t pairs_, computed_;
   int used_ = 0;

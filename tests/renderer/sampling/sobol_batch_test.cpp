@@ -130,6 +130,49 @@ TEST(SobolBatch, PrefetchedPathsSeeTheSamplersSequence) {
   }
 }
 
+// A bounce's paths from several pixels and dimensions, in the orders a batch has them (runs of
+// one pixel's samples, pixels alternating, a path a dimension ahead inside a run, one sampler
+// moved to another pixel between two paths), with every pair computed: each path takes the
+// values its own pixel's Sampler gives (BounceSamples takes a run's seeds once).
+TEST(SobolBatch, PrefetchedRunsOfSeveralPixelsSeeTheirSamplers) {
+  struct Path {
+    int sampler, x, y;
+    uint32_t index;
+    int skip;  // dimensions taken before the bounce
+  };
+  const std::vector<Path> paths = {{0, 1, 2, 0, 0}, {0, 1, 2, 1, 0}, {0, 1, 2, 2, 0}, {1, 7, 3, 0, 0},
+                                   {1, 7, 3, 1, 0}, {0, 1, 2, 3, 0}, {0, 1, 2, 4, 1}, {0, 1, 2, 5, 0},
+                                   {2, 4, 4, 9, 0}, {2, 5, 4, 9, 0}, {2, 5, 4, 10, 0}, {1, 7, 3, 2, 0}};
+  const int pattern[] = {3, 3, 1};
+  Sampler samplers[3] = {Sampler(5), Sampler(5), Sampler(5)};
+  BounceSamples samples;
+  samples.start(paths.size(), BounceSamples::kBounce, BounceSamples::kBouncePairs, 0b00101u);
+  std::vector<Sampler::Cursor> cursors;
+  for (const Path& p : paths) {
+    Sampler& s = samplers[p.sampler];
+    s.start_pixel_sample(p.x, p.y, p.index);
+    for (int d = 0; d < p.skip; ++d) s.get_1d();
+    cursors.push_back(s.cursor());
+    samples.add(s, cursors.back());
+  }
+  samples.compute();
+  for (size_t k = 0; k < paths.size(); ++k) {
+    const Path& p = paths[k];
+    Sampler& s = samplers[p.sampler];
+    s.start_pixel_sample(p.x, p.y, p.index);  // the pixel the path's sampler is on at its step
+    std::vector<float> got, expected;
+    PrefetchedSampler prefetched(s, cursors[k], samples, k);
+    take(prefetched, pattern, 3, &got);
+    Sampler alone(5);
+    alone.start_pixel_sample(p.x, p.y, p.index);
+    for (int d = 0; d < p.skip; ++d) alone.get_1d();
+    take(alone, pattern, 3, &expected);
+    ASSERT_EQ(got.size(), expected.size());
+    for (size_t i = 0; i < got.size(); ++i)
+      ASSERT_EQ(float_bits(got[i]), float_bits(expected[i])) << "path " << k << " value " << i;
+  }
+}
+
 // get_1d_2d pairs through BounceSamples/PrefetchedSampler: a bounce's light pair and lobe pair
 // (pattern 3 at dimensions 0 and 2), a surface with Dirac lobes only (its pair at 0, Russian
 // roulette's plain 1D value at 2, where the layout has the lobe pair), a pair where none was
