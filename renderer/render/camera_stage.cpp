@@ -24,9 +24,8 @@ void CameraStage::generate(PathBatch& batch) {
   for (const Queued& q : queued_) samples_.add(*q.sampler, Sampler::Cursor{q.index, 0});
   samples_.compute();
   const int film_dim = camera_film_dimension(sample_time_), lens_dim = camera_lens_dimension(sample_time_);
-  // Each dimension's values for all paths are contiguous (BounceSamples' layout).
-  const float* film_u = samples_.x(0) + size_t(film_dim) * samples_.stride();
-  const float* film_v = samples_.y(0) + size_t(film_dim) * samples_.stride();
+  const float* film_u = samples_.dimension_x(film_dim);
+  const float* film_v = samples_.dimension_y(film_dim);
   for (size_t i = 0; i < n; ++i) {
     const Queued& q = queued_[i];
     const vec2 film = vec2(float(q.x), float(q.y)) + vec2(film_u[i], film_v[i]);
@@ -34,8 +33,8 @@ void CameraStage::generate(PathBatch& batch) {
     film_y_[i] = film.y;
   }
   if (sample_lens_) {
-    std::copy_n(samples_.x(0) + size_t(lens_dim) * samples_.stride(), n, lens_x_.data());
-    std::copy_n(samples_.y(0) + size_t(lens_dim) * samples_.stride(), n, lens_y_.data());
+    std::copy_n(samples_.dimension_x(lens_dim), n, lens_x_.data());
+    std::copy_n(samples_.dimension_y(lens_dim), n, lens_y_.data());
   } else {
     std::fill_n(lens_x_.data(), n, 0.5f);
     std::fill_n(lens_y_.data(), n, 0.5f);

@@ -44,13 +44,13 @@ void scrambled_sobol_batch_portable(size_t n, const uint32_t* index, const uint3
 void scrambled_sobol_z_batch(size_t n, const uint32_t* index, const uint32_t* seed_index,
                              const uint32_t* seed_z, float* z) {
   if (sobol_gfni_available()) return scrambled_sobol_z_batch_gfni(n, index, seed_index, seed_z, z);
-  scrambled_sobol_z_kernel(n, index, seed_index, seed_z, z);
+  scrambled_sobol_z_batch_portable(n, index, seed_index, seed_z, z);
 }
 
 void scrambled_sobol_batch(size_t n, const uint32_t* index, const uint32_t* seed_index,
                            const uint32_t* seed_x, const uint32_t* seed_y, float* x, float* y) {
   if (sobol_gfni_available()) return scrambled_sobol_batch_gfni(n, index, seed_index, seed_x, seed_y, x, y);
-  scrambled_sobol_kernel(n, index, seed_index, seed_x, seed_y, x, y);
+  scrambled_sobol_batch_portable(n, index, seed_index, seed_x, seed_y, x, y);
 }
 
 }  // namespace penumbra

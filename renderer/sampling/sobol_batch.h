@@ -159,6 +159,9 @@ class BounceSamples {
   const float* y(size_t path) const { return y_.data() + path; }
   const float* z(size_t path) const { return z_.data() + path; }
   size_t stride() const { return stride_; }
+  // Dimension j's values for all paths, contiguous: x(k)[j * stride()] is dimension_x(j)[k].
+  const float* dimension_x(int j) const { return x_.data() + size_t(j) * stride_; }
+  const float* dimension_y(int j) const { return y_.data() + size_t(j) * stride_; }
   int per_path() const { return per_path_; }
   uint32_t pairs() const { return pairs_; }
   uint32_t computed_pairs() const { return computed_; }

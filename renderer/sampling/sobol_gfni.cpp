@@ -122,32 +122,16 @@ PENUMBRA_GFNI_TARGET inline __m512 unit_float_lanes(__m512i x) {
   return _mm512_mul_ps(_mm512_cvtepi32_ps(_mm512_srli_epi32(x, 8)), _mm512_set1_ps(0x1p-24f));
 }
 
-PENUMBRA_GFNI_TARGET void sobol_xy_kernel(size_t n, const uint32_t* index, const uint32_t* seed_index,
-                                          const uint32_t* seed_x, const uint32_t* seed_y, float* x, float* y) {
-  for (size_t i = 0; i < n; i += 16) {
-    const __mmask16 live = n - i >= 16 ? __mmask16(0xffff) : __mmask16((1u << (n - i)) - 1u);
-    const __m512i u = laine_karras_lanes(reverse_lanes(_mm512_maskz_loadu_epi32(live, index + i)),
-                                         _mm512_maskz_loadu_epi32(live, seed_index + i));
-    const __m512i shuffled = reverse_lanes(u);  // shuffled_sample_index
-    const __m512i sx = _mm512_maskz_loadu_epi32(live, seed_x + i);
-    const __m512i sy = _mm512_maskz_loadu_epi32(live, seed_y + i);
-    _mm512_mask_storeu_ps(x + i, live, unit_float_lanes(reverse_lanes(laine_karras_lanes(shuffled, sx))));
-    _mm512_mask_storeu_ps(y + i, live,
-                          unit_float_lanes(reverse_lanes(laine_karras_lanes(superset_parity_lanes(shuffled), sy))));
-  }
+// The lanes of entries i .. i + 15 that exist (the tail's under a mask).
+inline __mmask16 live_lanes(size_t n, size_t i) {
+  return n - i >= 16 ? __mmask16(0xffff) : __mmask16((1u << (n - i)) - 1u);
 }
 
-PENUMBRA_GFNI_TARGET void sobol_z_kernel(size_t n, const uint32_t* index, const uint32_t* seed_index,
-                                         const uint32_t* seed_z, float* z) {
-  for (size_t i = 0; i < n; i += 16) {
-    const __mmask16 live = n - i >= 16 ? __mmask16(0xffff) : __mmask16((1u << (n - i)) - 1u);
-    const __m512i u = laine_karras_lanes(reverse_lanes(_mm512_maskz_loadu_epi32(live, index + i)),
-                                         _mm512_maskz_loadu_epi32(live, seed_index + i));
-    // reverse(sobol_dimension2(shuffled)) with shuffled = reverse(u): one matrix of u.
-    const __m512i reversed = apply_blocks(u, kReversedDimension2);
-    const __m512i sz = _mm512_maskz_loadu_epi32(live, seed_z + i);
-    _mm512_mask_storeu_ps(z + i, live, unit_float_lanes(reverse_lanes(laine_karras_lanes(reversed, sz))));
-  }
+// The sample indices' shuffle before its last reversal: shuffled_sample_index is reverse(u).
+PENUMBRA_GFNI_TARGET inline __m512i shuffle_before_reversal(__mmask16 live, const uint32_t* index,
+                                                           const uint32_t* seed_index) {
+  return laine_karras_lanes(reverse_lanes(_mm512_maskz_loadu_epi32(live, index)),
+                            _mm512_maskz_loadu_epi32(live, seed_index));
 }
 
 }  // namespace
@@ -158,14 +142,30 @@ bool sobol_gfni_available() {
   return available;
 }
 
-void scrambled_sobol_batch_gfni(size_t n, const uint32_t* index, const uint32_t* seed_index,
-                                const uint32_t* seed_x, const uint32_t* seed_y, float* x, float* y) {
-  sobol_xy_kernel(n, index, seed_index, seed_x, seed_y, x, y);
+PENUMBRA_GFNI_TARGET void scrambled_sobol_batch_gfni(size_t n, const uint32_t* index, const uint32_t* seed_index,
+                                                     const uint32_t* seed_x, const uint32_t* seed_y, float* x,
+                                                     float* y) {
+  for (size_t i = 0; i < n; i += 16) {
+    const __mmask16 live = live_lanes(n, i);
+    const __m512i shuffled = reverse_lanes(shuffle_before_reversal(live, index + i, seed_index + i));
+    const __m512i sx = _mm512_maskz_loadu_epi32(live, seed_x + i);
+    const __m512i sy = _mm512_maskz_loadu_epi32(live, seed_y + i);
+    _mm512_mask_storeu_ps(x + i, live, unit_float_lanes(reverse_lanes(laine_karras_lanes(shuffled, sx))));
+    _mm512_mask_storeu_ps(y + i, live,
+                          unit_float_lanes(reverse_lanes(laine_karras_lanes(superset_parity_lanes(shuffled), sy))));
+  }
 }
 
-void scrambled_sobol_z_batch_gfni(size_t n, const uint32_t* index, const uint32_t* seed_index,
-                                  const uint32_t* seed_z, float* z) {
-  sobol_z_kernel(n, index, seed_index, seed_z, z);
+PENUMBRA_GFNI_TARGET void scrambled_sobol_z_batch_gfni(size_t n, const uint32_t* index, const uint32_t* seed_index,
+                                                       const uint32_t* seed_z, float* z) {
+  for (size_t i = 0; i < n; i += 16) {
+    const __mmask16 live = live_lanes(n, i);
+    // reverse(sobol_dimension2(shuffled)) with shuffled = reverse(u): one matrix of u.
+    const __m512i u = shuffle_before_reversal(live, index + i, seed_index + i);
+    const __m512i reversed = apply_blocks(u, kReversedDimension2);
+    const __m512i sz = _mm512_maskz_loadu_epi32(live, seed_z + i);
+    _mm512_mask_storeu_ps(z + i, live, unit_float_lanes(reverse_lanes(laine_karras_lanes(reversed, sz))));
+  }
 }
 
 #else
