@@ -52,14 +52,18 @@ inline UserHitIds user_hit_ids(const RTCIntersectFunctionNArguments* args) {
 }
 
 // Whether a user geometry's hit at exactly the t of the ray's current hit replaces it: when it
-// comes first in (instance, geometry) order. Coincident surfaces (a duplicated object) tie to the
-// bit, and Embree visits them in a different order for a packet than for a single ray; with this
-// rule the lowest ids win whatever the order, so both drivers see the same hit
-// (tests/stress/wavefront_driver_test.cpp, coincident surfaces). No current hit: no tie.
-[[gnu::always_inline]] inline Mask tie_wins(unsigned inst, unsigned geom, unsigned hit_inst,
-                                            unsigned hit_geom) {
+// comes first in (instance, geometry, primitive) order. Coincident surfaces (a duplicated
+// object) tie to the bit, as do two faces of one mesh at the edge they share, and Embree visits
+// them in a different order for a packet than for a single ray; with this rule the lowest ids
+// win whatever the order, so both drivers see the same hit (tests/stress/wavefront_driver_test.cpp,
+// coincident surfaces). No current hit: no tie.
+[[gnu::always_inline]] inline Mask tie_wins(unsigned inst, unsigned geom, unsigned prim,
+                                            unsigned hit_inst, unsigned hit_geom,
+                                            unsigned hit_prim) {
   return mask(hit_geom != RTC_INVALID_GEOMETRY_ID) &
-         (mask(inst < hit_inst) | (mask(inst == hit_inst) & mask(geom < hit_geom)));
+         (mask(inst < hit_inst) |
+          (mask(inst == hit_inst) &
+           (mask(geom < hit_geom) | (mask(geom == hit_geom) & mask(prim < hit_prim)))));
 }
 
 // A user geometry's box as its bounds callback reports it.

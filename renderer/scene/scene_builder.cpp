@@ -191,6 +191,22 @@ class SceneBuilder {
     }
   }
 
+  // Static meshes made of quads are traced as parallelograms (shapes/parallelogram_pairs.h),
+  // unless copied: an instance's hits come through Embree's float inverse transform, and the
+  // copies keep the triangles' geometry filter (below).
+  void parallelogram_meshes() {
+    const std::vector<bool> copied = copied_objects();
+    for (size_t i = 0; i < s_.shapes_.size(); ++i)
+      if (TriangleMesh* mesh = s_.shapes_[i]->triangle_mesh(); mesh && !copied[i])
+        mesh->trace_as_parallelograms();
+  }
+
+  std::vector<bool> copied_objects() const {
+    std::vector<bool> copied(s_.objects_.size(), false);
+    for (const Instance& copy : s_.instances_) copied[copy.object()] = true;
+    return copied;
+  }
+
   // Where each mesh's exact-t test runs (scene/exact_t_check.h): a mesh without a cutout and
   // without copies is checked after traversal, unless two triangles of the scene coincide:
   // Embree's filter-free kernels break their exact-t ties differently in packets and in single
@@ -198,8 +214,7 @@ class SceneBuilder {
   // because Embree hands the filter the ray mapped by its own float inverse, which a check
   // after the fact could not reproduce bit for bit.
   void exact_t_check() {
-    std::vector<bool> copied(s_.objects_.size(), false);
-    for (const Instance& copy : s_.instances_) copied[copy.object()] = true;
+    const std::vector<bool> copied = copied_objects();
     std::vector<const TriangleMesh*> meshes, plain(s_.objects_.size(), nullptr);
     bool any_plain = false;
     for (size_t i = 0; i < s_.shapes_.size(); ++i) {
@@ -217,26 +232,25 @@ class SceneBuilder {
     s_.exact_t_ = ExactTCheck(std::move(plain));
   }
 
-  // Quads in one axis plane (a duplicate, a panel flush with a wall, a tiled floor) can tie
-  // exactly, and Embree would skip the flat box of the second: their boxes get a thickness
-  // (shapes/parallelogram.h, Parallelogram::thicken). Other quads keep their flat boxes.
-  void thicken_coplanar_quads() {
-    std::map<std::pair<int, uint32_t>, std::vector<Quad*>> planes;
-    for (auto& shape : s_.shapes_) {
-      auto* quad = dynamic_cast<Quad*>(shape.get());
-      if (!quad || !quad->parallelogram()) continue;
-      const int k = quad->test().flat_axis();
-      if (k >= 0)
-        planes[{k, std::bit_cast<uint32_t>(quad->test().origin[k] + 0.f)}].push_back(quad);
-    }
-    for (auto& [plane, quads] : planes)
-      if (quads.size() > 1)
-        for (Quad* quad : quads) quad->thicken_box();
+  // Parallelograms in one axis plane (a duplicate, a panel flush with a wall, a tiled floor, a
+  // box standing on the floor) can tie exactly, and Embree would skip the flat box of the
+  // second: their boxes get a thickness (shapes/parallelogram.h, Parallelogram::thicken). Others
+  // keep their flat boxes.
+  void thicken_coplanar_parallelograms() {
+    std::map<std::pair<int, uint32_t>, std::vector<Parallelogram*>> planes;
+    for (auto& shape : s_.shapes_)
+      for (Parallelogram& q : shape->parallelograms())
+        if (const int k = q.flat_axis(); k >= 0)
+          planes[{k, std::bit_cast<uint32_t>(q.origin[k] + 0.f)}].push_back(&q);
+    for (auto& [plane, shapes] : planes)
+      if (shapes.size() > 1)
+        for (Parallelogram* q : shapes) q->thicken();
   }
 
   void embree_scene() {
+    parallelogram_meshes();
     exact_t_check();
-    thicken_coplanar_quads();
+    thicken_coplanar_parallelograms();
     RTCDevice device = embree_device();
     EmbreeErrorScope errors;
     EmbreeScene scene(rtcNewScene(device));

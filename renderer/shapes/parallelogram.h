@@ -9,11 +9,16 @@
 // spawned ray, whose origin lies beyond the hit point's error bound, never meets its own quad
 // again. Seams: (s, t) may exceed [0, 1] by kEdgeTolerance, so two quads sharing an edge
 // overlap by that much instead of leaving a crack of rounding width between them. Ties: a hit
-// at exactly the t of the ray's current hit replaces it when its (instance, geometry) ids are
-// lower, so coincident quads give a ray the same hit in a packet as alone.
+// at exactly the t of the ray's current hit replaces it when its (instance, geometry,
+// primitive) ids are lower, so coincident quads give a ray the same hit in a packet as alone.
+//
+// One user geometry holds any number of them (a quad's one, the face pairs of a mesh traced as
+// parallelograms, shapes/parallelogram_pairs.h), Embree's primitive id indexing the array.
 #include <embree3/rtcore.h>
 
 #include "renderer/core/bounds.h"
+#include "renderer/core/ray.h"
+#include "renderer/embree/handles.h"
 #include "renderer/scene/scene_input.h"
 
 namespace penumbra {
@@ -37,14 +42,43 @@ struct Parallelogram {
   // their axis plane with another (scene_builder.cpp).
   void thicken();
 
+  // Decides hits near its edges exactly (below) from these four corners, in (s, t) order (0, 0),
+  // (1, 0), (1, 1), (0, 1): the first is the origin, the others lie within the tolerance of
+  // origin + u, + u + v and + v (their float sums may round away from them). For a mesh's face
+  // pairs, whose neighbours share these corners to the bit.
+  void use_exact_edges(const vec3& c00, const vec3& c10, const vec3& c11, const vec3& c01);
+
   vec3 origin, u, v;
   dvec3 normal;      // cross(u, v) in double: exact products of the float edges
   vec3 du, dv;       // s = (p - origin) . du, t = (p - origin) . dv for p in the plane
   Bounds3 bounds;    // padded by the tolerance and the test's rounding
+  // Edges: false, the test's (s, t) may overlap the neighbour's by kEdgeTolerance (separate
+  // quads, whose corners meet only to rounding); true, a hit whose (s, t) lies within
+  // kEdgeTolerance of an edge is decided by the side of that edge's line the ray passes, the
+  // sign of ((P - o) x (Q - o)) . d for the edge's corners P, Q (Pluecker, as Embree's robust
+  // triangles): computed from the same floats in the opposite order, a neighbour's is its exact
+  // negation, so the pair neither leaves a crack nor overlaps (an overlap stands out of a convex
+  // edge as a lip that grazing rays hit).
+  bool exact_edges = false;
+  vec3 corners[4];
 };
 
-// The Embree callbacks of a parallelogram's user geometry (user data: the Parallelogram). A hit
-// reports (s, t) as Embree's (u, v); declared for tests, which compare packets with single rays.
+// The point o + s u + t v and its error bound: three products and two sums per coordinate,
+// rounded once each (pbrt-v4 section 6.8.1).
+inline void parallelogram_point(const vec3& o, const vec3& u, const vec3& v, float s, float t,
+                                vec3* p, vec3* error) {
+  const vec3 su = s * u, tv = t * v;
+  *p = o + su + tv;
+  *error = gamma_bound(6) * (abs_components(o) + abs_components(su) + abs_components(tv));
+}
+
+// A committed user geometry of `count` parallelograms from `first` on (primitive k is
+// first[k]; the array must outlive the Embree scene, and their boxes be final).
+EmbreeGeometry make_parallelogram_geometry(RTCDevice device, const Parallelogram* first,
+                                          size_t count);
+
+// The Embree callbacks of that geometry (user data: the array). A hit reports (s, t) as Embree's
+// (u, v); declared for tests, which compare packets with single rays.
 void parallelogram_bounds_fn(const RTCBoundsFunctionArguments* args);
 void parallelogram_intersect_fn(const RTCIntersectFunctionNArguments* args);
 void parallelogram_occluded_fn(const RTCOccludedFunctionNArguments* args);

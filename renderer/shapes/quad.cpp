@@ -21,15 +21,6 @@ ShapeContext triangles_context(ShapeContext ctx) {
   return ctx;
 }
 
-// The point o + s u + t v and its error bound: three products and two sums per coordinate,
-// rounded once each (pbrt-v4 section 6.8.1).
-void parallelogram_point(const vec3& o, const vec3& u, const vec3& v, float s, float t, vec3* p,
-                         vec3* error) {
-  const vec3 su = s * u, tv = t * v;
-  *p = o + su + tv;
-  *error = gamma_bound(6) * (abs_components(o) + abs_components(su) + abs_components(tv));
-}
-
 }  // namespace
 
 Quad::Quad(const QuadDesc& desc, const ShapeContext& ctx)
@@ -43,15 +34,7 @@ Quad::Quad(const QuadDesc& desc, const ShapeContext& ctx)
 
 EmbreeGeometry Quad::make_geometry(RTCDevice device) const {
   if (!parallelogram_) return TriangleMesh::make_geometry(device);
-  EmbreeGeometry geom(rtcNewGeometry(device, RTC_GEOMETRY_TYPE_USER));
-  if (!geom) return geom;
-  rtcSetGeometryUserPrimitiveCount(geom.get(), 1);
-  rtcSetGeometryBoundsFunction(geom.get(), parallelogram_bounds_fn, nullptr);
-  rtcSetGeometryIntersectFunction(geom.get(), parallelogram_intersect_fn);
-  rtcSetGeometryOccludedFunction(geom.get(), parallelogram_occluded_fn);
-  rtcSetGeometryUserData(geom.get(), const_cast<Parallelogram*>(&test_));
-  rtcCommitGeometry(geom.get());
-  return geom;
+  return make_parallelogram_geometry(device, &test_, 1);
 }
 
 void Quad::hit_geometry(const Ray& ray, float t, uint32_t prim, const vec2& uv,

@@ -20,13 +20,14 @@ class Quad final : public TriangleMesh {
   vec3 reference_point() const override { return quad_.origin + 0.5f * (quad_.u + quad_.v); }
   // Not Embree triangles while traced as a parallelogram.
   TriangleMesh* triangle_mesh() override { return parallelogram_ ? nullptr : this; }
+  std::span<Parallelogram> parallelograms() override {
+    return parallelogram_ ? std::span<Parallelogram>(&test_, 1) : std::span<Parallelogram>();
+  }
 
   // Whether it is traced by its own test: static and without a cutout.
   bool parallelogram() const { return parallelogram_; }
-  // That test (meaningful only if parallelogram()), and its box made thick enough for ties
-  // (Parallelogram::thicken; before make_geometry).
+  // That test (meaningful only if parallelogram()).
   const Parallelogram& test() const { return test_; }
-  void thicken_box() { test_.thicken(); }
 
   // What sample() reads, for the wavefront driver's light kernels (render/light_kernels.h).
   const QuadDesc& desc() const { return quad_; }

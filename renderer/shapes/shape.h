@@ -7,6 +7,8 @@
 // scene/scene_input.h, one line in shapes/make_shape.cpp, and its tests (docs/architecture.md).
 #include <embree3/rtcore.h>
 
+#include <span>
+
 #include "renderer/core/bounds.h"
 #include "renderer/core/motion.h"
 #include "renderer/core/ray.h"
@@ -15,6 +17,7 @@
 namespace penumbra {
 
 class TriangleMesh;
+struct Parallelogram;
 
 struct ShapeSample {
   vec3 p;           // point on the surface
@@ -88,6 +91,9 @@ class Shape {
   // where their exact-t test runs (scene/exact_t_check.h) and looks for coincident triangles.
   virtual TriangleMesh* triangle_mesh() { return nullptr; }
   const TriangleMesh* triangle_mesh() const { return const_cast<Shape*>(this)->triangle_mesh(); }
+  // The parallelograms it is traced as (a static quad's one, a mesh's face pairs), else none:
+  // the scene build thickens those that share an axis plane (Parallelogram::thicken).
+  virtual std::span<Parallelogram> parallelograms() { return {}; }
 };
 
 // Solid-angle density of picking point p (normal n) uniformly by area on a surface of `area`:

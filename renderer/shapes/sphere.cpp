@@ -28,8 +28,9 @@ inline void sphere_intersect_one(const RTCIntersectFunctionNArguments* args, uns
   const vec3 o = embree_ray_origin(ray, n, i), d = embree_ray_direction(ray, n, i);
   const float t_far = RTCRayN_tfar(ray, n, i);
   const vec3 c = sphere.center_at(RTCRayN_time(ray, n, i));
-  const bool tie = tie_wins(args->context->instID[0], args->geomID, RTCHitN_instID(hit, n, i, 0),
-                            RTCHitN_geomID(hit, n, i)) != 0;
+  const bool tie = tie_wins(args->context->instID[0], args->geomID, args->primID,
+                            RTCHitN_instID(hit, n, i, 0), RTCHitN_geomID(hit, n, i),
+                            RTCHitN_primID(hit, n, i)) != 0;
   const float t = intersect_sphere(c, sphere.radius(), o, d, t_far, tie);
   if (t <= RTCRayN_tnear(ray, n, i)) return;
   record_user_hit(args, n, i, t, o + t * d - c, 0.f, 0.f);
@@ -136,7 +137,8 @@ template <class RayHitK, bool kMoving>
     lane_center<kMoving>(s, ray.time[i], &cx, &cy, &cz);
     const float ox = ray.org_x[i], oy = ray.org_y[i], oz = ray.org_z[i];
     const float dx = ray.dir_x[i], dy = ray.dir_y[i], dz = ray.dir_z[i];
-    const Mask tie = tie_wins(ids.inst, ids.geom, hit.instID[0][i], hit.geomID[i]);
+    const Mask tie =
+        tie_wins(ids.inst, ids.geom, ids.prim, hit.instID[0][i], hit.geomID[i], hit.primID[i]);
     const float t =
         lane_intersect_sphere(cx, cy, cz, s.radius, ox, oy, oz, dx, dy, dz, ray.tfar[i], tie);
     // The scalar rejection `t <= tnear`, negated (not t > tnear: they differ for a NaN tnear).

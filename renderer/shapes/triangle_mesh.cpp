@@ -139,7 +139,15 @@ vec3 TriangleMesh::interpolated_displacement(float time) const {
   return glm::mix(step_displacement_[i], step_displacement_[i + 1], w);
 }
 
+bool TriangleMesh::trace_as_parallelograms() {
+  if (moving() || has_cutout() || !triangle_cdf_.empty()) return false;
+  face_pairs_ = pair_into_parallelograms(positions_, indices_);
+  return !face_pairs_.shapes.empty();
+}
+
 EmbreeGeometry TriangleMesh::make_geometry(RTCDevice device) const {
+  if (!face_pairs_.shapes.empty())
+    return make_parallelogram_geometry(device, face_pairs_.shapes.data(), face_pairs_.shapes.size());
   EmbreeGeometry geom(rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE));
   if (!geom) return geom;
   if (filter_in_traversal()) {
@@ -172,6 +180,7 @@ EmbreeGeometry TriangleMesh::make_geometry(RTCDevice device) const {
 
 void TriangleMesh::hit_geometry(const Ray& ray, float, uint32_t prim, const vec2& uv,
                                 SurfaceHit* hit) const {
+  if (!face_pairs_.shapes.empty()) return face_pair_hit(prim, uv, hit);
   const uint32_t* tri = &indices_[size_t(prim) * 3];
   vec3 p0 = positions_[tri[0]], p1 = positions_[tri[1]], p2 = positions_[tri[2]];
   vec3 ng;
@@ -186,8 +195,26 @@ void TriangleMesh::hit_geometry(const Ray& ray, float, uint32_t prim, const vec2
   }
   const float b1 = uv.x, b2 = uv.y, b0 = 1.f - b1 - b2;
   barycentric_point(p0, p1, p2, b0, b1, b2, &hit->p, &hit->p_error);
-  if (need_uv_) hit->uv = uv_at(tri, b0, b1, b2);
   hit->ng = ng;
+  interpolate(tri, b0, b1, b2, hit);
+}
+
+void TriangleMesh::face_pair_hit(uint32_t pair, const vec2& st, SurfaceHit* hit) const {
+  // The point on the parallelogram the test met (Quad::hit_geometry), in the triangle of the
+  // pair it lies in, which surface_derivatives reads through hit->primitive.
+  const Parallelogram& q = face_pairs_.shapes[pair];
+  parallelogram_point(q.origin, q.u, q.v, st.x, st.y, &hit->p, &hit->p_error);
+  float b[3];
+  const uint32_t prim = 2 * pair + uint32_t(face_pairs_.slots[pair].locate(st.x, st.y, b));
+  hit->primitive = prim;
+  hit->ng = face_normals_[prim];
+  interpolate(&indices_[size_t(prim) * 3], b[0], b[1], b[2], hit);
+}
+
+void TriangleMesh::interpolate(const uint32_t* tri, float b0, float b1, float b2,
+                               SurfaceHit* hit) const {
+  const vec3 ng = hit->ng;
+  if (need_uv_) hit->uv = uv_at(tri, b0, b1, b2);
   hit->ns = ng;
   if (!normals_.empty()) {
     vec3 ns = b0 * normals_[tri[0]] + b1 * normals_[tri[1]] + b2 * normals_[tri[2]];

@@ -1,10 +1,14 @@
 #pragma once
 // A triangle mesh: Embree's watertight triangle test with the sign of t settled exactly, hit
 // points rebuilt from barycentrics, shading normals and uvs interpolated (without uvs a hit's uv
-// is its barycentrics (b1, b2), as Mitsuba 3), uniform sampling by area.
+// is its barycentrics (b1, b2), as Mitsuba 3), uniform sampling by area. A static mesh whose
+// triangles pair into parallelograms may be traced as those instead (shapes/parallelogram_pairs.h,
+// trace_as_parallelograms); its hits then report the same triangle, barycentrics, uvs and
+// normals as a triangle's hit would.
 #include <vector>
 
 #include "renderer/scene/scene_input.h"
+#include "renderer/shapes/parallelogram_pairs.h"
 #include "renderer/shapes/shape.h"
 
 namespace penumbra {
@@ -22,7 +26,15 @@ class TriangleMesh : public Shape {
   bool sample(const vec3& ref, float time, const vec2& u, ShapeSample* out) const override;
   float pdf(const vec3& ref, const vec3& p, const vec3& n, float time) const override;
   vec3 reference_point() const override { return positions_[indices_[0]]; }
-  TriangleMesh* triangle_mesh() override { return this; }
+  // Not Embree triangles while traced as parallelograms.
+  TriangleMesh* triangle_mesh() override { return face_pairs_.shapes.empty() ? this : nullptr; }
+  std::span<Parallelogram> parallelograms() override { return face_pairs_.shapes; }
+
+  // Traces the mesh as parallelograms if it is static, has no cutout, is not an emitter (whose
+  // samples lie on the triangles) and every consecutive triangle pair is one; true if so. The
+  // scene build calls it before make_geometry, for meshes that are not instanced (copies keep
+  // the triangles' exact-t filter, scene/exact_t_check.h).
+  bool trace_as_parallelograms();
 
   // Whether Embree calls the exact-t test below on every candidate hit (a geometry filter, the
   // default) or the scene checks closest hits after traversal (scene/exact_t_check.h). Set
@@ -82,6 +94,11 @@ class TriangleMesh : public Shape {
   vec2 uv_at(const uint32_t* tri, float b0, float b1, float b2) const {
     return uvs_.empty() ? vec2(b1, b2) : b0 * uvs_[tri[0]] + b1 * uvs_[tri[1]] + b2 * uvs_[tri[2]];
   }
+  // A hit's uv and shading normal at barycentrics (b0, b1, b2) of triangle `tri`, its geometric
+  // normal ng already set.
+  void interpolate(const uint32_t* tri, float b0, float b1, float b2, SurfaceHit* hit) const;
+  // hit_geometry of a mesh traced as parallelograms: face pair `pair` at (s, t).
+  void face_pair_hit(uint32_t pair, const vec2& st, SurfaceHit* hit) const;
 
   const FloatTexture* alpha_ = nullptr;
   float alpha_factor_ = 1.f, alpha_cutoff_ = 0.5f;
@@ -102,6 +119,7 @@ class TriangleMesh : public Shape {
   std::vector<vec3> step_displacement_;
   bool need_uv_ = false;  // something reads SurfaceHit::uv (ShapeContext::need_uv)
   bool filter_in_traversal_ = true;
+  FacePairs face_pairs_;  // empty unless traced as parallelograms
 };
 
 }  // namespace penumbra

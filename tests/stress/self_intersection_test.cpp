@@ -55,7 +55,9 @@ void make_moving(const Placement& p, SceneInput* in) {
 // ---- Point-level: convex objects never shadow themselves toward a light above their tangent
 // plane, and rays refracted into them always reach their far side. ----
 
-enum class Shape { kSphere, kMeshSphere, kBox };
+// kBox: a mesh of quads, traced as parallelograms (shapes/parallelogram_pairs.h); kTriangleBox:
+// the same box with four triangles per face, traced as Embree's triangles.
+enum class Shape { kSphere, kMeshSphere, kBox, kTriangleBox };
 
 SceneInput convex_object(Shape shape, const Placement& p) {
   SceneInput in;
@@ -67,8 +69,12 @@ SceneInput convex_object(Shape shape, const Placement& p) {
     ObjectDesc o;
     o.shape = uv_sphere_mesh(p.offset, p.scale, 24, 48, false);
     in.objects = {o};
-  } else {
+  } else if (shape == Shape::kBox) {
     in.objects = {box(p.offset - vec3(p.scale), p.offset + vec3(p.scale), 0)};
+  } else {
+    ObjectDesc o;
+    o.shape = box_mesh_of_triangles(p.offset - vec3(p.scale), p.offset + vec3(p.scale));
+    in.objects = {o};
   }
   make_moving(p, &in);
   return in;
@@ -144,6 +150,10 @@ TEST_P(ConvexSpawn, TessellatedSphereNoAcneNoLostExits) {
 }
 
 TEST_P(ConvexSpawn, BoxNoAcneNoLostExits) { expect_clean_spawns(Shape::kBox, GetParam()); }
+
+TEST_P(ConvexSpawn, TriangleBoxNoAcneNoLostExits) {
+  expect_clean_spawns(Shape::kTriangleBox, GetParam());
+}
 
 INSTANTIATE_TEST_SUITE_P(Placements, ConvexSpawn, ::testing::ValuesIn(kPlacements));
 
@@ -399,15 +409,19 @@ INSTANTIATE_TEST_SUITE_P(
 // corner: every one must be stopped by a wall. Embree's default (Moeller-Trumbore) triangle test
 // is not watertight and let 92, 130 and 438 of 2e6 rays slip through shared edges at scales 1,
 // 1e3 and 1e-3; the scene is built with RTC_SCENE_FLAG_ROBUST (renderer/scene.cpp), whose
-// Pluecker edge test leaves no crack.
+// Pluecker edge test leaves no crack. The same for the box as a mesh of quads, traced as
+// parallelograms whose exact edges (shapes/parallelogram.h) take the same Pluecker sign.
 TEST(LightLeak, ShadowRaysNeverSlipThroughBoxEdges) {
+  for (const bool triangles : {true, false})
   for (float s : {1e-3f, 1.f, 1e3f}) {
     SceneInput in;
     in.camera = camera_looking(vec3(1, 2, 4) * s, vec3(0.f), 40.f);
     in.materials = {DiffuseParams{Spectrum(0.8f)}};
     in.objects = {box(-vec3(s), vec3(s), 0)};
+    if (triangles) in.objects[0].shape = box_mesh_of_triangles(-vec3(s), vec3(s));
     const auto scene = Scene::build(in);
     const Scene& impl = *scene;
+    ASSERT_EQ(impl.object(0).shape->triangle_mesh() != nullptr, triangles);
     const vec3 light = vec3(1.f - 1e-4f) * s;
     std::mt19937 rng(1);
     std::uniform_real_distribution<float> u(-1.f, 1.f);
@@ -415,6 +429,37 @@ TEST(LightLeak, ShadowRaysNeverSlipThroughBoxEdges) {
     for (int i = 0; i < 2'000'000; ++i) {
       const vec3 o = vec3(u(rng) * 10.f, -1.f, u(rng) * 10.f) * s;
       if (std::abs(o.x) < s && std::abs(o.z) < s) continue;
+      const vec3 d = light - o;
+      const float dist = glm::length(d);
+      if (!impl.occluded(o, d / dist, dist, 0.f)) ++leaks;
+    }
+    EXPECT_EQ(leaks, 0) << "scale " << s << (triangles ? " triangles" : " parallelograms");
+  }
+}
+
+// A mesh box turned so that its corners are rounded floats, traced as parallelograms: faces
+// meet at shared corners, their fourth corners a rounding off origin + u + v; shadow rays toward
+// a light just inside a corner never get through.
+TEST(LightLeak, ShadowRaysNeverSlipThroughEdgesOfATurnedMeshBox) {
+  const glm::mat3 turn = glm::mat3(glm::rotate(glm::mat4(1.f), 0.7f, glm::normalize(vec3(1, 2, 3))));
+  for (float s : {1e-3f, 1.f, 1e3f}) {
+    SceneInput in;
+    in.camera = camera_looking(vec3(1, 2, 4) * s, vec3(0.f), 40.f);
+    in.materials = {DiffuseParams{Spectrum(0.8f)}};
+    const vec3 lo = vec3(-s);
+    in.objects = {box(lo, vec3(s), 0)};
+    MeshDesc& mesh = std::get<MeshDesc>(in.objects[0].shape);
+    for (vec3& p : mesh.positions) p = lo + turn * (p - lo);
+    const auto scene = Scene::build(in);
+    const Scene& impl = *scene;
+    ASSERT_EQ(impl.object(0).shape->triangle_mesh(), nullptr) << "parallelograms";
+    const vec3 light = lo + turn * vec3(2e-4f * s);
+    std::mt19937 rng(1);
+    std::uniform_real_distribution<float> u(-1.f, 1.f);
+    int leaks = 0;
+    for (int i = 0; i < 2'000'000; ++i) {
+      const vec3 o = vec3(u(rng) * 10.f, u(rng) * 10.f, u(rng) * 10.f) * s;
+      if (glm::length(o) < 2.f * s) continue;  // outside the box's sphere
       const vec3 d = light - o;
       const float dist = glm::length(d);
       if (!impl.occluded(o, d / dist, dist, 0.f)) ++leaks;

@@ -105,6 +105,22 @@ inline MeshDesc box_mesh(const vec3& lo, const vec3& hi) {
   return m;
 }
 
+// The same box with each face as four triangles around its centre: they do not pair into
+// parallelograms (shapes/parallelogram_pairs.h), so the box is traced as Embree's triangles.
+inline MeshDesc box_mesh_of_triangles(const vec3& lo, const vec3& hi) {
+  const MeshDesc quads = box_mesh(lo, hi);
+  MeshDesc m;
+  m.positions = quads.positions;
+  for (size_t f = 0; f < quads.indices.size(); f += 6) {
+    const uint32_t c[4] = {quads.indices[f], quads.indices[f + 1], quads.indices[f + 2],
+                           quads.indices[f + 5]};
+    const uint32_t centre = uint32_t(m.positions.size());
+    m.positions.push_back(0.5f * (m.positions[c[0]] + m.positions[c[2]]));
+    for (int k = 0; k < 4; ++k) m.indices.insert(m.indices.end(), {centre, c[k], c[(k + 1) % 4]});
+  }
+  return m;
+}
+
 inline ObjectDesc sphere_object(const vec3& center, float radius, uint32_t material,
                                 const Spectrum& emission = Spectrum(0.f)) {
   ObjectDesc o;

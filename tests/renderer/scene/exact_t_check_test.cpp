@@ -18,14 +18,16 @@
 namespace penumbra::test {
 namespace {
 
+// Boxes of Embree triangles: a box of quads' face pairs would be traced as parallelograms
+// (shapes/parallelogram_pairs.h), which this test is not about.
 ObjectDesc box(const vec3& lo, const vec3& hi, uint32_t material) {
   ObjectDesc o;
-  o.shape = box_mesh(lo, hi);
+  o.shape = box_mesh_of_triangles(lo, hi);
   o.material = material;
   return o;
 }
 
-// A large tilted quad of two triangles (object 0) whose plane passes close to the world origin, inside a box
+// A large tilted quad of four triangles (object 0) whose plane passes close to the world origin, inside a box
 // (object 1). Embree computes a triangle's plane distance from its first vertex translated to
 // the ray origin, with an error of order eps times that vertex's distance (~1000 here), far
 // above the distance from the plane of a float point near the origin (docs/design-notes.md):
@@ -37,12 +39,13 @@ SceneInput tilted_quad_in_box(bool coincident_elsewhere) {
   SceneInput in;
   in.camera = camera_looking({0.f, 0.f, 0.f}, {0.f, 0.f, -1.f}, 40.f);
   in.materials = {MaterialParams{}};
-  // The quad as a mesh of two triangles: a quad shape is traced by its own test
+  // The quad as a mesh of four triangles around its centre: a quad shape, and a mesh whose
+  // triangles pair into parallelograms, are traced by the parallelogram test
   // (shapes/parallelogram.h), not as Embree triangles.
   ObjectDesc quad;
   quad.shape = MeshDesc{{kQuadOrigin, kQuadOrigin + kQuadU, kQuadOrigin + kQuadU + kQuadV,
-                         kQuadOrigin + kQuadV},
-                        {0, 1, 2, 0, 2, 3}};
+                         kQuadOrigin + kQuadV, kQuadOrigin + 0.5f * (kQuadU + kQuadV)},
+                        {4, 0, 1, 4, 1, 2, 4, 2, 3, 4, 3, 0}};
   in.objects = {quad, box(vec3(-1500.f), vec3(1500.f), 0)};
   if (coincident_elsewhere) {
     MeshDesc tri;

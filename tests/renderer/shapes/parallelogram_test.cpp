@@ -1,6 +1,7 @@
 // A static quad's own ray test (shapes/parallelogram.h): where it hits and what it reports, that
 // a ray spawned from one of its hits never meets it again, that two quads sharing an edge leave
-// no crack, and that its packets of 4, 8 and 16 rays give every lane the single ray's bits.
+// no crack, and that its packets of 4, 8 and 16 rays give every lane the single ray's bits, with
+// the quads' overlapping edges and with a mesh face pair's exact ones.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -289,11 +290,19 @@ TEST(Parallelogram, PacketLanesMatchSingleRays) {
        {QuadDesc{vec3(-4.f, 0.f, -4.f), vec3(0.f, 0.f, 8.f), vec3(8.f, 0.f, 0.f)},
         QuadDesc{vec3(1.f, -2.f, 3.f), vec3(2.f, 0.5f, 0.f), vec3(0.3f, 0.f, -1.5f)},
         QuadDesc{vec3(300.f, 120.f, -80.f), vec3(1e-2f, 3e-3f, 0.f), vec3(0.f, 2e-3f, 1e-2f)}}) {
-    const Parallelogram q(desc);
-    expect_packets_match<RTCRayHit16, RTCRay16>(q, desc, 2000, 1);
-    expect_packets_match<RTCRayHit8, RTCRay8>(q, desc, 1000, 2);
-    expect_packets_match<RTCRayHit4, RTCRay4>(q, desc, 1000, 3);
-    if (HasFatalFailure()) return;
+    for (const bool exact : {false, true}) {
+      // Exact edges (a mesh's face pair), the fourth corner an ulp off origin + u + v.
+      Parallelogram q(desc);
+      const vec3 far = desc.origin + desc.u + desc.v;
+      if (exact)
+        q.use_exact_edges(desc.origin, desc.origin + desc.u,
+                          vec3(std::nextafter(far.x, kInfinity), far.y, far.z),
+                          desc.origin + desc.v);
+      expect_packets_match<RTCRayHit16, RTCRay16>(q, desc, 2000, 1);
+      expect_packets_match<RTCRayHit8, RTCRay8>(q, desc, 1000, 2);
+      expect_packets_match<RTCRayHit4, RTCRay4>(q, desc, 1000, 3);
+      if (HasFatalFailure()) return;
+    }
   }
 }
 
