@@ -2,8 +2,6 @@
 // under construction or by an RAII handle, so a step that throws leaks nothing.
 #include <embree3/rtcore.h>
 
-#include <bit>
-#include <map>
 #include <utility>
 #include <vector>
 
@@ -13,6 +11,7 @@
 #include "renderer/lights/environment_map.h"
 #include "renderer/lights/make_light.h"
 #include "renderer/materials/coating_tables.h"
+#include "renderer/scene/coplanar_parallelograms.h"
 #include "renderer/scene/scene.h"
 #include "renderer/shapes/make_shape.h"
 #include "renderer/shapes/quad.h"
@@ -192,13 +191,15 @@ class SceneBuilder {
   }
 
   // Static meshes made of quads are traced as parallelograms (shapes/parallelogram_pairs.h),
-  // unless copied: an instance's hits come through Embree's float inverse transform, and the
-  // copies keep the triangles' geometry filter (below).
+  // unless copied (an instance's hits come through Embree's float inverse transform, and the
+  // copies keep the triangles' geometry filter, below) or holding a face twice (coincident
+  // faces tie at every point; triangles have the rule below for them).
   void parallelogram_meshes() {
     const std::vector<bool> copied = copied_objects();
     for (size_t i = 0; i < s_.shapes_.size(); ++i)
       if (TriangleMesh* mesh = s_.shapes_[i]->triangle_mesh(); mesh && !copied[i])
-        mesh->trace_as_parallelograms();
+        if (mesh->trace_as_parallelograms() && has_coincident_triangles({mesh}))
+          mesh->trace_as_triangles();
   }
 
   std::vector<bool> copied_objects() const {
@@ -232,25 +233,19 @@ class SceneBuilder {
     s_.exact_t_ = ExactTCheck(std::move(plain));
   }
 
-  // Parallelograms in one axis plane (a duplicate, a panel flush with a wall, a tiled floor, a
-  // box standing on the floor) can tie exactly, and Embree would skip the flat box of the
-  // second: their boxes get a thickness (shapes/parallelogram.h, Parallelogram::thicken). Others
-  // keep their flat boxes.
-  void thicken_coplanar_parallelograms() {
-    std::map<std::pair<int, uint32_t>, std::vector<Parallelogram*>> planes;
-    for (auto& shape : s_.shapes_)
-      for (Parallelogram& q : shape->parallelograms())
-        if (const int k = q.flat_axis(); k >= 0)
-          planes[{k, std::bit_cast<uint32_t>(q.origin[k] + 0.f)}].push_back(&q);
-    for (auto& [plane, shapes] : planes)
-      if (shapes.size() > 1)
-        for (Parallelogram* q : shapes) q->thicken();
+  // Parallelograms that can tie with another shape's in their plane get thick boxes
+  // (scene/coplanar_parallelograms.h).
+  void thicken_coplanar() {
+    std::vector<PlacedParallelogram> all;
+    for (size_t i = 0; i < s_.shapes_.size(); ++i)
+      for (Parallelogram& q : s_.shapes_[i]->parallelograms()) all.push_back({&q, uint32_t(i)});
+    thicken_coplanar_parallelograms(all);
   }
 
   void embree_scene() {
     parallelogram_meshes();
     exact_t_check();
-    thicken_coplanar_parallelograms();
+    thicken_coplanar();
     RTCDevice device = embree_device();
     EmbreeErrorScope errors;
     EmbreeScene scene(rtcNewScene(device));

@@ -140,7 +140,9 @@ vec3 TriangleMesh::interpolated_displacement(float time) const {
 }
 
 bool TriangleMesh::trace_as_parallelograms() {
-  if (moving() || has_cutout() || !triangle_cdf_.empty()) return false;
+  if (moving() || has_cutout() || !triangle_cdf_.empty() ||
+      triangle_count() > 2 * kMaxFacePairs)
+    return false;
   face_pairs_ = pair_into_parallelograms(positions_, indices_);
   return !face_pairs_.shapes.empty();
 }

@@ -184,9 +184,10 @@ ObjectDesc mesh_object(const MeshDesc& m) {
   return o;
 }
 
-// Static meshes of quads are traced as parallelograms; moving, emitting and instanced ones, and
-// meshes of other triangles, stay Embree triangles. A box standing on a floor joins the floor's
-// plane, so both get thick boxes (Parallelogram::thicken).
+// Static meshes of quads are traced as parallelograms; moving, emitting and instanced ones,
+// meshes of other triangles, meshes holding a face twice and meshes of more than kMaxFacePairs
+// quads stay Embree triangles. A box standing on a floor shares the floor's plane: the floor,
+// which wins their ties, gets a thick box (scene/coplanar_parallelograms.h).
 TEST(ParallelogramPairs, SceneTracesTheMeshesItShouldAsParallelograms) {
   ObjectDesc floor = quad_object(vec3(-5.f, 0.f, 5.f), vec3(10.f, 0.f, 0.f), vec3(0.f, 0.f, -10.f), 0);
   ObjectDesc standing = mesh_object(turned_box(vec3(-1.f, 0.f, -1.f), vec3(1.f, 1.f, 1.f),
@@ -197,7 +198,21 @@ TEST(ParallelogramPairs, SceneTracesTheMeshesItShouldAsParallelograms) {
   emitting.emission = Spectrum(1.f);
   ObjectDesc copied = mesh_object(box_mesh(vec3(4.f), vec3(5.f)));
   ObjectDesc fan = mesh_object(box_mesh_of_triangles(vec3(-5.f), vec3(-4.f)));
-  SceneInput in = mesh_scene({floor, standing, moving, emitting, copied, fan});
+  MeshDesc twice_desc = box_mesh(vec3(6.f), vec3(7.f));
+  twice_desc.indices.insert(twice_desc.indices.end(), twice_desc.indices.begin(),
+                            twice_desc.indices.begin() + 6);
+  ObjectDesc twice = mesh_object(twice_desc);
+  // A grid of quads, one more than the limit.
+  MeshDesc grid_desc;
+  const int n = int(TriangleMesh::kMaxFacePairs) + 1;
+  for (int i = 0; i <= n; ++i)
+    for (int j = 0; j <= 1; ++j) grid_desc.positions.push_back(vec3(float(i), 8.f, float(j)));
+  for (uint32_t i = 0; i < uint32_t(n); ++i)
+    grid_desc.indices.insert(grid_desc.indices.end(), {2 * i, 2 * i + 1, 2 * i + 3, 2 * i, 2 * i + 3, 2 * i + 2});
+  ObjectDesc grid = mesh_object(grid_desc);
+  grid_desc.indices.resize(grid_desc.indices.size() - 6);  // at the limit
+  ObjectDesc smaller_grid = mesh_object(grid_desc);
+  SceneInput in = mesh_scene({floor, standing, moving, emitting, copied, fan, twice, grid, smaller_grid});
   in.camera.shutter_open = 0.f;
   in.camera.shutter_close = 1.f;
   in.instances = {InstancesDesc{4, {InstanceTransform{glm::mat3(1.f), vec3(0.f, 10.f, 0.f)}}}};
@@ -211,16 +226,19 @@ TEST(ParallelogramPairs, SceneTracesTheMeshesItShouldAsParallelograms) {
   EXPECT_FALSE(traced_as_parallelograms(3));
   EXPECT_FALSE(traced_as_parallelograms(4));
   EXPECT_FALSE(traced_as_parallelograms(5));
-  // The standing box's bottom face (its one face in the plane y = 0) and the floor are thick.
-  int thick = 0;
-  for (uint32_t i : {0u, 1u})
-    for (const Parallelogram& q : const_cast<Shape&>(*scene->object(i).shape).parallelograms())
-      if (q.flat_axis() == 1 && q.origin.y == 0.f) {
-        EXPECT_LT(q.bounds.lo.y, 0.f) << i;
-        EXPECT_GT(q.bounds.hi.y, 0.f) << i;
-        ++thick;
-      }
-  EXPECT_EQ(thick, 2);
+  EXPECT_FALSE(traced_as_parallelograms(6));
+  EXPECT_FALSE(traced_as_parallelograms(7));
+  EXPECT_TRUE(traced_as_parallelograms(8));
+  // The floor is thick, the standing box's bottom face (its one face in the plane y = 0) is not.
+  auto thick = [](const Parallelogram& q) { return q.bounds.lo.y < 0.f && q.bounds.hi.y > 0.f; };
+  EXPECT_TRUE(thick(const_cast<Shape&>(*scene->object(0).shape).parallelograms()[0]));
+  int bottoms = 0;
+  for (const Parallelogram& q : const_cast<Shape&>(*scene->object(1).shape).parallelograms())
+    if (q.flat_axis() == 1 && q.origin.y == 0.f) {
+      EXPECT_FALSE(thick(q));
+      ++bottoms;
+    }
+  EXPECT_EQ(bottoms, 1);
 }
 
 // A convex fold of two faces of one mesh whose corners are turned floats: rays aimed exactly at
