@@ -437,34 +437,43 @@ TEST(LightLeak, ShadowRaysNeverSlipThroughBoxEdges) {
   }
 }
 
+// Shadow rays from random points around a box (corner `lo`, size 2s, turned by `turn` about lo)
+// toward a light just inside its corner `lo`, in the box's own frame: how many get through.
+// Every object of the box must be traced as parallelograms.
+int shadow_leaks_into_turned_box(const std::vector<ObjectDesc>& box, const vec3& lo,
+                                 const glm::mat3& turn, float s) {
+  SceneInput in;
+  in.camera = camera_looking(vec3(1, 2, 4) * s, vec3(0.f), 40.f);
+  in.materials = {DiffuseParams{Spectrum(0.8f)}};
+  in.objects = box;
+  const auto scene = Scene::build(in);
+  const Scene& impl = *scene;
+  for (size_t i = 0; i < in.objects.size(); ++i)
+    EXPECT_EQ(impl.object(uint32_t(i)).shape->triangle_mesh(), nullptr) << "parallelograms";
+  const vec3 light = lo + turn * vec3(2e-4f * s);
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<float> u(-1.f, 1.f);
+  int leaks = 0;
+  for (int i = 0; i < 2'000'000; ++i) {
+    const vec3 o = vec3(u(rng) * 10.f, u(rng) * 10.f, u(rng) * 10.f) * s;
+    if (glm::length(o) < 2.f * s) continue;  // outside the box's sphere
+    const vec3 d = light - o;
+    const float dist = glm::length(d);
+    if (!impl.occluded(o, d / dist, dist, 0.f)) ++leaks;
+  }
+  return leaks;
+}
+
+const glm::mat3 kTurn = glm::mat3(glm::rotate(glm::mat4(1.f), 0.7f, glm::normalize(vec3(1, 2, 3))));
+
 // A mesh box turned so that its corners are rounded floats, traced as parallelograms: faces
-// meet at shared corners, their fourth corners a rounding off origin + u + v; shadow rays toward
-// a light just inside a corner never get through.
+// meet at shared corners, their fourth corners a rounding off origin + u + v.
 TEST(LightLeak, ShadowRaysNeverSlipThroughEdgesOfATurnedMeshBox) {
-  const glm::mat3 turn = glm::mat3(glm::rotate(glm::mat4(1.f), 0.7f, glm::normalize(vec3(1, 2, 3))));
   for (float s : {1e-3f, 1.f, 1e3f}) {
-    SceneInput in;
-    in.camera = camera_looking(vec3(1, 2, 4) * s, vec3(0.f), 40.f);
-    in.materials = {DiffuseParams{Spectrum(0.8f)}};
     const vec3 lo = vec3(-s);
-    in.objects = {box(lo, vec3(s), 0)};
-    MeshDesc& mesh = std::get<MeshDesc>(in.objects[0].shape);
-    for (vec3& p : mesh.positions) p = lo + turn * (p - lo);
-    const auto scene = Scene::build(in);
-    const Scene& impl = *scene;
-    ASSERT_EQ(impl.object(0).shape->triangle_mesh(), nullptr) << "parallelograms";
-    const vec3 light = lo + turn * vec3(2e-4f * s);
-    std::mt19937 rng(1);
-    std::uniform_real_distribution<float> u(-1.f, 1.f);
-    int leaks = 0;
-    for (int i = 0; i < 2'000'000; ++i) {
-      const vec3 o = vec3(u(rng) * 10.f, u(rng) * 10.f, u(rng) * 10.f) * s;
-      if (glm::length(o) < 2.f * s) continue;  // outside the box's sphere
-      const vec3 d = light - o;
-      const float dist = glm::length(d);
-      if (!impl.occluded(o, d / dist, dist, 0.f)) ++leaks;
-    }
-    EXPECT_EQ(leaks, 0) << "scale " << s;
+    ObjectDesc mesh_box = box(lo, vec3(s), 0);
+    for (vec3& p : std::get<MeshDesc>(mesh_box.shape).positions) p = lo + kTurn * (p - lo);
+    EXPECT_EQ(shadow_leaks_into_turned_box({mesh_box}, lo, kTurn, s), 0) << "scale " << s;
   }
 }
 
@@ -472,30 +481,10 @@ TEST(LightLeak, ShadowRaysNeverSlipThroughEdgesOfATurnedMeshBox) {
 // (shapes/parallelogram.h), turned so that neighbouring faces meet only to float rounding: the
 // tests' tolerance at the edges must close every seam.
 TEST(LightLeak, ShadowRaysNeverSlipThroughEdgesOfABoxOfQuads) {
-  const glm::mat3 turn = glm::mat3(glm::rotate(glm::mat4(1.f), 0.7f, glm::normalize(vec3(1, 2, 3))));
   for (float s : {1e-3f, 1.f, 1e3f}) {
-    SceneInput in;
-    in.camera = camera_looking(vec3(1, 2, 4) * s, vec3(0.f), 40.f);
-    in.materials = {DiffuseParams{Spectrum(0.8f)}};
     const vec3 lo = vec3(-s);
-    in.objects = quad_box(lo, vec3(s), 0, turn);
-    const auto scene = Scene::build(in);
-    const Scene& impl = *scene;
-    for (size_t i = 0; i < in.objects.size(); ++i)
-      ASSERT_EQ(impl.object(uint32_t(i)).shape->triangle_mesh(), nullptr) << "a parallelogram";
-    // Just inside a corner, in the box's own frame.
-    const vec3 light = lo + turn * vec3(2e-4f * s);
-    std::mt19937 rng(1);
-    std::uniform_real_distribution<float> u(-1.f, 1.f);
-    int leaks = 0;
-    for (int i = 0; i < 2'000'000; ++i) {
-      const vec3 o = vec3(u(rng) * 10.f, u(rng) * 10.f, u(rng) * 10.f) * s;
-      if (glm::length(o) < 2.f * s) continue;  // outside the box's sphere
-      const vec3 d = light - o;
-      const float dist = glm::length(d);
-      if (!impl.occluded(o, d / dist, dist, 0.f)) ++leaks;
-    }
-    EXPECT_EQ(leaks, 0) << "scale " << s;
+    EXPECT_EQ(shadow_leaks_into_turned_box(quad_box(lo, vec3(s), 0, kTurn), lo, kTurn, s), 0)
+        << "scale " << s;
   }
 }
 
