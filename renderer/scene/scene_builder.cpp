@@ -191,13 +191,12 @@ class SceneBuilder {
   }
 
   // Static meshes made of quads are traced as parallelograms (shapes/parallelogram_pairs.h),
-  // unless copied (an instance's hits come through Embree's float inverse transform, and the
-  // copies keep the triangles' geometry filter, below) or holding a face twice (coincident
-  // faces tie at every point; triangles have the rule below for them).
+  // copied ones too (the test runs in the callback on the ray Embree maps into the copy, so it
+  // needs no check after traversal), unless holding a face twice (coincident faces tie at every
+  // point; triangles have the rule below for them).
   void parallelogram_meshes() {
-    const std::vector<bool> copied = copied_objects();
-    for (size_t i = 0; i < s_.shapes_.size(); ++i)
-      if (TriangleMesh* mesh = s_.shapes_[i]->triangle_mesh(); mesh && !copied[i])
+    for (auto& shape : s_.shapes_)
+      if (TriangleMesh* mesh = shape->triangle_mesh())
         if (mesh->trace_as_parallelograms() && has_coincident_triangles({mesh}))
           mesh->trace_as_triangles();
   }

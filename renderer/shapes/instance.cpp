@@ -78,7 +78,9 @@ void Instance::hit_geometry(const Ray& world_ray, float t, uint32_t prim, const 
   local.origin = inverse_ * world_ray.origin + inverse_translation_;
   local.direction = inverse_ * world_ray.direction;  // not unit: the parameter t is shared
   SurfaceHit h;
+  h.primitive = prim;
   shape_->hit_geometry(local, t, prim, uv, &h);
+  hit->primitive = h.primitive;  // a mesh traced as parallelograms names the triangle hit
 
   // pbrt-v4's Transform applied to a point with an error interval: three products and three
   // sums per component, each rounding once, plus the carried error grown by (1 + gamma(3)).

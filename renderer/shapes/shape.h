@@ -92,7 +92,8 @@ class Shape {
   virtual TriangleMesh* triangle_mesh() { return nullptr; }
   const TriangleMesh* triangle_mesh() const { return const_cast<Shape*>(this)->triangle_mesh(); }
   // The parallelograms it is traced as (a static quad's one, a mesh's face pairs), else none:
-  // the scene build thickens those that share an axis plane (Parallelogram::thicken).
+  // the scene build thickens the boxes of those that can tie with another object's
+  // (scene/coplanar_parallelograms.h).
   virtual std::span<Parallelogram> parallelograms() { return {}; }
 };
 

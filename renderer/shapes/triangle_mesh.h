@@ -32,14 +32,14 @@ class TriangleMesh : public Shape {
 
   // Traces the mesh as parallelograms if it is static, has no cutout, is not an emitter (whose
   // samples lie on the triangles), has at most kMaxFacePairs of them and every consecutive
-  // triangle pair is one; true if so. The scene build calls it before make_geometry, for meshes
-  // that are not instanced (copies keep the triangles' exact-t filter, scene/exact_t_check.h).
+  // triangle pair is one; true if so. The scene build calls it before make_geometry.
   bool trace_as_parallelograms();
-  // Boxes, panels and rooms gain (a Cornell box's two boxes: 0.94 of the time; a glass box:
-  // 0.75), large meshes do not: Embree's triangle leaves test four at once, a user geometry one
+  // Boxes, panels and rooms gain (a Cornell box's two boxes: 0.95 of the time; a glass box:
+  // 0.80), large meshes do not: Embree's triangle leaves test four at once, a user geometry one
   // primitive per call (a floor of 16 x 16 quads: 1.01 of the time, 64 x 64: 1.08, 200 x 200:
   // 1.15; docs/performance.md, session 28).
   static constexpr size_t kMaxFacePairs = 256;
+  // Undoes trace_as_parallelograms (the scene build's own conditions, scene_builder.cpp).
   void trace_as_triangles() { face_pairs_ = FacePairs(); }
 
   // Whether Embree calls the exact-t test below on every candidate hit (a geometry filter, the

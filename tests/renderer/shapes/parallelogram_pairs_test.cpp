@@ -184,8 +184,8 @@ ObjectDesc mesh_object(const MeshDesc& m) {
   return o;
 }
 
-// Static meshes of quads are traced as parallelograms; moving, emitting and instanced ones,
-// meshes of other triangles, meshes holding a face twice and meshes of more than kMaxFacePairs
+// Static meshes of quads are traced as parallelograms, instanced ones too; moving and emitting
+// ones, meshes of other triangles, meshes holding a face twice and meshes of more than kMaxFacePairs
 // quads stay Embree triangles. A box standing on a floor shares the floor's plane: the floor,
 // which wins their ties, gets a thick box (scene/coplanar_parallelograms.h).
 TEST(ParallelogramPairs, SceneTracesTheMeshesItShouldAsParallelograms) {
@@ -224,7 +224,7 @@ TEST(ParallelogramPairs, SceneTracesTheMeshesItShouldAsParallelograms) {
   EXPECT_TRUE(traced_as_parallelograms(1));
   EXPECT_FALSE(traced_as_parallelograms(2));
   EXPECT_FALSE(traced_as_parallelograms(3));
-  EXPECT_FALSE(traced_as_parallelograms(4));
+  EXPECT_TRUE(traced_as_parallelograms(4));
   EXPECT_FALSE(traced_as_parallelograms(5));
   EXPECT_FALSE(traced_as_parallelograms(6));
   EXPECT_FALSE(traced_as_parallelograms(7));
@@ -239,6 +239,50 @@ TEST(ParallelogramPairs, SceneTracesTheMeshesItShouldAsParallelograms) {
       ++bottoms;
     }
   EXPECT_EQ(bottoms, 1);
+}
+
+// Hits on an instanced copy of a mesh of quads name the triangle they lie in (the instance
+// passes on the primitive the mesh reports), which surface_derivatives reads.
+TEST(ParallelogramPairs, CopiesNameTheTriangleTheirHitsLieIn) {
+  const MeshDesc box = box_mesh(vec3(-1.f), vec3(1.f));
+  const glm::mat3 rotation = turn(0.6f, {1, 1, 0});
+  const vec3 offset(10.f, 0.f, 0.f);  // the copy; the mesh itself stays out of the rays' way
+  SceneInput in = mesh_scene({mesh_object(box)});
+  in.camera = camera_looking(offset + vec3(0.f, 0.f, 8.f), offset, 40.f);
+  in.instances = {InstancesDesc{0, {InstanceTransform{rotation, offset}}}};
+  const auto scene = Scene::build(in);
+  ASSERT_EQ(scene->object(0).shape->triangle_mesh(), nullptr);
+  std::mt19937 rng(2);
+  std::uniform_real_distribution<float> u01(0.f, 1.f);
+  const glm::dmat3 inverse = glm::inverse(glm::dmat3(rotation));
+  int checked = 0;
+  for (int i = 0; i < 4000; ++i) {
+    const vec3 target = offset + vec3(2.f * u01(rng) - 1.f, 2.f * u01(rng) - 1.f, 0.f) * 1.5f;
+    const vec3 from = offset + vec3(0.f, 0.f, 8.f);
+    SurfaceHit hit;
+    if (!scene->intersect(Ray{from, glm::normalize(target - from), 0.f}, &hit)) continue;
+    ASSERT_NE(hit.instance, SurfaceHit::kNotACopy) << i;
+    // The point in the mesh's space, and the one triangle of the face that holds it by more
+    // than rounding.
+    const dvec3 local = inverse * (dvec3(hit.p) - dvec3(offset));
+    int holding = -1, count = 0;
+    for (uint32_t tri = 0; tri < box.indices.size() / 3; ++tri) {
+      const dvec3 a(box.positions[box.indices[3 * tri]]), b(box.positions[box.indices[3 * tri + 1]]),
+          c(box.positions[box.indices[3 * tri + 2]]);
+      const dvec3 n = glm::cross(b - a, c - a);
+      if (std::abs(glm::dot(local - a, glm::normalize(n))) > 1e-4) continue;
+      const double b1 = glm::dot(glm::cross(local - a, c - a), n) / glm::dot(n, n);
+      const double b2 = glm::dot(glm::cross(b - a, local - a), n) / glm::dot(n, n);
+      if (b1 > 1e-4 && b2 > 1e-4 && b1 + b2 < 1.0 - 1e-4) {
+        holding = int(tri);
+        ++count;
+      }
+    }
+    if (count != 1) continue;  // on an edge or the diagonal
+    EXPECT_EQ(hit.primitive, uint32_t(holding)) << i;
+    ++checked;
+  }
+  EXPECT_GT(checked, 1000);
 }
 
 // A convex fold of two faces of one mesh whose corners are turned floats: rays aimed exactly at
