@@ -201,12 +201,6 @@ class SceneBuilder {
           mesh->trace_as_triangles();
   }
 
-  std::vector<bool> copied_objects() const {
-    std::vector<bool> copied(s_.objects_.size(), false);
-    for (const Instance& copy : s_.instances_) copied[copy.object()] = true;
-    return copied;
-  }
-
   // Where each mesh's exact-t test runs (scene/exact_t_check.h): a mesh without a cutout and
   // without copies is checked after traversal, unless two triangles of the scene coincide:
   // Embree's filter-free kernels break their exact-t ties differently in packets and in single
@@ -214,7 +208,8 @@ class SceneBuilder {
   // because Embree hands the filter the ray mapped by its own float inverse, which a check
   // after the fact could not reproduce bit for bit.
   void exact_t_check() {
-    const std::vector<bool> copied = copied_objects();
+    std::vector<bool> copied(s_.objects_.size(), false);
+    for (const Instance& copy : s_.instances_) copied[copy.object()] = true;
     std::vector<const TriangleMesh*> meshes, plain(s_.objects_.size(), nullptr);
     bool any_plain = false;
     for (size_t i = 0; i < s_.shapes_.size(); ++i) {

@@ -122,17 +122,14 @@ inline void intersect_one(const RTCIntersectFunctionNArguments* args, unsigned i
   const Mask tie = tie_wins(args->context->instID[0], args->geomID, args->primID,
                             RTCHitN_instID(hit, n, i, 0), RTCHitN_geomID(hit, n, i),
                             RTCHitN_primID(hit, n, i));
+  const float ox = RTCRayN_org_x(ray, n, i), oy = RTCRayN_org_y(ray, n, i),
+              oz = RTCRayN_org_z(ray, n, i), dx = RTCRayN_dir_x(ray, n, i),
+              dy = RTCRayN_dir_y(ray, n, i), dz = RTCRayN_dir_z(ray, n, i),
+              tnear = RTCRayN_tnear(ray, n, i), tfar = RTCRayN_tfar(ray, n, i);
   Mask near;
-  float t = lane_test(q, RTCRayN_org_x(ray, n, i), RTCRayN_org_y(ray, n, i),
-                      RTCRayN_org_z(ray, n, i), RTCRayN_dir_x(ray, n, i),
-                      RTCRayN_dir_y(ray, n, i), RTCRayN_dir_z(ray, n, i),
-                      RTCRayN_tnear(ray, n, i), RTCRayN_tfar(ray, n, i), tie, &s, &r, &near);
-  if (near)
-    t = decide_near_edge(*q.exact, RTCRayN_org_x(ray, n, i), RTCRayN_org_y(ray, n, i),
-                         RTCRayN_org_z(ray, n, i), RTCRayN_dir_x(ray, n, i),
-                         RTCRayN_dir_y(ray, n, i), RTCRayN_dir_z(ray, n, i),
-                         RTCRayN_tnear(ray, n, i), RTCRayN_tfar(ray, n, i), tie, &s, &r);
-  if (!(t > RTCRayN_tnear(ray, n, i))) return;
+  float t = lane_test(q, ox, oy, oz, dx, dy, dz, tnear, tfar, tie, &s, &r, &near);
+  if (near) t = decide_near_edge(*q.exact, ox, oy, oz, dx, dy, dz, tnear, tfar, tie, &s, &r);
+  if (!(t > tnear)) return;
   record_user_hit(args, n, i, t, vec3(float(q.nx), float(q.ny), float(q.nz)), s, r);
 }
 
@@ -143,17 +140,14 @@ inline void occluded_one(const RTCOccludedFunctionNArguments* args, unsigned i) 
   const ParallelogramLanes q = lanes_of(parallelogram_of(args));
   RTCRayN* ray = args->ray;
   float s, r;
+  const float ox = RTCRayN_org_x(ray, n, i), oy = RTCRayN_org_y(ray, n, i),
+              oz = RTCRayN_org_z(ray, n, i), dx = RTCRayN_dir_x(ray, n, i),
+              dy = RTCRayN_dir_y(ray, n, i), dz = RTCRayN_dir_z(ray, n, i),
+              tnear = RTCRayN_tnear(ray, n, i), tfar = RTCRayN_tfar(ray, n, i);
   Mask near;
-  float t = lane_test(q, RTCRayN_org_x(ray, n, i), RTCRayN_org_y(ray, n, i),
-                      RTCRayN_org_z(ray, n, i), RTCRayN_dir_x(ray, n, i),
-                      RTCRayN_dir_y(ray, n, i), RTCRayN_dir_z(ray, n, i),
-                      RTCRayN_tnear(ray, n, i), RTCRayN_tfar(ray, n, i), 0, &s, &r, &near);
-  if (near)
-    t = decide_near_edge(*q.exact, RTCRayN_org_x(ray, n, i), RTCRayN_org_y(ray, n, i),
-                         RTCRayN_org_z(ray, n, i), RTCRayN_dir_x(ray, n, i),
-                         RTCRayN_dir_y(ray, n, i), RTCRayN_dir_z(ray, n, i),
-                         RTCRayN_tnear(ray, n, i), RTCRayN_tfar(ray, n, i), 0, &s, &r);
-  if (t > RTCRayN_tnear(ray, n, i)) RTCRayN_tfar(ray, n, i) = -kInfinity;
+  float t = lane_test(q, ox, oy, oz, dx, dy, dz, tnear, tfar, 0, &s, &r, &near);
+  if (near) t = decide_near_edge(*q.exact, ox, oy, oz, dx, dy, dz, tnear, tfar, 0, &s, &r);
+  if (t > tnear) RTCRayN_tfar(ray, n, i) = -kInfinity;
 }
 
 // Packets of 4, 8 and 16 rays in SIMD lanes; a lane that does not hit keeps its old values. A

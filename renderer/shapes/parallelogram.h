@@ -38,8 +38,8 @@ struct Parallelogram {
   // duplicate, or a neighbour at their shared edge) it may skip this one, and whether it does
   // depends on the traversal order, which differs between packets and single rays; the tie rule
   // of the callbacks (lowest ids win) only works on hits it is shown. Flat boxes trace faster
-  // (thickening every quad cost cornell 7%), so the scene build thickens only quads that share
-  // their axis plane with another (scene_builder.cpp).
+  // (thickening every quad cost cornell 7%), so the scene build thickens only those that can tie
+  // with another object's (scene/coplanar_parallelograms.h).
   void thicken();
 
   // Decides hits near its edges exactly (below) from these four corners, in (s, t) order (0, 0),
