@@ -212,7 +212,9 @@ Coverage expect_stage_matches_scene(const SceneInput& in, bool lights, uint32_t 
   EXPECT_TRUE(stage.takes(0));
   EXPECT_TRUE(stage.takes(1));
   stage.start(lanes.size());
-  for (size_t k = 0; k < lanes.size(); ++k)
+  // Added last slot first: lane i is slot n - 1 - i, so a result put in the lane's place
+  // instead of its slot's shows.
+  for (size_t k = lanes.size(); k-- > 0;)
     stage.add(uint32_t(k), lanes[k].state, lanes[k].hit, lanes[k].x, lanes[k].y, lanes[k].z, 1, next_event);
   stage.compute(settings, next_event);
   EXPECT_EQ(stage.size(), lanes.size());
