@@ -44,7 +44,7 @@ std::optional<glm::mat3> parse_orientation(ObjectReader& reader, Diagnostics& di
 
 // Reads the image named by "map" into `map` (linear RGB); false after reporting an error.
 bool read_map(const std::string& relative, const AssetFolder& assets, EnvironmentMapDesc& map,
-              Diagnostics& diag) {
+              std::vector<AssetUse>* uses, Diagnostics& diag) {
   const std::string pointer = child_pointer(kPointer, "map");
   const auto path = resolve_asset_path(assets, relative, pointer, diag);
   if (!path) return false;
@@ -64,6 +64,9 @@ bool read_map(const std::string& relative, const AssetFolder& assets, Environmen
     diag.error(pointer, "'" + relative + "': " + reason);
     return false;
   }
+  uses->push_back(AssetUse{pointer, relative,
+                           describe_image(image.width, image.height, image.channels,
+                                          image.is_float ? "float" : "integer")});
   // Integer formats (PNG, JPEG) store sRGB-encoded values, as Mitsuba's Bitmap assumes too.
   if (!image.is_float) srgb_to_linear_in_place(image);
   map.width = image.width;
@@ -82,7 +85,7 @@ bool read_map(const std::string& relative, const AssetFolder& assets, Environmen
 }  // namespace
 
 bool parse_environment(const Json* value, const AssetFolder& assets, SceneInput& scene,
-                       Diagnostics& diag) {
+                       std::vector<AssetUse>* uses, Diagnostics& diag) {
   if (!value) return false;
   ObjectReader r(*value, kPointer, diag);
   if (!r.valid()) return false;
@@ -111,7 +114,7 @@ bool parse_environment(const Json* value, const AssetFolder& assets, SceneInput&
   if (scale) map.scale = float(*scale);
   if (to_world) map.to_world = *to_world;
   // The file is checked even when other fields are wrong: validation reports every problem.
-  if (!file || !read_map(*file, assets, map, diag) || diag.error_count() != errors_before)
+  if (!file || !read_map(*file, assets, map, uses, diag) || diag.error_count() != errors_before)
     return false;
 
   const float brightest = map.rgb.empty() ? 0.f : *std::max_element(map.rgb.begin(), map.rgb.end());

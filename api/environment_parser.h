@@ -6,14 +6,18 @@
 // The image is read here, through the scene's asset folder, so an unreadable or oversized file
 // is an error on /environment/map like any other invalid field.
 #include "api/asset_path.h"
+#include <vector>
+
 #include "api/json_reader.h"
+#include "api/scene_loader.h"
 #include "renderer/scene/scene_input.h"
 
 namespace penumbra::api {
 
 // Fills scene.environment or scene.environment_map; `value` may be null (black environment).
-// Returns whether the environment emits anything (for the "no light source" warning).
+// Returns whether the environment emits anything (for the "no light source" warning). A map's
+// file is added to *uses.
 bool parse_environment(const Json* value, const AssetFolder& assets, SceneInput& scene,
-                       Diagnostics& diag);
+                       std::vector<AssetUse>* uses, Diagnostics& diag);
 
 }  // namespace penumbra::api

@@ -14,6 +14,11 @@
 
 namespace penumbra::api {
 
+std::string describe_image(int width, int height, int channels, const std::string& storage) {
+  return std::to_string(width) + " x " + std::to_string(height) + ", " + std::to_string(channels) +
+         (channels == 1 ? " channel, " : " channels, ") + storage;
+}
+
 LoadResult load_scene(std::string_view json_text, const Limits& limits,
                       std::span<const RenderOverride> overrides, const AssetFolder& assets) {
   LoadResult result;

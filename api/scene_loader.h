@@ -66,6 +66,10 @@ struct AssetUse {
   std::string summary;  // what was read from it: "12000 triangles (6000 faces), normals, uvs"
 };
 
+// An image asset's AssetUse summary: "512 x 256, 3 channels, float"; `storage` is how the file
+// stores its values ("float", "8-bit", "integer").
+std::string describe_image(int width, int height, int channels, const std::string& storage);
+
 struct SceneRequest {
   SceneInput scene;
   RenderSettings settings;
@@ -73,7 +77,10 @@ struct SceneRequest {
   // position): single-precision rendering keeps its accuracy however far from the JSON origin
   // the scene lies. Add it back to recover JSON coordinates.
   glm::dvec3 world_origin{0.0};
-  std::vector<AssetUse> assets;  // in the order the scene names them
+  // The environment map, the image textures (in the order materials and objects name them),
+  // then the mesh and glTF files (in the order of the objects).
+  std::vector<AssetUse> assets;
+  int64_t texture_bytes = 0;  // the image textures' decoded size (api/texture_parser.h)
   // The scene's "animation" (api/animation.h). With one, `scene` is set to its first frame;
   // select_frame chooses another.
   std::optional<Animation> animation;

@@ -245,8 +245,9 @@ std::optional<SceneRequest> parse_scene(const Json& document, const Limits& limi
   glm::dvec3 origin(0.0);
   parse_camera(root.get("camera"), request.scene.camera, origin, diag);
 
+  std::vector<AssetUse> environment_files;
   const bool environment_lit =
-      parse_environment(root.get("environment"), assets, request.scene, diag);
+      parse_environment(root.get("environment"), assets, request.scene, &environment_files, diag);
 
   TextureSet textures(limits, assets);
   ParsedMaterials materials =
@@ -302,7 +303,10 @@ std::optional<SceneRequest> parse_scene(const Json& document, const Limits& limi
                                  objects.extra_materials.end());
   request.scene.objects = std::move(objects.objects);
   request.scene.instances = std::move(objects.instances);
-  request.assets = std::move(objects.assets);
+  request.assets = std::move(environment_files);
+  request.assets.insert(request.assets.end(), textures.uses().begin(), textures.uses().end());
+  request.assets.insert(request.assets.end(), objects.assets.begin(), objects.assets.end());
+  request.texture_bytes = textures.bytes();
   request.scene.texture_limits = textures.renderer_limits();
   return request;
 }

@@ -139,7 +139,14 @@ std::optional<std::pair<std::string, AssetImageInfo>> TextureSet::probe(const st
                                 " (max_texture_pixels)");
       else
         result.emplace(file->string(), info);
-      if (result) channels_[file->string()] = info.channels;
+      if (result) {
+        channels_[file->string()] = info.channels;
+        uses_.push_back(AssetUse{pointer, path,
+                                 describe_image(info.width, info.height, info.channels,
+                                                info.is_float  ? "float"
+                                                : info.is_8bit ? "8-bit"
+                                                               : "integer")});
+      }
     } catch (const ImageIoError& e) {
       // The message names the resolved file; the user wrote `path`.
       std::string reason = e.what();

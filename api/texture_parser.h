@@ -8,6 +8,7 @@
 #include <string>
 #include <string_view>
 #include <utility>
+#include <vector>
 
 #include "api/asset_path.h"
 #include "api/json_reader.h"
@@ -46,6 +47,8 @@ class TextureSet {
     return {limits_.max_texture_pixels, limits_.max_texture_bytes};
   }
   int64_t bytes() const { return bytes_; }
+  // The image files probe() accepted, once each, in the order fields first named them.
+  const std::vector<AssetUse>& uses() const { return uses_; }
 
  private:
   const Limits& limits_;
@@ -56,6 +59,7 @@ class TextureSet {
   std::map<std::string, int> channels_;  // by canonical file (or key)
   std::map<std::pair<std::string, TextureColorspace>, int64_t> reserved_;
   int64_t bytes_ = 0;
+  std::vector<AssetUse> uses_;
 };
 
 // What a texture stands for: its default colorspace, whether `channel` and `scale` apply.

@@ -61,9 +61,10 @@ std::string byte_size(int64_t bytes) {
 void print_memory(const MemoryEstimate& m, bool with_film) {
   std::printf(
       "  memory      about %s: scene input %s, renderer copies %s, Embree %s (+%s while "
-      "building)%s\n",
+      "building)%s%s\n",
       byte_size(m.total()).c_str(), byte_size(m.scene_input).c_str(), byte_size(m.shapes).c_str(),
       byte_size(m.embree).c_str(), byte_size(m.embree_build_peak).c_str(),
+      m.textures > 0 ? (", textures " + byte_size(m.textures)).c_str() : "",
       with_film ? (", film " + byte_size(m.film)).c_str() : "");
 }
 
@@ -157,7 +158,9 @@ int print_scene(const std::string& file) {
   for (const api::AssetUse& asset : request.assets)
     std::printf("    %s  %s: %s\n", asset.pointer.c_str(), asset.path.c_str(),
                 asset.summary.c_str());
-  print_memory(estimate_memory(scene, settings), true);
+  MemoryEstimate memory = estimate_memory(scene, settings);
+  memory.textures = request.texture_bytes;
+  print_memory(memory, true);
   return 0;
 }
 

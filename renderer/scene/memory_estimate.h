@@ -14,7 +14,12 @@ struct MemoryEstimate {
   int64_t embree = 0;             // Embree's vertex and index buffers and its BVH, after the build
   int64_t embree_build_peak = 0;  // the build's transient extra on top of `embree`
   int64_t film = 0;               // per-pixel accumulators and the output images
-  int64_t total() const { return scene_input + shapes + embree + embree_build_peak + film; }
+  // Decoded image textures: their sizes come from the files' headers, which a SceneInput does
+  // not hold, so the caller fills this (api's SceneRequest::texture_bytes).
+  int64_t textures = 0;
+  int64_t total() const {
+    return scene_input + shapes + embree + embree_build_peak + film + textures;
+  }
 };
 
 MemoryEstimate estimate_memory(const SceneInput& scene, const RenderSettings& settings);

@@ -60,7 +60,35 @@ TEST(Info, SceneWithAnEnvironmentMap) {
   const CommandResult r = run_penumbra(folder, "info sky.json");
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_TRUE(contains(r.output, "  lights      none; environment map 512 x 256\n")) << r.output;
+  EXPECT_TRUE(contains(r.output, "  files       1\n    /environment/map  sky.hdr: 512 x 256, 3 channels, float\n"))
+      << r.output;
   EXPECT_TRUE(contains(r.output, "scene input 1.5 MiB, renderer copies 2.6 MiB")) << r.output;
+}
+
+// Image textures: each file once (the first field naming it), with its header's size, channels
+// and storage, and their decoded size in the estimate (a 128 x 128 RGB PNG as 8-bit texels,
+// 48 KiB; a 64 x 64 grey one, 4 KiB).
+TEST(Info, SceneWithTextures) {
+  SceneFolder folder;
+  const std::string textures = std::string(PENUMBRA_SOURCE_DIR) + "/tests/accuracy/scenes/textures/";
+  std::filesystem::copy_file(textures + "wood.png", folder.file("wood.png"));
+  std::filesystem::copy_file(textures + "rough.png", folder.file("rough.png"));
+  write_file(folder, "textured.json", R"({"version": 1,
+      "camera": {"position": [0, 0, 5], "look_at": [0, 0, 0]},
+      "environment": {"radiance": [1, 1, 1]},
+      "materials": {"a": {"type": "diffuse", "color": {"texture": "wood.png"}},
+                    "b": {"type": "conductor", "roughness": {"texture": "rough.png"},
+                          "color": {"texture": "wood.png"}}},
+      "objects": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "a"},
+                  {"type": "sphere", "center": [2, 0, 0], "radius": 1, "material": "b"}]})");
+  const CommandResult r = run_penumbra(folder, "info textured.json");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(contains(r.output,
+                       "  files       2\n"
+                       "    /materials/a/color/texture  wood.png: 128 x 128, 3 channels, 8-bit\n"
+                       "    /materials/b/roughness/texture  rough.png: 64 x 64, 1 channel, 8-bit\n"))
+      << r.output;
+  EXPECT_TRUE(contains(r.output, ", textures 52.0 KiB, film ")) << r.output;
 }
 
 TEST(Info, SceneWithInstances) {
