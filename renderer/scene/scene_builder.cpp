@@ -193,12 +193,29 @@ class SceneBuilder {
   // Static meshes made of quads are traced as parallelograms (shapes/parallelogram_pairs.h),
   // copied ones too (the test runs in the callback on the ray Embree maps into the copy, so it
   // needs no check after traversal), unless holding a face twice (coincident faces tie at every
-  // point; triangles have the rule below for them).
+  // point; triangles have the rule below for them). Embree keeps one BVH per kind of primitive
+  // and every ray traverses each, so converting pays only where the scene already has user
+  // geometry (spheres, static quads) or no triangles stay: a glTF scene of triangles whose
+  // floor, one quad, became the only user primitive took 1.03 of the time, 0.98 with a sphere
+  // beside it (docs/performance.md, levers, session 29).
   void parallelogram_meshes() {
-    for (auto& shape : s_.shapes_)
-      if (TriangleMesh* mesh = shape->triangle_mesh())
-        if (mesh->trace_as_parallelograms() && has_coincident_triangles({mesh}))
-          mesh->trace_as_triangles();
+    bool user_geometry = false, triangles_stay = false;
+    std::vector<TriangleMesh*> converted;
+    for (auto& shape : s_.shapes_) {
+      TriangleMesh* mesh = shape->triangle_mesh();
+      if (!mesh) {
+        user_geometry = true;  // a sphere or a quad traced by its own test
+        continue;
+      }
+      if (mesh->trace_as_parallelograms() && !has_coincident_triangles({mesh})) {
+        converted.push_back(mesh);
+        continue;
+      }
+      mesh->trace_as_triangles();
+      triangles_stay = true;
+    }
+    if (triangles_stay && !user_geometry)
+      for (TriangleMesh* mesh : converted) mesh->trace_as_triangles();
   }
 
   // Where each mesh's exact-t test runs (scene/exact_t_check.h): a mesh without a cutout and

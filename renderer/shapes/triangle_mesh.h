@@ -37,7 +37,8 @@ class TriangleMesh : public Shape {
   // Boxes, panels and rooms gain (a Cornell box's two boxes: 0.95 of the time; a glass box:
   // 0.80), large meshes do not: Embree's triangle leaves test four at once, a user geometry one
   // primitive per call (a floor of 16 x 16 quads: 1.01 of the time, 64 x 64: 1.08, 200 x 200:
-  // 1.15; docs/performance.md, session 28).
+  // 1.15; docs/performance.md, session 28). The scene build also undoes it where the mesh would
+  // add the only user geometry beside triangles (scene_builder.cpp, parallelogram_meshes).
   static constexpr size_t kMaxFacePairs = 256;
   // Undoes trace_as_parallelograms (the scene build's own conditions, scene_builder.cpp).
   void trace_as_triangles() { face_pairs_ = FacePairs(); }
