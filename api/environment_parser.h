@@ -5,9 +5,9 @@
 //   {"map": file, "scale": number, "rotate": {"axis", "degrees"} | "matrix": 16 numbers}.
 // The image is read here, through the scene's asset folder, so an unreadable or oversized file
 // is an error on /environment/map like any other invalid field.
-#include "api/asset_path.h"
 #include <vector>
 
+#include "api/asset_path.h"
 #include "api/json_reader.h"
 #include "api/scene_loader.h"
 #include "renderer/scene/scene_input.h"
