@@ -224,9 +224,13 @@ TEST(AnimationJobs, EventsCarryProgressPerFrame) {
   TempDir dir;
   ServerProcess server(dir.path(), {"--render-threads", "1"});
   auto c = server.client();
-  // Frames of about 0.7 s on one thread: progress is sampled at most 4 times a second, so a
-  // shorter frame may pass between two samples.
-  const std::string id = submit(*c, animation_scene(1, 6, 32, 512));
+  // Frames of 0.75 s each, whatever the renderer's speed (a time budget per frame, samples
+  // without end): progress is sampled at most 4 times a second, so a shorter frame may pass
+  // between two samples. (With 512 spp instead, frames meant to last 0.7 s took 0.2 s once the
+  // renderer got faster, and the test failed now and then.)
+  Json scene = animation_scene(1, 6, 32, 1 << 16);
+  scene["render"]["time_limit"] = 0.75;
+  const std::string id = submit(*c, scene);
   const StreamRead r = read_events(server, id);
   ASSERT_EQ(r.status, 200);
   ASSERT_FALSE(r.events.empty());
