@@ -50,6 +50,25 @@ PixelOrder make_pixel_order(int width, int height, int size) {
   return o;
 }
 
+// Work items of a pass where every pixel takes the same samples: the tiles, or, where several
+// threads share fewer tiles than kItemsPerThread each, that many equal ranges of the pixel order. A
+// thread that runs out of items waits for the other's last one, and the accuracy scenes' 64 x 64
+// images are 16 tiles of very unequal cost (a sphere's tiles against the sky's): with 64-pixel
+// items instead, two threads take 0.95-1.00 of the time (instances 0.95, plastics and
+// kitchen_sink 0.96, conductors 0.96, none slower; docs/performance.md, levers, session 30).
+constexpr int kItemsPerThread = 32;
+std::vector<size_t> even_items(const PixelOrder& order, int threads) {
+  const size_t tiles = order.tile_starts.size() - 1;
+  const size_t parts = size_t(kItemsPerThread) * size_t(std::max(1, threads));
+  if (threads <= 1 || tiles >= parts) return order.tile_starts;  // one thread: nothing to balance
+  const size_t pixels = order.pixels.size();
+  const size_t size = std::max<size_t>(1, (pixels + parts - 1) / parts);
+  std::vector<size_t> starts;
+  for (size_t k = 0; k < pixels; k += size) starts.push_back(k);
+  starts.push_back(pixels);
+  return starts;
+}
+
 // Work items of an adaptive pass: consecutive ranges of the pixel order holding about equal
 // numbers of samples. Once limits differ, the samples of a pass crowd into the few tiles where
 // the noise is, and tile-sized items would leave threads idle at the pass's end.
@@ -203,7 +222,7 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
     const double pass_start = elapsed();
     // Limits are decided here, between passes, so the image does not depend on threads or tile
     // order; the progress total follows them so the fraction and ETA stay meaningful.
-    std::vector<size_t> items = order.tile_starts;
+    std::vector<size_t> items = even_items(order, arena.max_concurrency());
     if (adaptive && s0 >= adaptive_limits.min_samples) {
       arena.execute([&] { update_limits(film, adaptive_limits, &limit); });
       samples_total = 0;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <climits>
+#include <utility>
 #include <vector>
 
 #include "renderer/render/pass_plan.h"
@@ -44,6 +45,32 @@ TEST(RenderDeterminism, SameImageForAnyThreadCountAndTileSize) {
   const Image c = render(*scene, s).image;
   EXPECT_EQ(a.rgb, b.rgb);
   EXPECT_EQ(a.rgb, c.rgb);
+}
+
+// A pass's work items are the tiles, or ranges of the pixel order where the window has few tiles
+// for its threads (render.cpp, even_items): whatever the split, every pixel takes its samples
+// once, and the image is the one tile-sized items give.
+TEST(RenderDeterminism, EveryPixelSampledOnceWhateverTheWorkItems) {
+  const auto scene = Scene::build(busy_scene());
+  for (const auto [w, h] : {std::pair{1, 1}, std::pair{17, 3}, std::pair{40, 30}, std::pair{130, 20}}) {
+    RenderSettings s = small_settings(w, h, 3, 4);
+    s.tile_size = 1 << 20;  // one tile: the items are ranges of the pixel order
+    Image first;
+    for (const int threads : {1, 2, 3, 7, 64}) {
+      s.threads = threads;
+      const RenderResult r = render(*scene, s);
+      EXPECT_EQ(r.stats.camera_samples, uint64_t(w) * h * 3) << w << "x" << h << ", " << threads;
+      for (size_t i = 0; i < r.image.rgb.size(); ++i)
+        ASSERT_GT(r.image.rgb[i], 0.f) << "value " << i << " unrendered, " << w << "x" << h << ", " << threads;
+      if (first.rgb.empty())
+        first = r.image;
+      else
+        EXPECT_EQ(r.image.rgb, first.rgb) << w << "x" << h << ", " << threads;
+    }
+    s.tile_size = 1;  // w x h tiles, as many items as pixels or fewer
+    s.threads = 2;
+    EXPECT_EQ(render(*scene, s).image.rgb, first.rgb) << w << "x" << h;
+  }
 }
 
 // The passes a render makes: the largest RenderProgress::passes_done its progress reports saw
