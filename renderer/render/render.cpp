@@ -50,28 +50,16 @@ PixelOrder make_pixel_order(int width, int height, int size) {
   return o;
 }
 
-// Work items of a pass where every pixel takes the same samples: the tiles, or, where several
-// threads share fewer tiles than kItemsPerThread each, that many equal ranges of the pixel order. A
-// thread that runs out of items waits for the other's last one, and the accuracy scenes' 64 x 64
-// images are 16 tiles of very unequal cost (a sphere's tiles against the sky's): with 64-pixel
-// items instead, two threads take 0.95-1.00 of the time (instances 0.95, plastics and
-// kitchen_sink 0.96, conductors 0.96, none slower; docs/performance.md, levers, session 30).
+// Work items of a pass: consecutive ranges of the pixel order holding about equal numbers of
+// samples. An adaptive pass needs them once limits differ: the samples of a pass crowd into the
+// few tiles where the noise is, and tile-sized items would leave threads idle at the pass's end.
+// A pass where every pixel takes the same samples needs them where several threads share fewer
+// tiles than kItemsPerThread each: a thread that runs out of items waits for the other's last
+// one, and the accuracy scenes' 64 x 64 images are 16 tiles of very unequal cost (a sphere's
+// tiles against the sky's); with 64-pixel items instead, two threads take 0.95-1.00 of the time
+// (instances 0.95, plastics and kitchen_sink 0.96, conductors 0.96, none slower;
+// docs/performance.md, levers, session 30). One thread keeps the tiles: nothing to balance.
 constexpr int kItemsPerThread = 32;
-std::vector<size_t> even_items(const PixelOrder& order, int threads) {
-  const size_t tiles = order.tile_starts.size() - 1;
-  const size_t parts = size_t(kItemsPerThread) * size_t(std::max(1, threads));
-  if (threads <= 1 || tiles >= parts) return order.tile_starts;  // one thread: nothing to balance
-  const size_t pixels = order.pixels.size();
-  const size_t size = std::max<size_t>(1, (pixels + parts - 1) / parts);
-  std::vector<size_t> starts;
-  for (size_t k = 0; k < pixels; k += size) starts.push_back(k);
-  starts.push_back(pixels);
-  return starts;
-}
-
-// Work items of an adaptive pass: consecutive ranges of the pixel order holding about equal
-// numbers of samples. Once limits differ, the samples of a pass crowd into the few tiles where
-// the noise is, and tile-sized items would leave threads idle at the pass's end.
 std::vector<size_t> balanced_items(const PixelOrder& order, const std::vector<uint32_t>& taken,
                                    const std::vector<uint32_t>& limit, uint32_t pass_samples,
                                    int parts) {
@@ -222,12 +210,15 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
     const double pass_start = elapsed();
     // Limits are decided here, between passes, so the image does not depend on threads or tile
     // order; the progress total follows them so the fraction and ETA stay meaningful.
-    std::vector<size_t> items = even_items(order, arena.max_concurrency());
+    const int threads = arena.max_concurrency();
+    std::vector<size_t> items = order.tile_starts;
     if (adaptive && s0 >= adaptive_limits.min_samples) {
       arena.execute([&] { update_limits(film, adaptive_limits, &limit); });
       samples_total = 0;
       for (size_t i = 0; i < limit.size(); ++i) samples_total += std::max(limit[i], taken[i]);
-      items = balanced_items(order, taken, limit, uint32_t(s1 - s0), 8 * arena.max_concurrency());
+      items = balanced_items(order, taken, limit, uint32_t(s1 - s0), 8 * threads);
+    } else if (threads > 1 && items.size() - 1 < size_t(kItemsPerThread) * size_t(threads)) {
+      items = balanced_items(order, taken, limit, uint32_t(s1 - s0), kItemsPerThread * threads);
     }
     arena.execute([&] {
       tbb::parallel_for(tbb::blocked_range<size_t>(0, items.size() - 1, 1), [&](const auto& range) {

@@ -48,7 +48,7 @@ TEST(RenderDeterminism, SameImageForAnyThreadCountAndTileSize) {
 }
 
 // A pass's work items are the tiles, or ranges of the pixel order where the window has few tiles
-// for its threads (render.cpp, even_items): whatever the split, every pixel takes its samples
+// for its threads (render.cpp, balanced_items): whatever the split, every pixel takes its samples
 // once, and the image is the one tile-sized items give.
 TEST(RenderDeterminism, EveryPixelSampledOnceWhateverTheWorkItems) {
   const auto scene = Scene::build(busy_scene());
