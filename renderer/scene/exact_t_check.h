@@ -7,7 +7,9 @@
 // candidate. The filter only removes candidates, so an unfiltered closest hit that passes is
 // the filtered closest hit, provided the closest hit is unique. Occlusion queries use the
 // context filter from the start (a blocked shadow ray is common, and a second traversal costs
-// more than the filter calls an occlusion query makes before it stops).
+// more than the filter calls an occlusion query makes before it stops); the filter settles most
+// candidates without the exact test, where a bound on Embree's rounding says the sign of its t
+// cannot be wrong (embree_hit_certainly_ahead).
 //
 // The closest hit is not unique on exactly coincident triangles, and Embree's filter-free
 // packet kernels break those ties differently from its single-ray ones (a path through two
@@ -20,6 +22,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "renderer/core/bounds.h"
 #include "renderer/core/ray.h"
 #include "renderer/shapes/triangle_mesh.h"
 
@@ -65,6 +68,34 @@ class ExactTCheck {
  private:
   std::vector<const TriangleMesh*> plain_;
 };
+
+// Whether a candidate hit Embree's robust triangle test reports on a static triangle, at t along
+// the ray (o, d) with Embree's unnormalised geometric normal ng, has t > 0 in exact arithmetic
+// for certain, so the exact test (TriangleMesh::ahead_of_ray, three vertex loads and a double
+// cross product) can be skipped; false means "do the exact test", never "reject".
+// `box` holds the triangle's vertices, `max_edge` bounds its edges.
+//
+// Why it holds. Embree's Pluecker test translates the vertices to the ray origin, v = V - o
+// (each coordinate rounded: |dv| <= u |v|, u = 2^-24), takes the edges between those and the
+// normal Ng from two edges, then T = dot(v0, Ng) and den = dot(Ng, d), and t = T / den. With
+// R >= |v| for every vertex and L >= every edge, the rounded edges are off by at most
+// u (2 R + L), Ng by u (4 R + 5 L) L + 3 u |Ng|, so T is off by at most
+// E_T = u R A and den by E_den = u |d| A, where A = 7 (R + L) L + 5 |Ng|. A hit whose exact t
+// is <= 0 while Embree's is > 0 has a sign of T or of den wrong, hence |T| <= 2 E_T or
+// |den| <= 2 E_den as Embree computed them; with T = t den that is den <= 2 u A max(|d|, R / t).
+// The test asks for 16 times more. It fails safe: NaN, infinities and underflow all give false.
+// Grazing rays and hits close to the origin relative to R fail it and take the exact test.
+inline bool embree_hit_certainly_ahead(const vec3& o, const vec3& d, float t, const vec3& ng,
+                                       const Bounds3& box, float max_edge) {
+  constexpr double kMargin = 16.0, kUlp = 0x1p-24;
+  const dvec3 centre = 0.5 * (dvec3(box.lo) + dvec3(box.hi));
+  const double reach = glm::length(dvec3(o) - centre) + 0.5 * glm::length(dvec3(box.hi) - dvec3(box.lo));
+  const dvec3 n(ng);
+  const double den = std::abs(glm::dot(n, dvec3(d)));
+  const double a = 7.0 * (reach + double(max_edge)) * double(max_edge) + 5.0 * glm::length(n);
+  const double bound = 2.0 * kMargin * kUlp * a * std::max(glm::length(dvec3(d)), reach / double(t));
+  return t > 0.f && den > bound;
+}
 
 // The closest hit along `ray` with the test on every candidate: one ray through the context
 // filter, for a ray whose unfiltered closest hit the check rejected.

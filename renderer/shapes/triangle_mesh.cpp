@@ -94,9 +94,11 @@ TriangleMesh::TriangleMesh(const MeshDesc& desc, const ShapeContext& ctx)
   std::vector<float> areas(n);
   double total = 0.0;
   for (size_t t = 0; t < n; ++t) {
-    areas[t] = triangle_area(positions_[indices_[3 * t]], positions_[indices_[3 * t + 1]],
-                             positions_[indices_[3 * t + 2]]);
+    const vec3 &a = positions_[indices_[3 * t]], &b = positions_[indices_[3 * t + 1]],
+               &c = positions_[indices_[3 * t + 2]];
+    areas[t] = triangle_area(a, b, c);
     total += areas[t];
+    max_edge_ = std::max({max_edge_, glm::length(b - a), glm::length(c - b), glm::length(a - c)});
   }
   area_ = float(total);
   if (ctx.emissive && n > 0) {

@@ -85,6 +85,8 @@ class TriangleMesh : public Shape {
     // Signs compared, not num * den > 0, which could underflow to 0 in a tiny scene.
     return (num > 0.0 && den > 0.0) || (num < 0.0 && den < 0.0);
   }
+  // The longest edge of any triangle (motion is rigid: the same at every time).
+  float max_edge() const { return max_edge_; }
   // With a cutout: whether the surface exists at barycentrics (b1, b2) of triangle `prim`.
   bool has_cutout() const { return alpha_ != nullptr; }
   bool solid_at(uint32_t prim, float b1, float b2) const;
@@ -119,6 +121,7 @@ class TriangleMesh : public Shape {
   // moving mesh, whose displaced vertices round differently.
   std::vector<vec3> face_normals_;
   float area_ = 0.f;
+  float max_edge_ = 0.f;
   Bounds3 bounds_;
   // Embree motion: vertex buffers at time_steps_ instants evenly spread over the shutter, and
   // the displacement at each (all vertices share it: motion is rigid).

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <random>
 
@@ -139,6 +140,176 @@ TEST(ExactTCheck, OcclusionDoesNotSeeTheSurfaceTheRayLeaves) {
     scene->occluded_packet(shadow.data(), Scene::kPacketSize, occluded);
     for (int k = 0; k < Scene::kPacketSize; ++k) EXPECT_FALSE(occluded[k]) << first + k;
   }
+}
+
+// ---- the early accept of candidates (embree_hit_certainly_ahead) ----
+
+// A candidate hit as Embree's robust test reported it to a filter: the ray's tfar then is the
+// candidate's t.
+struct Candidate {
+  uint32_t geom, prim;
+  float t;
+  vec3 ng, o, d;
+};
+struct RecordingContext {
+  RTCIntersectContext embree;  // first: the filter casts Embree's pointer back
+  std::vector<Candidate>* out;
+};
+// Records every candidate and rejects it, so that the traversal goes on and shows them all.
+void record_every_candidate(const RTCFilterFunctionNArguments* args) {
+  auto* ctx = reinterpret_cast<const RecordingContext*>(args->context);
+  for_each_filter_lane(args, [&](unsigned n, unsigned i) {
+    if (args->valid[i] == 0) return;
+    ctx->out->push_back({RTCHitN_geomID(args->hit, n, i), RTCHitN_primID(args->hit, n, i),
+                         RTCRayN_tfar(args->ray, n, i),
+                         vec3(RTCHitN_Ng_x(args->hit, n, i), RTCHitN_Ng_y(args->hit, n, i),
+                              RTCHitN_Ng_z(args->hit, n, i)),
+                         embree_ray_origin(args->ray, n, i), embree_ray_direction(args->ray, n, i)});
+    args->valid[i] = 0;
+  });
+}
+
+// Every candidate of `rays`, traced one by one (rtcIntersect1) and in 16-wide occlusion packets
+// (rtcOccluded16, as the renderer's shadow rays): the two use different kernels.
+std::vector<Candidate> candidates_of(RTCScene scene, const std::vector<Ray>& rays) {
+  std::vector<Candidate> out;
+  RecordingContext ctx;
+  rtcInitIntersectContext(&ctx.embree);
+  ctx.embree.filter = record_every_candidate;
+  ctx.out = &out;
+  for (const Ray& ray : rays) {
+    RTCRayHit rh = embree_ray_hit(ray);
+    rtcIntersect1(scene, &ctx.embree, &rh);
+  }
+  for (size_t first = 0; first < rays.size(); first += 16) {
+    alignas(64) int valid[16];
+    alignas(64) RTCRay16 r;
+    for (int k = 0; k < 16; ++k) {
+      const size_t i = std::min(first + size_t(k), rays.size() - 1);
+      valid[k] = first + size_t(k) < rays.size() ? -1 : 0;
+      r.org_x[k] = rays[i].origin.x, r.org_y[k] = rays[i].origin.y, r.org_z[k] = rays[i].origin.z;
+      r.dir_x[k] = rays[i].direction.x, r.dir_y[k] = rays[i].direction.y, r.dir_z[k] = rays[i].direction.z;
+      r.tnear[k] = 0.f, r.tfar[k] = rays[i].t_max, r.time[k] = 0.f;
+      r.mask[k] = 0xFFFFFFFFu, r.id[k] = 0, r.flags[k] = 0;
+    }
+    rtcOccluded16(valid, scene, &ctx.embree, &r);
+  }
+  return out;
+}
+
+vec3 random_direction(std::mt19937& rng) {
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  const double z = 2 * u01(rng) - 1, phi = 2 * M_PI * u01(rng), r = std::sqrt(1 - z * z);
+  return vec3(dvec3(r * std::cos(phi), r * std::sin(phi), z));
+}
+
+// A bumpy height field of 48 x 48 cells (two triangles each, no pair a parallelogram) over a
+// square of side `size` centred at `centre`.
+MeshDesc bumpy_field(const vec3& centre, float size) {
+  MeshDesc m;
+  const int n = 48;
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) {
+      const float x = (float(i) / n - 0.5f) * size, z = (float(j) / n - 0.5f) * size;
+      const float y = 0.04f * size * std::sin(13.f * x / size) * std::cos(11.f * z / size) +
+                      0.003f * size * float((i * 7 + j * 13) % 5);
+      m.positions.push_back(centre + vec3(x, y, z));
+    }
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const uint32_t a = uint32_t(j * (n + 1) + i), b = a + 1, c = a + uint32_t(n + 1), d = c + 1;
+      m.indices.insert(m.indices.end(), {a, c, b, b, c, d});
+    }
+  return m;
+}
+
+struct Tally {
+  size_t candidates = 0, behind = 0, accepted = 0, ahead = 0, wrongly_accepted = 0;
+};
+
+// Checks every candidate of `rays` on `scene`'s plain meshes against the exact test.
+Tally check_candidates(const Scene& scene, const std::vector<Ray>& rays) {
+  Tally tally;
+  for (const Candidate& c : candidates_of(scene.embree_scene(), rays)) {
+    const TriangleMesh* mesh = scene.exact_t_check().plain_mesh(c.geom, RTC_INVALID_GEOMETRY_ID);
+    if (!mesh) continue;
+    ++tally.candidates;
+    // Embree's normal is the unnormalised cross product of two edges (the predicate's scale).
+    vec3 v[3];
+    mesh->step_triangle(c.prim, 0, v);
+    const float cross = glm::length(glm::cross(v[1] - v[0], v[2] - v[0]));
+    EXPECT_GT(glm::length(c.ng), 0.25f * cross) << "prim " << c.prim;
+    EXPECT_LT(glm::length(c.ng), 4.f * cross) << "prim " << c.prim;
+    const bool exact = mesh->ahead_of_ray(c.prim, c.o, c.d, 0.f);
+    const bool early = embree_hit_certainly_ahead(c.o, c.d, c.t, c.ng, mesh->bounds(), mesh->max_edge());
+    tally.behind += !exact;
+    tally.ahead += exact;
+    tally.accepted += early;
+    tally.wrongly_accepted += early && !exact;
+  }
+  return tally;
+}
+
+// The early accept must never pass a candidate whose exact t is <= 0 (a re-hit of the surface
+// the ray leaves: a false shadow), and should settle most other candidates. The rays: from
+// points of the large tilted quad near the world origin (Embree misjudges the sign of t for many
+// of them, see rays_that_rehit), and from hit points of a bumpy field, rounded to float and not
+// offset (re-hits of the triangle left and of its neighbours at both kinds of fold), in every
+// direction, grazing ones included; the field at three scales and far from the origin.
+TEST(ExactTCheck, EarlyAcceptNeverPassesAReHit) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u01(0.f, 1.f);
+  Tally total;
+  auto add = [&](const Tally& t) {
+    total.candidates += t.candidates, total.behind += t.behind, total.accepted += t.accepted;
+    total.ahead += t.ahead, total.wrongly_accepted += t.wrongly_accepted;
+  };
+  {
+    const auto scene = Scene::build(tilted_quad_in_box(false));
+    ASSERT_TRUE(scene->exact_t_check().enabled());
+    std::vector<Ray> rays = rays_that_rehit(*scene, 400);
+    ASSERT_EQ(rays.size(), 400u);
+    for (Ray& r : rays) r.t_max = 1e30f;
+    const Tally t = check_candidates(*scene, rays);
+    EXPECT_GE(t.behind, 400u);  // every ray's re-hit, from one kernel and the other
+    add(t);
+  }
+  for (const auto& [centre, size] : {std::pair{vec3(0.f), 2.f}, std::pair{vec3(0.f), 2e-3f},
+                                     std::pair{vec3(0.f), 2e3f}, std::pair{vec3(300.f, -40.f, 120.f), 2.f}}) {
+    SceneInput in;
+    in.camera = camera_looking(centre + vec3(0.f, size, 2.f * size), centre, 40.f);
+    in.materials = {MaterialParams{}};
+    ObjectDesc field;
+    field.shape = bumpy_field(centre, size);
+    in.objects = {field};
+    const auto scene = Scene::build(in);
+    ASSERT_TRUE(scene->exact_t_check().enabled());
+    std::vector<Ray> rays;
+    for (int k = 0; k < 3000; ++k) {
+      // A hit point of the field, as the renderer's intersect computes it, without the spawn
+      // offset: the hardest origin for the sign of t.
+      const vec3 above = centre + size * vec3(u01(rng) - 0.5f, 1.f, u01(rng) - 0.5f);
+      SurfaceHit hit;
+      if (!scene->intersect(Ray{above, vec3(0.f, -1.f, 0.f), 0.f}, &hit)) continue;
+      vec3 d = random_direction(rng);
+      if (k % 3 == 0) {  // grazing: within about 1e-3 .. 1e-6 radians of the tangent plane
+        const vec3 n = hit.ng;
+        d = glm::normalize(d - glm::dot(d, n) * n) + n * (std::pow(10.f, -3.f - 3.f * u01(rng)) * (u01(rng) < 0.5f ? -1.f : 1.f));
+      }
+      rays.push_back(Ray{hit.p, d, 0.f});
+      // And a ray from far above, whose candidates are ordinary hits.
+      rays.push_back(Ray{above, glm::normalize(vec3(u01(rng) - 0.5f, -1.f, u01(rng) - 0.5f)), 0.f});
+    }
+    for (Ray& r : rays) r.t_max = 1e30f;
+    add(check_candidates(*scene, rays));
+  }
+  EXPECT_EQ(total.wrongly_accepted, 0u) << "of " << total.candidates << " candidates";
+  // The data exercise the case, and the early accept does its job on the rest.
+  EXPECT_GE(total.behind, 1000u);
+  EXPECT_GT(double(total.accepted), 0.5 * double(total.ahead))
+      << total.accepted << " accepted of " << total.ahead << " ahead";
+  std::printf("candidates %zu, exact t <= 0: %zu, ahead %zu, accepted early %zu\n", total.candidates,
+              total.behind, total.ahead, total.accepted);
 }
 
 std::unique_ptr<TriangleMesh> mesh(const MeshDesc& desc, const vec3& velocity = vec3(0.f)) {
