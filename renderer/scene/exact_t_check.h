@@ -79,11 +79,13 @@ class ExactTCheck {
 // (each coordinate rounded: |dv| <= u |v|, u = 2^-24), takes the edges between those and the
 // normal Ng from two edges, then T = dot(v0, Ng) and den = dot(Ng, d), and t = T / den. With
 // R >= |v| for every vertex and L >= every edge, the rounded edges are off by at most
-// u (2 R + L), Ng by u (4 R + 5 L) L + 3 u |Ng|, so T is off by at most
-// E_T = u R A and den by E_den = u |d| A, where A = 7 (R + L) L + 5 |Ng|. A hit whose exact t
-// is <= 0 while Embree's is > 0 has a sign of T or of den wrong, hence |T| <= 2 E_T or
-// |den| <= 2 E_den as Embree computed them; with T = t den that is den <= 2 u A max(|d|, R / t).
-// The test asks for 16 times more. It fails safe: NaN, infinities and underflow all give false.
+// u (2 R + L) and Ng (each component a difference of two products of edge components) by
+// u (4 R + 5 L) L, so T is off by at most u R ((4 R + 5 L) L + 4 |Ng|) (v0's rounding, Ng's,
+// the dot product's) and den by u |d| ((4 R + 5 L) L + 3 |Ng|): within E_T = u R A and
+// E_den = u |d| A, where A = 7 (R + L) L + 5 |Ng|. Embree keeps a candidate whose T and den have
+// the same sign; if the exact t is <= 0 one of them has the wrong sign (or T is exactly 0), so
+// |T| <= E_T or |den| <= E_den as Embree computed them; with T = t den, den <= u A max(|d|, R / t).
+// The test asks for 32 times more. It fails safe: NaN, infinities and underflow all give false.
 // Grazing rays and hits close to the origin relative to R fail it and take the exact test.
 inline bool embree_hit_certainly_ahead(const vec3& o, const vec3& d, float t, const vec3& ng,
                                        const Bounds3& box, float max_edge) {
