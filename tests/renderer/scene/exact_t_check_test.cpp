@@ -60,6 +60,13 @@ SceneInput tilted_quad_in_box(bool coincident_elsewhere) {
   return in;
 }
 
+// A direction uniform on the sphere, in double before rounding.
+vec3 random_direction(std::mt19937& rng) {
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  const double z = 2 * u01(rng) - 1, phi = 2 * M_PI * u01(rng), r = std::sqrt(1 - z * z);
+  return vec3(dvec3(r * std::cos(phi), r * std::sin(phi), z));
+}
+
 // Rays from points of the quad's plane within 1 of the world origin (the exact point rounded to
 // float) in random directions; kept are those whose exact t on the triangle Embree reports is
 // <= 0, while Embree's unfiltered closest hit is that quad anyway: a re-hit.
@@ -76,8 +83,7 @@ std::vector<Ray> rays_that_rehit(const Scene& scene, int wanted) {
     const double s = ((x - o0.x) * v.y - v.x * (y - o0.y)) / det;
     const double t = (u.x * (y - o0.y) - (x - o0.x) * u.y) / det;
     const vec3 o(o0 + s * u + t * v);
-    const double z = 2 * u01(rng) - 1, phi = 2 * M_PI * u01(rng), r = std::sqrt(1 - z * z);
-    const vec3 d(vec3(dvec3(r * std::cos(phi), r * std::sin(phi), z)));
+    const vec3 d = random_direction(rng);
     const Ray ray{o, d, 0.f};
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
@@ -197,12 +203,6 @@ std::vector<Candidate> candidates_of(RTCScene scene, const std::vector<Ray>& ray
   return out;
 }
 
-vec3 random_direction(std::mt19937& rng) {
-  std::uniform_real_distribution<double> u01(0.0, 1.0);
-  const double z = 2 * u01(rng) - 1, phi = 2 * M_PI * u01(rng), r = std::sqrt(1 - z * z);
-  return vec3(dvec3(r * std::cos(phi), r * std::sin(phi), z));
-}
-
 // A bumpy height field of 48 x 48 cells (two triangles each, no pair a parallelogram) over a
 // square of side `size` centred at `centre`.
 MeshDesc bumpy_field(const vec3& centre, float size) {
@@ -267,9 +267,8 @@ TEST(ExactTCheck, EarlyAcceptNeverPassesAReHit) {
   {
     const auto scene = Scene::build(tilted_quad_in_box(false));
     ASSERT_TRUE(scene->exact_t_check().enabled());
-    std::vector<Ray> rays = rays_that_rehit(*scene, 400);
+    const std::vector<Ray> rays = rays_that_rehit(*scene, 400);
     ASSERT_EQ(rays.size(), 400u);
-    for (Ray& r : rays) r.t_max = 1e30f;
     const Tally t = check_candidates(*scene, rays);
     EXPECT_GE(t.behind, 400u);  // every ray's re-hit, from one kernel and the other
     add(t);
@@ -300,7 +299,6 @@ TEST(ExactTCheck, EarlyAcceptNeverPassesAReHit) {
       // And a ray from far above, whose candidates are ordinary hits.
       rays.push_back(Ray{above, glm::normalize(vec3(u01(rng) - 0.5f, -1.f, u01(rng) - 0.5f)), 0.f});
     }
-    for (Ray& r : rays) r.t_max = 1e30f;
     add(check_candidates(*scene, rays));
   }
   EXPECT_EQ(total.wrongly_accepted, 0u) << "of " << total.candidates << " candidates";
