@@ -72,13 +72,15 @@ def main() -> int:
         name = os.path.splitext(os.path.basename(scene))[0]
         reference = np.array(mi.Bitmap(os.path.join(args.references, f"{name}.exr")), dtype=np.float64)[..., :3]
         denominator = reference ** 2 + 0.01
-        s = np.sqrt((renders(args.penumbra, scene, 1, args.single, mi).var(axis=0, ddof=1) / denominator).mean(axis=2))
 
+        def variance(images: np.ndarray) -> np.ndarray:
+            """Per pixel, the variance across renders over relMSE's denominator, channels averaged."""
+            return (images.var(axis=0, ddof=1) / denominator).mean(axis=2)
+
+        s = np.sqrt(variance(renders(args.penumbra, scene, 1, args.single, mi)))
         stack = renders(args.penumbra, scene, args.spp, args.seeds, mi)
-        v = (stack.var(axis=0, ddof=1) / denominator).mean(axis=2)
         half = args.seeds // 2
-        v_a = (stack[:half].var(axis=0, ddof=1) / denominator).mean(axis=2)
-        v_b = (stack[half:].var(axis=0, ddof=1) / denominator).mean(axis=2)
+        v, v_a, v_b = variance(stack), variance(stack[:half]), variance(stack[half:])
 
         def gain(n: np.ndarray, on: np.ndarray = v) -> float:
             # The renderer's floor: every pixel keeps its first samples (16 of a mean of ~256).
