@@ -25,6 +25,11 @@ A curve that has not reached penumbra's error by its last point is extended (spp
 adaptive threshold divided by sqrt 2; at most ``--extend`` points), so times are interpolated
 between measured points; a time that still had to be extrapolated is marked "~" in the table.
 
+The renderers take turns: every seed of every point is rendered by each renderer in turn before
+the next seed (the first in turn rotating with the seed), so that a drift of the machine's speed
+over minutes reaches all of them alike; Cycles, a Blender process per render, runs its ladder
+after the others.
+
 The fastest Mitsuba is the fastest of its configurations: ``--mitsuba`` lists variants, each
 optionally with a sampler (``llvm_ad_rgb:multijitter``). Mitsuba's default ``independent``
 sampler is not its best: its stratified samplers (``multijitter``, ``ldsampler``) reach a given
@@ -58,6 +63,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import dataclasses
 import json
 import glob
 import math
@@ -334,6 +340,120 @@ def write_report(rows: list[dict], scenes: list[str], renderers: list[str], out:
     print("\n".join(table))
 
 
+@dataclasses.dataclass
+class RunContext:
+    """What every render of one scene needs."""
+    penumbra: str
+    scene_name: str
+    scene_path: str
+    scene: dict
+    assets: str
+    instants: int
+    mi: object
+    reference: np.ndarray
+
+
+class Curve:
+    """One renderer's points on one scene: its spp ladder, or for "penumbra adaptive" its noise
+    thresholds under the spp cap; extended by :meth:`next_point`."""
+
+    def __init__(self, renderer: str, ladder: list[int], thresholds: list[float], cap: int):
+        self.renderer = renderer
+        self.is_penumbra = renderer.startswith("penumbra")
+        self.adaptive = renderer == "penumbra adaptive"
+        self.variant, self.sampler = ("", "") if self.is_penumbra else mitsuba_config(renderer)
+        self.points = [(cap, t) for t in thresholds] if self.adaptive else [(s, 0.0) for s in ladder]
+        self.errors: list[float] = []  # seed-mean relMSE per measured point
+        self.base_points = len(self.points)
+        self.stalled = False  # an extension that lowered no error (an adaptive cap reached)
+
+    def render(self, ctx: RunContext, spp: int, threshold: float, seed: int) -> tuple[np.ndarray, float, int, int]:
+        """Image, seconds, spp taken and shutter instants of one render."""
+        if self.is_penumbra:
+            image, seconds = run_penumbra(ctx.penumbra, ctx.scene_path, spp, seed, ctx.mi, threshold)
+            return image, seconds, spp, 1
+        image, seconds, used = run_mitsuba(self.variant, ctx.scene, max(spp, ctx.instants), seed,
+                                           ctx.instants, ctx.assets, self.sampler)
+        return image, seconds, used, ctx.instants
+
+    def warm_up(self, ctx: RunContext, spp: int) -> None:
+        self.render(ctx, spp, 0.0, 0)
+
+    def warm_up_count(self, ctx: RunContext, spp: int) -> None:
+        """Mitsuba's other samplers compile the sample count into their kernels: a discarded
+        render per count keeps that compilation (0.3 s and more, paid once per count thanks to
+        Dr.Jit's kernel cache) out of the measured seeds."""
+        if not self.is_penumbra and self.sampler != "independent":
+            self.render(ctx, spp, 0.0, 0)
+
+    def wants_more(self, target: float) -> bool:
+        """Whether the curve has not reached penumbra's error yet and can be extended (plain
+        penumbra's ladder defines the target and is never extended)."""
+        return self.renderer != "penumbra" and not self.stalled and self.errors[-1] > target
+
+    def next_point(self) -> tuple[int, float]:
+        spp, threshold = self.points[-1]
+        point = (spp, threshold / math.sqrt(2.0)) if self.adaptive else (spp * 2, threshold)
+        self.points.append(point)
+        return point
+
+    def record(self, error: float) -> None:
+        if len(self.errors) >= self.base_points and not error < self.errors[-1]:
+            self.stalled = True
+        self.errors.append(error)
+
+
+def measure_round(ctx: RunContext, jobs: list[tuple[Curve, int, float]], seeds: int) -> list[dict]:
+    """One point (spp, threshold) of each curve over all seeds, the curves taking turns within
+    each seed (the first in turn rotating with the seed); records each curve's seed-mean
+    relMSE and returns the rows."""
+    for c, spp, _ in jobs:
+        c.warm_up_count(ctx, spp)
+    rows: list[dict] = []
+    errs: dict[int, list[float]] = {id(c): [] for c, _, _ in jobs}
+    for seed in range(seeds):
+        turn = seed % len(jobs)
+        for c, spp, threshold in jobs[turn:] + jobs[:turn]:
+            start = time.perf_counter()
+            image, seconds, used_spp, used_instants = c.render(ctx, spp, threshold, seed)
+            process = time.perf_counter() - start
+            row = {"scene": ctx.scene_name, "renderer": c.renderer, "spp": used_spp, "threshold": threshold,
+                   "seed": seed, "seconds": seconds, "instants": used_instants, **errors(image, ctx.reference),
+                   "process_seconds": process, "reference": "mitsuba"}
+            rows.append(row)
+            errs[id(c)].append(row["relmse"])
+            print(f"{ctx.scene_name:13s} {c.renderer:20s} spp {spp:5d} t {threshold:g} seed {seed}: {seconds:7.3f} s  "
+                  f"relMSE {row['relmse']:.3e}  FLIP {row['flip']:.4f}", flush=True)
+    for c, _, _ in jobs:
+        c.record(float(np.mean(errs[id(c)])))
+    return rows
+
+
+def measure_cycles(args, scene_name: str, scene_path: str, scene: dict, ladder: list[int], seeds: int,
+                   mi, reference: np.ndarray) -> list[dict]:
+    """Blender Cycles' ladder on one scene, against the Mitsuba reference, or against its own
+    render where its translation or material models differ (:func:`cycles_differs`)."""
+    approximate = cycles_differs(scene)
+    if approximate:
+        reference = cycles_reference(args.cycles, scene_path, args.cycles_reference_spp, mi,
+                                     args.cycles_sphere_mesh, args.cycles_rough_glass, args.out)
+        ref_name = f"cycles {args.cycles_reference_spp} spp render: {approximate}"
+    run_cycles(args.cycles, scene_path, ladder[0], 0, mi, args.cycles_sphere_mesh, args.cycles_rough_glass)
+    rows: list[dict] = []
+    for spp in ladder:
+        for seed in range(seeds):
+            image, seconds, process = run_cycles(args.cycles, scene_path, spp, seed, mi,
+                                                 args.cycles_sphere_mesh, args.cycles_rough_glass)
+            row = {"scene": scene_name, "renderer": "cycles", "spp": spp, "threshold": 0.0,
+                   "seed": seed, "seconds": seconds, "instants": 1, **errors(image, reference),
+                   "process_seconds": process, "reference": ref_name if approximate else "mitsuba"}
+            rows.append(row)
+            print(f"{scene_name:13s} {'cycles':20s} spp {spp:5d} t 0 seed {seed}: {seconds:7.3f} s  "
+                  f"(process {process:.2f} s)  relMSE {row['relmse']:.3e}  FLIP {row['flip']:.4f}"
+                  f"{'  vs ' + ref_name if approximate else ''}", flush=True)
+    return rows
+
+
 def main(argv: list[str]) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--penumbra", help="the penumbra executable (required unless --summarise)")
@@ -403,89 +523,35 @@ def main(argv: list[str]) -> int:
         seeds = max(args.seeds, args.heavy_seeds) if scene_name in HEAVY_TAILED else args.seeds
         with open(scene_path, encoding="utf-8") as f:
             refused = p2c.refusals(json.load(f), args.cycles_sphere_mesh, args.cycles_rough_glass)
-        for renderer in renderers:
-            if renderer == "cycles":
-                if refused:
-                    print(f"{scene_name:13s} cycles: skipped, " + "; ".join(str(p) for p in refused), flush=True)
-                    continue
-                approximate = cycles_differs(scene)
-                if approximate:
-                    cycles_ref = cycles_reference(args.cycles, scene_path, args.cycles_reference_spp, mi,
-                                                  args.cycles_sphere_mesh, args.cycles_rough_glass, args.out)
-                    ref_name = f"cycles {args.cycles_reference_spp} spp render: {approximate}"
-                run_cycles(args.cycles, scene_path, ladder[0], 0, mi, args.cycles_sphere_mesh,
-                           args.cycles_rough_glass)
-                for spp in ladder:
-                    for seed in range(seeds):
-                        image, seconds, process = run_cycles(args.cycles, scene_path, spp, seed, mi,
-                                                             args.cycles_sphere_mesh, args.cycles_rough_glass)
-                        row = {"scene": scene_name, "renderer": renderer, "spp": spp, "threshold": 0.0,
-                               "seed": seed, "seconds": seconds, "instants": 1,
-                               **errors(image, cycles_ref if approximate else reference),
-                               "process_seconds": process,
-                               "reference": ref_name if approximate else "mitsuba"}
-                        rows.append(row)
-                        print(f"{scene_name:13s} {renderer:20s} spp {spp:5d} t 0 seed {seed}: {seconds:7.3f} s  "
-                              f"(process {process:.2f} s)  relMSE {row['relmse']:.3e}  FLIP {row['flip']:.4f}"
-                              f"{'  vs ' + ref_name if approximate else ''}", flush=True)
-                continue
-            # One discarded warm-up render: Dr.Jit compiles its kernels on first use, and the
-            # first penumbra run pays for reading the scene file from a cold cache.
-            adaptive = renderer == "penumbra adaptive"
-            # (spp, noise_threshold) of each point: the spp ladder, or the thresholds under a cap
-            points = [(args.adaptive_cap, t) for t in thresholds] if adaptive else [(s, 0.0) for s in ladder]
-            is_penumbra = renderer.startswith("penumbra")
-            variant, sampler = ("", "") if is_penumbra else mitsuba_config(renderer)
-            if is_penumbra:
-                run_penumbra(args.penumbra, scene_path, ladder[0], 0, mi)
+        curves = [Curve(r, ladder, thresholds, args.adaptive_cap) for r in renderers if r != "cycles"]
+        ctx = RunContext(args.penumbra, scene_name, scene_path, scene, assets, instants, mi, reference)
+        # One discarded warm-up render each: Dr.Jit compiles its kernels on first use, and the
+        # first penumbra run pays for reading the scene file from a cold cache.
+        for c in curves:
+            c.warm_up(ctx, ladder[0])
+        # The renderers take turns within every seed of every point (the first in turn rotating
+        # with the seed), instead of each running its whole ladder in turn: this machine's speed
+        # drifts by a quarter over minutes, and renderers measured minutes apart drifted apart
+        # (docs/accuracy.md, session 31); taking turns gives them the same drift.
+        for i in range(max(len(c.points) for c in curves)):
+            rows += measure_round(ctx, [(c, *c.points[i]) for c in curves if i < len(c.points)], seeds)
+        # Extend the curves until they bracket the target (penumbra's relMSE at its top spp,
+        # measured first), so the time to reach it is interpolated, not extrapolated: a line
+        # through a ladder whose cheap points are mostly fixed cost (start-up, kernel
+        # compilation) overstates how fast a renderer's error falls with time. The extensions
+        # take turns as well.
+        target = penumbra_target(rows, scene_name)
+        for _ in range(args.extend):
+            due = [c for c in curves if c.wants_more(target)]
+            if not due:
+                break
+            rows += measure_round(ctx, [(c, *c.next_point()) for c in due], seeds)
+        # Cycles runs as a Blender process per render, its ladder on its own after the others.
+        if "cycles" in renderers:
+            if refused:
+                print(f"{scene_name:13s} cycles: skipped, " + "; ".join(str(p) for p in refused), flush=True)
             else:
-                run_mitsuba(variant, scene, max(ladder[0], instants), 0, instants, assets, sampler)
-            def measure(spp: int, threshold: float) -> float:
-                """One point of the curve over all seeds; returns its mean relMSE."""
-                errs = []
-                if not is_penumbra and sampler != "independent":
-                    # Mitsuba's other samplers compile the sample count into their kernels: a
-                    # discarded render per count keeps that compilation (0.3 s and more, paid
-                    # once per count thanks to Dr.Jit's kernel cache) out of the measured seeds.
-                    run_mitsuba(variant, scene, max(spp, instants), 0, instants, assets, sampler)
-                for seed in range(seeds):
-                    start = time.perf_counter()
-                    if is_penumbra:
-                        image, seconds = run_penumbra(args.penumbra, scene_path, spp, seed, mi, threshold)
-                        used_spp, used_instants = spp, 1
-                    else:
-                        image, seconds, used_spp = run_mitsuba(variant, scene, max(spp, instants), seed,
-                                                               instants, assets, sampler)
-                        used_instants = instants
-                    process = time.perf_counter() - start
-                    row = {"scene": scene_name, "renderer": renderer, "spp": used_spp, "threshold": threshold,
-                           "seed": seed, "seconds": seconds, "instants": used_instants, **errors(image, reference),
-                           "process_seconds": process, "reference": "mitsuba"}
-                    rows.append(row)
-                    errs.append(row["relmse"])
-                    print(f"{scene_name:13s} {renderer:20s} spp {spp:5d} t {threshold:g} seed {seed}: {seconds:7.3f} s  "
-                          f"relMSE {row['relmse']:.3e}  FLIP {row['flip']:.4f}", flush=True)
-                return float(np.mean(errs))
-
-            last = math.inf
-            for spp, threshold in points:
-                last = measure(spp, threshold)
-            # Extend the curve until it brackets the target (penumbra's relMSE at its top spp,
-            # measured first), so the time to reach it is interpolated, not extrapolated: a line
-            # through a ladder whose cheap points are mostly fixed cost (start-up, kernel
-            # compilation) overstates how fast a renderer's error falls with time.
-            target = penumbra_target(rows, scene_name)
-            spp, threshold = points[-1]
-            for _ in range(args.extend):
-                if renderer == "penumbra" or not last > target:
-                    break
-                if adaptive:
-                    threshold /= math.sqrt(2.0)
-                else:
-                    spp *= 2
-                previous, last = last, measure(spp, threshold)
-                if not last < previous:  # an adaptive cap reached: no lower error to be had
-                    break
+                rows += measure_cycles(args, scene_name, scene_path, scene, ladder, seeds, mi, reference)
 
     with open(os.path.join(args.out, "bench.csv"), "w", newline="", encoding="utf-8") as f:
         writer = csv.DictWriter(f, fieldnames=list(rows[0]), restval="")
