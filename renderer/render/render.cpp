@@ -27,8 +27,11 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 // Camera samples the wavefront driver advances together: enough to fill its 16-wide packets
-// for several bounces as paths end, few enough that their state stays in cache.
-constexpr size_t kWavefrontBatch = 256;
+// for several bounces as paths end and to spread each bounce's fixed costs, few enough that
+// their state stays in cache. 512 against 256, measured side by side (bench/pair_renders.sh):
+// 0.96-0.98 of the time on every scene tried, 1024 another 0-1.5% on some and 1.006 on
+// mesh_100k (docs/performance.md, levers, session 32).
+constexpr size_t kWavefrontBatch = 512;
 
 // The rendered pixels tile by tile (row-major inside each tile), and where each tile starts in
 // that order: a pass's work items are ranges of it. Indices are into the film, which covers the
