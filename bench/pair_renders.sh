@@ -34,6 +34,10 @@ for scene in $scenes; do
     render_seconds "$core_a" "$spec_a" "$scene" "$out/a" &
     render_seconds "$core_b" "$spec_b" "$scene" "$out/b" &
     wait
+    if [[ ! -s $out/a || ! -s $out/b ]]; then
+      echo "pair_renders.sh: a render of $scene failed (no summary line)" >&2
+      exit 1
+    fi
     echo "$(cat "$out/a") $(cat "$out/b")" >>"$out/pairs"
   done
   a=$(awk '{print $1}' "$out/pairs" | median)
