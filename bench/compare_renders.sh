@@ -14,7 +14,6 @@ repeat=${REPEAT:-5}
 read -r -a extra <<<"${ARGS:-}"
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
-median() { sort -g | awk '{a[NR]=$1} END {print (NR % 2) ? a[(NR+1)/2] : (a[NR/2] + a[NR/2+1]) / 2}'; }
 printf '| scene | binary | render s (median of %s) | / first | CPU s | / first |\n| --- | --- | ---: | ---: | ---: | ---: |\n' "$repeat"
 for scene in $scenes; do
   name=$(basename "$scene" .json)
@@ -24,7 +23,7 @@ for scene in $scenes; do
       split_binary "$bin"
       env "${binary_env[@]}" /usr/bin/time -o "$out/cpu" -f "%U %S" "$binary_path" render "$scene" -o "$out/img.exr" \
         "${extra[@]}" >"$out/log" 2>&1
-      sed -n 's/.*spp (min [0-9]*, max [0-9]*), \([0-9.]*\) s.*/\1/p' "$out/log" >>"$out/$name.$i"
+      render_phase_seconds <"$out/log" >>"$out/$name.$i"
       awk '{print $1 + $2}' "$out/cpu" >>"$out/$name.cpu.$i"
       i=$((i + 1))
     done

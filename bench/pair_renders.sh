@@ -22,9 +22,8 @@ trap 'rm -rf "$out"' EXIT
 render_seconds() {  # core spec scene file
   split_binary "$2"
   env "${binary_env[@]}" taskset -c "$1" "$binary_path" render "$3" -o "$out/img$1.exr" --spp "$spp" \
-    --threads 1 -q 2>&1 | sed -n 's/.*spp (min [0-9]*, max [0-9]*), \([0-9.]*\) s.*/\1/p' >"$4"
+    --threads 1 -q 2>&1 | render_phase_seconds >"$4"
 }
-median() { sort -g | awk '{a[NR]=$1} END {print (NR % 2) ? a[(NR+1)/2] : (a[NR/2] + a[NR/2+1]) / 2}'; }
 printf '| scene (%s spp, 1 thread each) | A render s | B render s | B / A (median of %s pairs) | lowest, highest pair |\n' "$spp" "$repeat"
 printf '| --- | ---: | ---: | ---: | ---: |\n'
 for scene in $scenes; do
