@@ -72,7 +72,7 @@ TEST(WavefrontDriver, SameImagesAsTheScalarDriverOnEveryExampleAndAccuracyScene)
   }
 }
 
-// A pixel's samples that do not fit one batch (512 paths) continue in the next batch on a fresh
+// A pixel's samples that do not fit one batch (1024 paths) continue in the next batch on a fresh
 // sampler of the same pixel; adaptive sampling, a window and several threads change which samples
 // share a batch.
 TEST(WavefrontDriver, SameImagesAcrossBatchesAdaptiveSamplingAndWindows) {
