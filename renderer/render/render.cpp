@@ -29,9 +29,9 @@ using Clock = std::chrono::steady_clock;
 // Camera samples the wavefront driver advances together: enough to fill its 16-wide packets
 // for several bounces as paths end and to spread each bounce's fixed costs, few enough that
 // their state stays in cache. Measured side by side (bench/pair_renders.sh): 512 against 256
-// 0.96-0.98 of the time on every scene tried (session 32), 1024 against 512 0.96-1.00 on 17 of
-// 18 scenes (mesh_100k 1.006), 2048 against 1024 1.00-1.05 (docs/performance.md, levers,
-// sessions 32 and 33).
+// 0.96-0.98 of the time on every scene tried (session 32), 1024 against 512 0.93-1.00 on the
+// sixteen other scenes and 1.006-1.013 on mesh_100k, 2048 against 1024 1.00-1.05
+// (docs/performance.md, levers, sessions 32 and 33).
 constexpr size_t kWavefrontBatch = 1024;
 
 // The rendered pixels tile by tile (row-major inside each tile), and where each tile starts in
