@@ -44,35 +44,64 @@ EnvironmentMap::EnvironmentMap(const EnvironmentMapDesc& desc)
   const int rows = has_pixels ? desc.height : 1;
   // One row is a map that does not vary with v: its row stands at both poles.
   height_ = std::max(rows, 2);
-  texels_.resize(size_t(width_) * size_t(height_), Spectrum(0.f));
+  auto texels = std::make_shared<std::vector<Spectrum>>(size_t(width_) * size_t(height_), Spectrum(0.f));
   if (has_pixels)
     for (int y = 0; y < height_; ++y)
       for (int x = 0; x < width_; ++x) {
         const size_t src = (size_t(std::min(y, rows - 1)) * size_t(width_) + size_t(x)) * 3;
         // Scaled here, so luminances and weights stay within the range the loader checked
         // (brightest texel x scale <= 1e30) even for texels near the float maximum.
-        Spectrum& t = texels_[size_t(y) * size_t(width_) + size_t(x)];
+        Spectrum& t = (*texels)[size_t(y) * size_t(width_) + size_t(x)];
         for (int c = 0; c < 3; ++c) t[c] = clean(clean(desc.rgb[src + size_t(c)]) * scale);
       }
+  texels_ = texels->data();
+  texel_store_ = std::move(texels);
   to_world_ = desc.to_world;
   to_local_ = glm::transpose(desc.to_world);  // orthogonal: the inverse is the transpose
   half_texel_ = 0.5f / float(width_);
 
-  // Cell (x, y) lies between rows y and y + 1, at polar angles theta0..theta1, and between the
-  // centres of texels x and x + 1. Sampling density: each corner (texel) carries its luminance x
-  // its row's sin(theta); within a cell the density is their bilinear interpolant, so a cell's
-  // weight is their mean. The sin(theta) factor keeps the poles, which the map stretches across
-  // a whole row, from drawing samples out of proportion to their solid angle (pbrt-v3 §14.2.4;
-  // Mitsuba's envmap weights its grid by sin(theta) too). A pole row's sin(theta) would be 0, and
-  // a map lit only there (or a one-row map, whose two rows are both poles) would then have no
-  // samples at all: the poles count as sin(theta) a quarter row in, which only shapes the density
-  // within their cells. So a cell is zero only if its four texels are, i.e. only where the
-  // radiance is zero. `sum` is the luminance integral itself (for the light's power): each cell's
-  // mean luminance times its band's cos(theta0) - cos(theta1), the integral of sin(theta) dtheta.
-  const int nu = width_, nv = height_ - 1;
+  const int nv = height_ - 1;
   row_sin_.resize(size_t(height_));
   const double pole_sin = std::sin(M_PI / (4.0 * nv));
   for (int y = 0; y < height_; ++y) row_sin_[size_t(y)] = float(std::max(std::sin(M_PI * y / nv), pole_sin));
+  build_distribution();
+}
+
+std::unique_ptr<EnvironmentMap> EnvironmentMap::compensated() const {
+  if (uniform_sampling_ || is_black()) return nullptr;
+  // The floor is the mean luminance over the sphere of directions (the integral is over 4 pi sr).
+  return std::unique_ptr<EnvironmentMap>(new EnvironmentMap(*this, float(integral_ / (4.0 * M_PI))));
+}
+
+EnvironmentMap::EnvironmentMap(const EnvironmentMap& full, float floor)
+    : width_(full.width_),
+      height_(full.height_),
+      texel_store_(full.texel_store_),
+      texels_(full.texels_),
+      floor_(floor),
+      to_world_(full.to_world_),
+      to_local_(full.to_local_),
+      row_sin_(full.row_sin_),
+      half_texel_(full.half_texel_),
+      uniform_sampling_(full.uniform_sampling_) {
+  build_distribution();
+  sampled_nowhere_ = !(distribution_.integral() > 0.0);
+}
+
+// Cell (x, y) lies between rows y and y + 1, at polar angles theta0..theta1, and between the
+// centres of texels x and x + 1. Sampling density: each corner (texel) carries its luminance x
+// its row's sin(theta); within a cell the density is their bilinear interpolant, so a cell's
+// weight is their mean. The sin(theta) factor keeps the poles, which the map stretches across
+// a whole row, from drawing samples out of proportion to their solid angle (pbrt-v3 §14.2.4;
+// Mitsuba's envmap weights its grid by sin(theta) too). A pole row's sin(theta) would be 0, and
+// a map lit only there (or a one-row map, whose two rows are both poles) would then have no
+// samples at all: the poles count as sin(theta) a quarter row in, which only shapes the density
+// within their cells. So a cell is zero only if its four texels are, i.e. only where the
+// radiance is zero (for the compensated twin, whose corners carry max(L - floor, 0): only where
+// no corner is brighter than the mean). `sum` is the luminance integral itself (for the light's power): each cell's
+// mean luminance times its band's cos(theta0) - cos(theta1), the integral of sin(theta) dtheta.
+void EnvironmentMap::build_distribution() {
+  const int nu = width_, nv = height_ - 1;
   std::vector<float> weights(size_t(nu) * size_t(nv));
   double sum = 0.0;
   for (int y = 0; y < nv; ++y) {
@@ -88,15 +117,16 @@ EnvironmentMap::EnvironmentMap(const EnvironmentMapDesc& desc)
     }
   }
   distribution_ = Distribution2D(weights, nu, nv);
-  // Each cell spans 2 pi / width in azimuth.
+  // Each cell spans 2 pi / width in azimuth. (The radiance's integral, whatever the density.)
   integral_ = sum * (2.0 * M_PI / nu);
 }
 
 EnvironmentMap::Corners EnvironmentMap::corners(int x, int y) const {
   const int x1 = x + 1 == width_ ? 0 : x + 1;
   const float s0 = row_sin_[size_t(y)], s1 = row_sin_[size_t(y) + 1];
-  return {luminance(texel(x, y)) * s0, luminance(texel(x1, y)) * s0, luminance(texel(x, y + 1)) * s1,
-          luminance(texel(x1, y + 1)) * s1};
+  // (With floor_ 0 each term is the luminance itself: texels are >= 0.)
+  const auto w = [&](int tx, int ty) { return std::max(luminance(texel(tx, ty)) - floor_, 0.f); };
+  return {w(x, y) * s0, w(x1, y) * s0, w(x, y + 1) * s1, w(x1, y + 1) * s1};
 }
 
 Spectrum EnvironmentMap::lookup(const TexelSpot& t) const {

@@ -11,8 +11,18 @@
 //    within it from the bilinear interpolant of its corners' luminance x sin(theta) (pbrt-v4
 //    SampleBilinear, §A.3.2) -- the shape of the bilinear radiance itself, so a cell half lit by
 //    the sun's edge gets its samples where the light is.
+//  - MIS compensation (Karlik, Sik, Vevoda, Skrivan and Krivanek 2019, "MIS compensation:
+//    optimizing sampling techniques in multiple importance sampling"; pbrt-v4's
+//    ImageInfiniteLight compensatedDistribution): an integrator that weighs light against BSDF
+//    sampling by MIS everywhere (the path integrator) samples the map in proportion to
+//    max(L - mean L, 0) instead, from a twin made by compensated(). Where the map is dimmer than
+//    its mean, BSDF sampling, which the MIS weights then give all of it, covers it well; the
+//    light samples all go where the map is bright, so a sun is no longer a Bernoulli mixture of
+//    sun and sky samples. The distributed integrator keeps the full density: its diffuse lobes
+//    see direct light only through light sampling.
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <vector>
 
 #include "renderer/core/arc_tangent.h"
@@ -27,6 +37,10 @@ class EnvironmentMap final : public EnvironmentLight {
  public:
   // Negative and non-finite texels count as 0; an image of one row is constant in v.
   explicit EnvironmentMap(const EnvironmentMapDesc& desc);
+  // The same map (its texels shared, not copied) sampled in proportion to max(L - mean L, 0) x
+  // sin(theta), for MIS-compensated light sampling (see above); nullptr where that would change
+  // nothing (a map sampled uniformly, or one that emits nothing).
+  std::unique_ptr<EnvironmentMap> compensated() const;
 
   bool sample(const vec3& ref, float time, const vec2& u, LightSample* out) const override;
   // In stages over chunks of samples: every sample's row, then every column, then the cells'
@@ -41,6 +55,9 @@ class EnvironmentMap final : public EnvironmentLight {
   float pdf(const vec3& dir) const override;
   Spectrum radiance_and_pdf(const vec3& dir, float* pdf) const override;
   bool prefers_many() const override { return true; }
+  // A compensated map with nothing above its mean (a constant one) has no density anywhere: it
+  // is left to BSDF sampling, as a constant environment is.
+  bool left_to_bsdf_sampling() const override { return sampled_nowhere_; }
   // In two stages over chunks: every direction's lat-long coordinates, cell and texels in SIMD
   // lanes, then every texel lookup and density. radiance(), pdf() and radiance_and_pdf() are
   // this on one direction.
@@ -77,20 +94,30 @@ class EnvironmentMap final : public EnvironmentLight {
  private:
   // Bilinear lookup at the texels `t` names, as Mitsuba's EnvironmentMapEmitter::eval_spectrum.
   Spectrum lookup(const TexelSpot& t) const;
-  // Cell (x, y)'s corners: luminance x sin(theta) of texels x, x + 1 in rows y, y + 1.
+  // Cell (x, y)'s corners: max(luminance - floor_, 0) x sin(theta) of texels x, x + 1 in rows
+  // y, y + 1.
   struct Corners {
     float w00, w10, w01, w11;
   };
   Corners corners(int x, int y) const;
   const Spectrum& texel(int x, int y) const { return texels_[size_t(y) * size_t(width_) + size_t(x)]; }
+  // The compensated twin of `full`: its texels shared, its density over max(L - floor, 0).
+  EnvironmentMap(const EnvironmentMap& full, float floor);
+  // The sampling distribution over the cells' corners (with floor_ subtracted), and integral_.
+  void build_distribution();
 
   int width_ = 1, height_ = 2;      // height >= 2: rows are samples from pole to pole
-  std::vector<Spectrum> texels_;  // times scale
+  // The texels times scale, shared by the map and its compensated twin; texels_ points into it.
+  std::shared_ptr<const std::vector<Spectrum>> texel_store_;
+  const Spectrum* texels_ = nullptr;
+  // The luminance the sampling density leaves out: 0, or the map's mean for the compensated twin.
+  float floor_ = 0.f;
+  bool sampled_nowhere_ = false;
   glm::mat3 to_world_{1.f}, to_local_{1.f};
   // Cell (x, y) of the distribution spans texels x, x + 1 and rows y, y + 1; in u it starts at
   // texel x's centre, half a texel right of the cell's own coordinate.
   Distribution2D distribution_;
-  std::vector<float> row_sin_;  // sin(theta) of each texel row (poles: see the constructor)
+  std::vector<float> row_sin_;  // sin(theta) of each texel row (poles: see build_distribution)
   float half_texel_ = 0.f;
   double integral_ = 0.0;
   bool uniform_sampling_ = false;

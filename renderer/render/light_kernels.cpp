@@ -122,7 +122,7 @@ StagedLights::StagedLights(const Scene& scene) {
   kind.assign(lights, kOwnCode);
   index.assign(lights, -1);
   for (size_t l = 0; l < lights; ++l) {
-    const Light& light = scene.light(int(l));
+    const Light& light = scene.mis_light(int(l));  // the stages run the path integrator
     if (const auto* point = dynamic_cast<const PointLight*>(&light)) {
       PointSource p;
       p.light = int32_t(l);

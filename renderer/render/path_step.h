@@ -156,6 +156,20 @@ template <bool kDistributed>
   else return scene.mis_light_sampler();
 }
 
+// The light `index` as that integrator samples it, and the environment whose density weighs an
+// escaped path's MIS: the path integrator's environment map is sampled where it is brighter than
+// its mean (Scene::mis_light, MIS compensation), the distributed integrator's everywhere.
+template <bool kDistributed>
+[[gnu::always_inline]] inline const Light& next_event_light(const Scene& scene, int index) {
+  if constexpr (kDistributed) return scene.light(index);
+  else return scene.mis_light(index);
+}
+template <bool kDistributed>
+[[gnu::always_inline]] inline const EnvironmentLight* escape_environment(const Scene& scene) {
+  if constexpr (kDistributed) return scene.environment();
+  else return scene.mis_environment();
+}
+
 // What an escaped path gathers from the environment's answer for its ray: `radiance`, and
 // `pdf` (asked for only when the last bounce was not a delta) for the MIS weight.
 template <bool kDistributed>
@@ -178,7 +192,7 @@ inline void path_escape_record(const Scene& scene, const PathState& s, FirstHit*
 // 0). The path ends.
 template <bool kDistributed, uint32_t kFeatures>
 inline void path_escaped(const Scene& scene, PathState& s, FirstHit* first) {
-  const EnvironmentLight* environment = scene.environment();
+  const EnvironmentLight* environment = escape_environment<kDistributed>(scene);
   path_escape_record(scene, s, first);
   if constexpr ((kFeatures & kFeatureEnvironment) != 0) {
     if (!environment) return;
@@ -254,7 +268,7 @@ inline bool path_scatter(const Scene& scene, const IntegratorSettings& settings,
     sampler.get_1d_2d(&u_light, &u_point);  // one 3D point (Sampler::get_1d_2d)
     LightSample ls;
     const int light = lights.choose(u_light);
-    if (scene.light(light).sample(hit.p, ray.time, u_point, &ls)) {
+    if (next_event_light<kDistributed>(scene, light).sample(hit.p, ray.time, u_point, &ls)) {
       ls.pdf *= lights.pmf(light);
       const vec3 wo = frame.to_local(ls.wi);
       if (geometry_agrees(wi_world, ls.wi, hit.ng, wi, wo)) {

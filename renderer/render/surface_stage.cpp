@@ -908,7 +908,7 @@ void SurfaceStage::sample_own_code_lights() {
       continue;
     }
     LightSample ls;
-    const bool ok = scene_.light(light_[i]).sample(ref, time_[i], u, &ls);
+    const bool ok = scene_.mis_light(light_[i]).sample(ref, time_[i], u, &ls);  // path integrator
     store(i, ok, ls);
   }
   const size_t n = environment_lanes_.size();
@@ -917,8 +917,8 @@ void SurfaceStage::sample_own_code_lights() {
     many_out_.resize(n);
     many_ok_ = std::make_unique<bool[]>(n);
   }
-  scene_.light(environment).sample_many(n, many_refs_.data(), many_times_.data(), many_u_.data(),
-                                        many_out_.data(), many_ok_.get());
+  scene_.mis_light(environment).sample_many(n, many_refs_.data(), many_times_.data(), many_u_.data(),
+                                            many_out_.data(), many_ok_.get());
   for (size_t k = 0; k < n; ++k) store(environment_lanes_[k], many_ok_[k], many_out_[k]);
 }
 

@@ -125,7 +125,7 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
     has_shadow.assign(live.size(), 0);
     std::vector<uint32_t>& hit_of = b.hit_of_;
     hit_of.resize(live.size());
-    const EnvironmentLight* environment = scene.environment();
+    const EnvironmentLight* environment = escape_environment<kDistributed>(scene);
     const bool escapes_together = environment && environment->prefers_many();
     b.escaped_.clear();
     for (size_t m = 0; m < miss_count; ++m) {

@@ -76,6 +76,15 @@ class Scene {
   // The environment (nullptr if rays that escape see black) and its index among the lights.
   const EnvironmentLight* environment() const { return environment_; }
   int environment_light() const { return environment_light_; }
+  // The light `index` and the environment as the path integrator samples them and weighs their
+  // MIS: light(index) and environment(), except an environment map, which it samples where it
+  // is brighter than its mean (EnvironmentMap::compensated, MIS compensation).
+  const Light& mis_light(int index) const {
+    return index == environment_light_ && mis_environment_ ? *mis_environment_ : *lights_[size_t(index)];
+  }
+  const EnvironmentLight* mis_environment() const {
+    return mis_environment_ ? mis_environment_.get() : environment_;
+  }
 
   // The Embree scene, for the Embree-only benchmark (render/embree_baseline.cpp). Rays that
   // leave a surface must be traced with exact_t_check().context(...) to skip re-hits of it.
@@ -111,6 +120,7 @@ class Scene {
   LightSampler light_sampler_, mis_light_sampler_;
   const EnvironmentLight* environment_ = nullptr;
   int environment_light_ = -1;
+  std::unique_ptr<EnvironmentLight> mis_environment_;  // nullptr: environment_ itself
   ExactTCheck exact_t_;
   RTCSceneTy* rtc_scene_ = nullptr;  // owned; released before the shapes it points into
 };

@@ -144,7 +144,10 @@ class SceneBuilder {
     if (in_.environment_map) {
       // A map that emits nothing is left out, as a black constant environment is.
       auto map = std::make_unique<EnvironmentMap>(*in_.environment_map);
-      if (!map->is_black()) add_environment(std::move(map));
+      if (!map->is_black()) {
+        s_.mis_environment_ = map->compensated();
+        add_environment(std::move(map));
+      }
     } else if (!is_black(in_.environment)) {
       add_environment(std::make_unique<ConstantEnvironment>(in_.environment));
     }
@@ -152,9 +155,9 @@ class SceneBuilder {
     const float radius = std::max(0.5f * glm::length(s_.bounds_.hi - s_.bounds_.lo), 1e-6f);
     std::vector<float> powers;
     std::vector<bool> mis_sampled;
-    for (const auto& light : s_.lights_) {
-      powers.push_back(light->power(radius));
-      mis_sampled.push_back(!light->left_to_bsdf_sampling());
+    for (int l = 0; l < s_.light_count(); ++l) {
+      powers.push_back(s_.light(l).power(radius));
+      mis_sampled.push_back(!s_.mis_light(l).left_to_bsdf_sampling());
     }
     s_.light_sampler_ = LightSampler(powers);
     s_.mis_light_sampler_ = LightSampler(powers, mis_sampled);

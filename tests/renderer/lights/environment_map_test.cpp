@@ -1,6 +1,7 @@
 // The environment map: Mitsuba 3's lat-long orientation and bilinear lookup, importance sampling
 // (chi-square against pdf(), pdf integrating to 1 over the sphere, sample/pdf agreement, a density
-// proportional to radiance), its power, and degenerate maps (black, one texel, one hot texel).
+// proportional to radiance), its power, degenerate maps (black, one texel, one hot texel), and the
+// MIS-compensated twin the path integrator samples (a density over max(L - mean L, 0)).
 #include <gtest/gtest.h>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -116,10 +117,9 @@ TEST(EnvironmentMap, PdfIntegratesToOneOverTheSphere) {
   EXPECT_NEAR(pdf_integral(EnvironmentMap(desc)), 1.0, 1e-4);
 }
 
-TEST(EnvironmentMap, SamplingFollowsPdfChiSquare) {
-  auto desc = sky_with_sun(12, 7);
-  desc.to_world = rotation(-50.f, glm::normalize(vec3(0.3f, 1, -1)));
-  const EnvironmentMap map(desc);
+// Whether sample()'s directions follow pdf(), by a chi-square test over bins in world
+// (cos theta, phi).
+void expect_sampling_follows_pdf(const EnvironmentMap& map) {
   // Bins in world (cos theta, phi); expected counts by cubature of pdf().
   constexpr int nt = 16, np = 32, samples = 300000;
   std::vector<double> observed(nt * np, 0.0), expected(nt * np, 0.0);
@@ -144,6 +144,12 @@ TEST(EnvironmentMap, SamplingFollowsPdfChiSquare) {
                                        2 * M_PI * pi / np, 2 * M_PI * (pi + 1) / np, 1e-8);
   const auto fit = chi2_goodness_of_fit(observed, expected);
   EXPECT_TRUE(fit.pass) << fit.message;
+}
+
+TEST(EnvironmentMap, SamplingFollowsPdfChiSquare) {
+  auto desc = sky_with_sun(12, 7);
+  desc.to_world = rotation(-50.f, glm::normalize(vec3(0.3f, 1, -1)));
+  expect_sampling_follows_pdf(EnvironmentMap(desc));
 }
 
 TEST(EnvironmentMap, SampleAgreesWithPdfAndRadiance) {
@@ -220,8 +226,12 @@ TEST(EnvironmentMap, SampleManyIsSampleToTheBit) {
   uniform.uniform_sampling = true;
   EnvironmentMapDesc black = make_map(8, 4, [](int, int) { return 0.f; });
   Rng rng(17);
-  for (const EnvironmentMapDesc* desc : {&sky, &patchy, &uniform, &black}) {
-    const EnvironmentMap map(*desc);
+  for (const EnvironmentMapDesc* desc : {&sky, &patchy, &uniform, &black})
+    for (const bool compensated : {false, true}) {
+    const EnvironmentMap full(*desc);
+    const auto twin = full.compensated();
+    if (compensated && !twin) continue;  // (uniform and black maps have none)
+    const EnvironmentMap& map = compensated ? *twin : full;
     for (const size_t n : {size_t(1), size_t(63), size_t(64), size_t(65), size_t(300)}) {
       std::vector<vec3> refs(n, vec3(0.5f, -1.f, 2.f));
       std::vector<float> times(n, 0.25f);
@@ -383,6 +393,87 @@ TEST(EnvironmentMap, OneHotTexelIsSampledWithFiniteWeights) {
     EXPECT_GT(accepted, 4900) << hx << "," << hy;
     EXPECT_NEAR(pdf_integral(map), 1.0, 1e-2) << hx << "," << hy;
   }
+}
+
+// The compensated twin (Karlik et al. 2019): the same radiance, a density that integrates to one
+// and that sample() follows, zero wherever the map is dimmer than its mean all round a cell and
+// positive where it is brighter.
+TEST(EnvironmentMap, CompensatedTwinSamplesOnlyWhereTheMapIsAboveItsMean) {
+  auto desc = sky_with_sun(16, 9);
+  desc.to_world = rotation(30.f, glm::normalize(vec3(1, 2, 0.5f)));
+  const EnvironmentMap full(desc);
+  const auto twin = full.compensated();
+  ASSERT_NE(twin, nullptr);
+  EXPECT_FALSE(twin->left_to_bsdf_sampling());
+  EXPECT_EQ(twin->luminance_integral(), full.luminance_integral());
+  EXPECT_EQ(twin->power(2.f), full.power(2.f));
+  EXPECT_NEAR(pdf_integral(*twin), 1.0, 2e-3);
+  // (The chi-square test on a sky without the sun: the sun's twin density lives in slivers of
+  // the test's bins too thin for the bins' cubature. Without it about half the sky is above the
+  // mean, with cells where one to four corners are.)
+  auto gradient = make_map(12, 7, [](int x, int y) { return 0.2f + float(y) / 7.f + 0.1f * float(x % 3); });
+  gradient.to_world = desc.to_world;
+  const auto gradient_twin = EnvironmentMap(gradient).compensated();
+  EXPECT_NEAR(pdf_integral(*gradient_twin), 1.0, 2e-3);
+  expect_sampling_follows_pdf(*gradient_twin);
+
+  // The sun (texels 0 and 15 of row 3, 500 against a sky of 0.2-1.3) makes the mean about 4.6, so
+  // only cells touching a sun texel keep a density.
+  const float mean = float(full.luminance_integral() / (4.0 * M_PI));
+  ASSERT_GT(mean, 1.5f);
+  ASSERT_LT(mean, 20.f);
+  const glm::mat3 to_local = glm::transpose(desc.to_world);
+  int zero = 0, positive = 0;
+  Rng rng(5);
+  for (int i = 0; i < 4000; ++i) {
+    const vec3 d = square_to_uniform_sphere(rng.next2());
+    const vec2 uv = EnvironmentMap::direction_to_uv(to_local * d);
+    // The cell's four texels: columns either side of u's texel centres, rows either side of v.
+    const float s = uv.x * 16.f - 0.5f, t = uv.y * 8.f;
+    const int x0 = int(std::floor(s)), y0 = std::min(int(t), 7);
+    bool bright = false;
+    for (const int x : {x0, x0 + 1})
+      for (const int y : {y0, y0 + 1}) bright |= value(desc, (x % 16 + 16) % 16, y) > mean;
+    // The radiance the integrator sees is the full map's, to the bit.
+    const Spectrum a = twin->radiance(d), b = full.radiance(d);
+    for (int c = 0; c < 3; ++c) ASSERT_EQ(a[c], b[c]);
+    const float pdf = twin->pdf(d);
+    if (bright) {
+      EXPECT_GT(pdf, 0.f) << d.x << " " << d.y << " " << d.z;
+      ++positive;
+    } else {
+      EXPECT_EQ(pdf, 0.f) << d.x << " " << d.y << " " << d.z;
+      EXPECT_GT(full.pdf(d), 0.f);
+      ++zero;
+    }
+  }
+  EXPECT_GT(zero, 3000);
+  EXPECT_GT(positive, 5);
+  for (int i = 0; i < 2000; ++i) {
+    LightSample ls;
+    if (!twin->sample(vec3(0.f), 0.f, rng.next2(), &ls)) continue;  // (a warp's rare rounding)
+    ASSERT_GT(ls.pdf, 0.f);
+    ASSERT_NEAR(ls.pdf, twin->pdf(ls.wi), 2e-3f * ls.pdf);
+  }
+}
+
+// Where nothing is brighter than the mean (a constant map) the twin has no density at all and is
+// left to BSDF sampling, as a constant environment is; a map sampled uniformly, or a black one,
+// has no twin.
+TEST(EnvironmentMap, CompensatedTwinOfAConstantMapIsLeftToBsdfSampling) {
+  const EnvironmentMap constant(make_map(8, 5, [](int, int) { return 2.f; }));
+  const auto twin = constant.compensated();
+  ASSERT_NE(twin, nullptr);
+  EXPECT_FALSE(constant.left_to_bsdf_sampling());
+  EXPECT_TRUE(twin->left_to_bsdf_sampling());
+  EXPECT_EQ(twin->pdf(vec3(0, 1, 0)), 0.f);
+  LightSample ls;
+  EXPECT_FALSE(twin->sample(vec3(0.f), 0.f, vec2(0.3f, 0.7f), &ls));
+
+  auto uniform = sky_with_sun(8, 5);
+  uniform.uniform_sampling = true;
+  EXPECT_EQ(EnvironmentMap(uniform).compensated(), nullptr);
+  EXPECT_EQ(EnvironmentMap(make_map(8, 5, [](int, int) { return 0.f; })).compensated(), nullptr);
 }
 
 }  // namespace

@@ -1,9 +1,13 @@
 // Environment maps through the whole renderer: a constant map renders as the constant environment
 // (furnace), a map bright on the upper hemisphere only gives the closed-form sky irradiance on a
-// diffuse plane, importance and uniform sampling agree, and a one-texel sun yields no NaN/Inf.
+// diffuse plane, a sky with a sun gives the irradiance of the map's own radiance by cubature (where
+// the path integrator's MIS-compensated sampling leaves the sky to BSDF sampling), importance and
+// uniform sampling agree, and a one-texel sun yields no NaN/Inf.
 #include <gtest/gtest.h>
 
 #include <glm/gtc/matrix_transform.hpp>
+
+#include "renderer/lights/environment_map.h"
 
 #include "tests/renderer/render/render_test_util.h"
 
@@ -126,6 +130,48 @@ TEST(RenderEnvironmentMap, TiltedSkyGivesViewFactorIrradiance) {
 }
 
 // The benchmark's uniform sampling must estimate the same image as importance sampling.
+// A sky of 0.5 over the upper hemisphere with a sun of 12 texels at 12 (about 45 degrees up): the
+// map's mean luminance (about 0.56) is above the whole sky, so the path integrator samples the map
+// only at the sun and leaves the sky to the plane's cosine samples, whose MIS weight there must be
+// 1 (EnvironmentMap::compensated). A diffuse plane facing up then shows albedo / pi times the
+// irradiance, which a midpoint rule over the hemisphere computes from the map's own radiance().
+// Both integrators; the distributed one samples the whole map. Escaped rays weighed against the
+// full map's density instead of the twin's make the image 3.7% too dark here.
+TEST(RenderEnvironmentMap, SkyWithASunGivesTheIrradianceOfTheMapsRadiance) {
+  constexpr int width = 32, height = 17;
+  constexpr float albedo = 0.7f;
+  SceneInput in = plane_scene(albedo);
+  in.environment_map = make_map(width, height, [](int x, int y, int) {
+    if (y > height / 2) return 0.f;
+    return (x >= 6 && x <= 8 && y >= 3 && y <= 6) ? 12.f : 0.5f;
+  });
+  const EnvironmentMap map(*in.environment_map);
+  const float mean = float(map.luminance_integral() / (4.0 * M_PI));
+  ASSERT_GT(mean, 0.52f);  // above the sky: the compensated density is the sun's alone
+  ASSERT_LT(mean, 0.7f);   // but not far: the full density gives the sky much of its samples
+  double irradiance = 0.0;
+  constexpr int nt = 1200, np = 2400;
+  for (int i = 0; i < nt; ++i) {
+    const double theta = 0.5 * M_PI * (i + 0.5) / nt;
+    const double weight = std::cos(theta) * std::sin(theta) * (0.5 * M_PI / nt) * (2.0 * M_PI / np);
+    for (int j = 0; j < np; ++j) {
+      const double phi = 2.0 * M_PI * (j + 0.5) / np;
+      const vec3 d(float(std::sin(theta) * std::cos(phi)), float(std::cos(theta)), float(std::sin(theta) * std::sin(phi)));
+      irradiance += weight * double(map.radiance(d)[1]);
+    }
+  }
+  for (const IntegratorKind kind : {IntegratorKind::kPath, IntegratorKind::kDistributed}) {
+    SCOPED_TRACE(kind == IntegratorKind::kPath ? "path" : "distributed");
+    RenderSettings s = small_settings(kSize, kSize, 256, 2);
+    s.integrator = kind;
+    const auto r = render_input(in, s);
+    EXPECT_EQ(r.stats.nonfinite_samples, 0u);
+    double m, se;
+    region_mean(r, 0, 0, kSize, kSize, 1, &m, &se);
+    EXPECT_NEAR(m, albedo / M_PI * irradiance, 0.002 * m + 4.0 * se);
+  }
+}
+
 TEST(RenderEnvironmentMap, UniformAndImportanceSamplingAgree) {
   SceneInput in = plane_scene(0.5f);
   in.camera = camera_looking({0, 2, 4}, {0, 0.3f, 0}, 45.f);

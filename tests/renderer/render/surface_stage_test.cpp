@@ -262,7 +262,7 @@ Coverage expect_stage_matches_scene(const SceneInput& in, bool lights, uint32_t 
     if (next_event) {
       LightSample ls;
       const int chosen = scene->mis_light_sampler().choose(lanes[k].x[0]);
-      const Light& light = scene->light(chosen);
+      const Light& light = scene->mis_light(chosen);
       cover.delta_lights += light.sample(hit.p, 0.f, vec2(0.5f), &ls) && ls.is_delta;
       cover.own_code_lights += staged_lights.kind[size_t(chosen)] == StagedLights::kOwnCode;
       cover.textured_lights += staged_lights.kind[size_t(chosen)] == StagedLights::kQuad &&
