@@ -86,6 +86,7 @@ int run_bench(int argc, char** argv) {
                    [](const api::RenderOverride& o) { return o.flag == "--integrator"; }))
     settings.integrator = IntegratorKind::kPath;
   const auto scene = Scene::build(loaded.request->scene);
+  scene->prepare_sampling(settings.integrator);
 
   std::vector<double> renderer_mrays, embree_mrays, ratios;
   for (long long i = 0; i < repeat; ++i) {

@@ -179,6 +179,7 @@ int render_one(const std::string& scene_path, const std::string& output, ImageFo
 
   const auto build_start = std::chrono::steady_clock::now();
   const auto scene = Scene::build(request.scene);
+  scene->prepare_sampling(settings.integrator);
   const double build_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - build_start).count();
 

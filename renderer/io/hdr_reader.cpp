@@ -1,5 +1,6 @@
 #include "renderer/io/hdr_reader.h"
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -48,8 +49,18 @@ bool read_line(SourceReader& in, std::string* line, size_t* header_bytes) {
   }
 }
 
+// 2^(e - 136) for each shared exponent e (0: the pixel is black), the scale of RGBE's 8-bit
+// mantissas: a component is mantissa x 2^(e - 136). A table: ldexp per component was 15% of
+// loading an 8192 x 4096 map; every entry is a power of two, exact in float (2^-135 as a
+// subnormal), so the values are ldexp's to the bit.
+const std::array<float, 256> kExponentScale = [] {
+  std::array<float, 256> t{};
+  for (int e = 1; e < 256; ++e) t[size_t(e)] = std::ldexp(1.f, e - 136);
+  return t;
+}();
+
 float rgbe_component(uint8_t mantissa, uint8_t exponent) {
-  return exponent == 0 ? 0.f : float(mantissa) * std::ldexp(1.f, int(exponent) - 136);
+  return float(mantissa) * kExponentScale[exponent];
 }
 
 }  // namespace

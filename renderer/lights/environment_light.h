@@ -24,6 +24,9 @@ class EnvironmentLight : public Light {
   // queue the directions first asks for many only then (a constant environment answers in a few
   // instructions, less than the queueing costs).
   virtual bool prefers_many() const { return false; }
+  // Builds now whatever the first sample or density would build (a map's sampling table), so
+  // that it is counted where the caller wants it (Scene::prepare_sampling). Thread-safe.
+  virtual void prepare_sampling() const {}
   // radiance_and_pdf for n directions at once: radiance[k] always, pdf[k] where want_pdf[k] (else
   // left alone); the same values to the bit. A map splits it in stages over all n, so the
   // texel loads of different directions overlap.

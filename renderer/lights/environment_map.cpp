@@ -64,7 +64,30 @@ EnvironmentMap::EnvironmentMap(const EnvironmentMapDesc& desc)
   row_sin_.resize(size_t(height_));
   const double pole_sin = std::sin(M_PI / (4.0 * nv));
   for (int y = 0; y < height_; ++y) row_sin_[size_t(y)] = float(std::max(std::sin(M_PI * y / nv), pole_sin));
-  build_distribution();
+  // The luminance integral (for the light's power): each cell's mean luminance times its band's
+  // cos(theta0) - cos(theta1), the integral of sin(theta) dtheta; each cell spans 2 pi / width in
+  // azimuth. The sampling distribution waits for the first sample (distribution()).
+  // Each texel's luminance once, in a pair of row buffers (a cell reads four).
+  const int nu = width_;
+  std::vector<float> row(static_cast<size_t>(nu)), next(static_cast<size_t>(nu));
+  const auto luminances = [&](int y, std::vector<float>& out) {
+    for (int x = 0; x < nu; ++x) {
+      out[size_t(x)] = luminance(texel(x, y));
+      max_luminance_ = std::max(max_luminance_, out[size_t(x)]);
+    }
+  };
+  luminances(0, row);
+  double sum = 0.0;
+  for (int y = 0; y < nv; ++y) {
+    luminances(y + 1, next);
+    const double band = std::cos(M_PI * y / nv) - std::cos(M_PI * (y + 1) / nv);
+    for (int x = 0; x < nu; ++x) {
+      const size_t x0 = size_t(x), x1 = size_t((x + 1) % nu);
+      sum += 0.25 * (double(row[x0]) + row[x1] + next[x0] + next[x1]) * band;
+    }
+    row.swap(next);
+  }
+  integral_ = sum * (2.0 * M_PI / nu);
 }
 
 std::unique_ptr<EnvironmentMap> EnvironmentMap::compensated() const {
@@ -83,9 +106,17 @@ EnvironmentMap::EnvironmentMap(const EnvironmentMap& full, float floor)
       to_local_(full.to_local_),
       row_sin_(full.row_sin_),
       half_texel_(full.half_texel_),
+      integral_(full.integral_),
+      max_luminance_(full.max_luminance_),
       uniform_sampling_(full.uniform_sampling_) {
-  build_distribution();
-  sampled_nowhere_ = !(distribution_.integral() > 0.0);
+  // A corner weighs max(L - floor, 0) x sin(theta), and sin(theta) > 0 at every row: the density
+  // is zero everywhere exactly when no texel is brighter than the floor.
+  sampled_nowhere_ = !(max_luminance_ > floor_);
+}
+
+const Distribution2D& EnvironmentMap::distribution() const {
+  std::call_once(distribution_built_, [this] { build_distribution(); });
+  return distribution_;
 }
 
 // Cell (x, y) lies between rows y and y + 1, at polar angles theta0..theta1, and between the
@@ -98,35 +129,41 @@ EnvironmentMap::EnvironmentMap(const EnvironmentMap& full, float floor)
 // samples at all: the poles count as sin(theta) a quarter row in, which only shapes the density
 // within their cells. So a cell is zero only if its four texels are, i.e. only where the
 // radiance is zero (for the compensated twin, whose corners carry max(L - floor, 0): only where
-// no corner is brighter than the mean). `sum` is the luminance integral itself (for the light's power): each cell's
-// mean luminance times its band's cos(theta0) - cos(theta1), the integral of sin(theta) dtheta.
-void EnvironmentMap::build_distribution() {
+// no corner is brighter than the mean).
+// Built once, by the first sample or density asked of this map: a render samples either the
+// full map (the distributed integrator) or its compensated twin (the path integrator), so the
+// other's table, as large as the image, is never made (an 8192 x 4096 map: 1.2 s and 280 MB).
+void EnvironmentMap::build_distribution() const {
   const int nu = width_, nv = height_ - 1;
   std::vector<float> weights(size_t(nu) * size_t(nv));
-  double sum = 0.0;
+  // Each texel's corner weight once, in a pair of row buffers: corner(x, y) is the value
+  // corners() computes for it, to the bit (the warp within a cell reads corners()).
+  std::vector<float> row(static_cast<size_t>(nu)), next(static_cast<size_t>(nu));
+  const auto corner_row = [&](int y, std::vector<float>& out) {
+    for (int x = 0; x < nu; ++x) out[size_t(x)] = corner(x, y);
+  };
+  corner_row(0, row);
   for (int y = 0; y < nv; ++y) {
-    const double band = std::cos(M_PI * y / nv) - std::cos(M_PI * (y + 1) / nv);
+    corner_row(y + 1, next);
     for (int x = 0; x < nu; ++x) {
-      const int x1 = (x + 1) % nu;
-      const double mean = 0.25 * (double(luminance(texel(x, y))) + luminance(texel(x1, y)) +
-                                  luminance(texel(x, y + 1)) + luminance(texel(x1, y + 1)));
-      const Corners c = corners(x, y);
-      weights[size_t(y) * size_t(nu) + size_t(x)] =
-          float(0.25 * (double(c.w00) + double(c.w10) + double(c.w01) + double(c.w11)));
-      sum += mean * band;
+      const size_t x0 = size_t(x), x1 = size_t((x + 1) % nu);
+      weights[size_t(y) * size_t(nu) + x0] =
+          float(0.25 * (double(row[x0]) + double(row[x1]) + double(next[x0]) + double(next[x1])));
     }
+    row.swap(next);
   }
   distribution_ = Distribution2D(weights, nu, nv);
-  // Each cell spans 2 pi / width in azimuth. (The radiance's integral, whatever the density.)
-  integral_ = sum * (2.0 * M_PI / nu);
+  table_built_.store(true, std::memory_order_release);
 }
 
 EnvironmentMap::Corners EnvironmentMap::corners(int x, int y) const {
   const int x1 = x + 1 == width_ ? 0 : x + 1;
-  const float s0 = row_sin_[size_t(y)], s1 = row_sin_[size_t(y) + 1];
-  // (With floor_ 0 each term is the luminance itself: texels are >= 0.)
-  const auto w = [&](int tx, int ty) { return std::max(luminance(texel(tx, ty)) - floor_, 0.f); };
-  return {w(x, y) * s0, w(x1, y) * s0, w(x, y + 1) * s1, w(x1, y + 1) * s1};
+  return {corner(x, y), corner(x1, y), corner(x, y + 1), corner(x1, y + 1)};
+}
+
+float EnvironmentMap::corner(int x, int y) const {
+  // (With floor_ 0 this is the luminance itself times sin(theta): texels are >= 0.)
+  return std::max(luminance(texel(x, y)) - floor_, 0.f) * row_sin_[size_t(y)];
 }
 
 Spectrum EnvironmentMap::lookup(const TexelSpot& t) const {
@@ -282,6 +319,7 @@ void EnvironmentMap::sample_many(size_t n, const vec3* refs, const float* times,
   // of dependent loads; each stage's loads are independent across samples, so the processor
   // overlaps them. Chunks keep the stages' state on the stack.
   const MapShape shape{to_world_, to_local_, width_, height_, half_texel_};
+  const Distribution2D& table = distribution();
   for (size_t k0 = 0; k0 < n; k0 += kChunk) {
     const size_t m = std::min(kChunk, n - k0);
     int row[kChunk], column[kChunk];
@@ -290,16 +328,16 @@ void EnvironmentMap::sample_many(size_t n, const vec3* refs, const float* times,
     WarpedLanes warped;
     float ux[kChunk], uy[kChunk];
     for (size_t k = 0; k < m; ++k) ux[k] = u[k0 + k].x, uy[k] = u[k0 + k].y;
-    distribution_.sample_rows(m, uy, row, v);
-    for (size_t k = 0; k < m; ++k) distribution_.prefetch_column(row[k], ux[k]);
-    distribution_.sample_columns(m, row, ux, column, x);
+    table.sample_rows(m, uy, row, v);
+    for (size_t k = 0; k < m; ++k) table.prefetch_column(row[k], ux[k]);
+    table.sample_columns(m, row, ux, column, x);
     for (size_t k = 0; k < m; ++k) {
-      distribution_.prefetch_cell(column[k], row[k]);
+      table.prefetch_cell(column[k], row[k]);
       __builtin_prefetch(&texel(column[k], row[k]));
       __builtin_prefetch(&texel(column[k], row[k] + 1));
     }
     for (size_t k = 0; k < m; ++k) {
-      cells.pdf_cell[k] = distribution_.cell_pdf(column[k], row[k]);
+      cells.pdf_cell[k] = table.cell_pdf(column[k], row[k]);
       // A uniform point of the cell (its row and column were drawn independently), which the
       // bilinear warp then reshapes.
       const CellPoint q = cell_point(x[k], v[k], width_, height_);
@@ -342,19 +380,24 @@ void EnvironmentMap::radiance_and_pdf_many(size_t n, const vec3* dirs, const uin
   // of the direction's cell (pbrt-v3 §14.2.4's Jacobian 1 / (2 pi^2 sin theta) per steradian; 0
   // within kMinSinTheta of a pole, as sample() draws nothing there).
   const int density = is_black() ? 0 : uniform_sampling_ ? 1 : 2;
+  // The table only where a density is asked for: a radiance lookup alone (an escape after a
+  // delta bounce, the first-hit record) leaves it unbuilt.
+  const Distribution2D* table =
+      density == 2 && std::any_of(want_pdf, want_pdf + n, [](uint8_t w) { return w != 0; }) ? &distribution()
+                                                                                          : nullptr;
   for (size_t k0 = 0; k0 < n; k0 += kChunk) {
     const size_t m = std::min(kChunk, n - k0);
     LocatedLanes lanes;
     locate_kernel(m, dirs + k0, shape, &lanes);
     for (size_t k = 0; k < m; ++k) {
-      if (density == 2 && want_pdf[k0 + k]) distribution_.prefetch_cell(lanes.cx[k], lanes.cy[k]);
+      if (table && want_pdf[k0 + k]) table->prefetch_cell(lanes.cx[k], lanes.cy[k]);
       __builtin_prefetch(&texel(lanes.x0[k], lanes.y0[k]));
       __builtin_prefetch(&texel(lanes.x0[k], lanes.y0[k] + 1));
     }
     for (size_t k = 0; k < m; ++k) {
       if (want_pdf[k0 + k]) {
         float p = density == 1 ? uniform_sphere_pdf() : 0.f;
-        const float pdf_cell = density == 2 ? distribution_.cell_pdf(lanes.cx[k], lanes.cy[k]) : 0.f;
+        const float pdf_cell = table ? table->cell_pdf(lanes.cx[k], lanes.cy[k]) : 0.f;
         if (pdf_cell > 0.f && lanes.sin_theta[k] > kMinSinTheta) {
           const Corners c = corners(lanes.cx[k], lanes.cy[k]);
           p = pdf_cell * bilinear_pdf(lanes.fx[k], lanes.fy[k], c.w00, c.w10, c.w01, c.w11) *

@@ -21,8 +21,10 @@
 //    sun and sky samples. The distributed integrator keeps the full density: its diffuse lobes
 //    see direct light only through light sampling.
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <memory>
+#include <mutex>
 #include <vector>
 
 #include "renderer/core/arc_tangent.h"
@@ -55,6 +57,12 @@ class EnvironmentMap final : public EnvironmentLight {
   float pdf(const vec3& dir) const override;
   Spectrum radiance_and_pdf(const vec3& dir, float* pdf) const override;
   bool prefers_many() const override { return true; }
+  void prepare_sampling() const override {
+    if (!is_black() && !uniform_sampling_) distribution();
+  }
+  // Whether the sampling table has been built (by a sample, a density or prepare_sampling; a
+  // radiance lookup alone builds nothing): for tests and memory accounting.
+  bool sampling_table_built() const { return table_built_.load(std::memory_order_acquire); }
   // A compensated map with nothing above its mean (a constant one) has no density anywhere: it
   // is left to BSDF sampling, as a constant environment is.
   bool left_to_bsdf_sampling() const override { return sampled_nowhere_; }
@@ -100,11 +108,15 @@ class EnvironmentMap final : public EnvironmentLight {
     float w00, w10, w01, w11;
   };
   Corners corners(int x, int y) const;
+  // One corner weight: texel (x, y)'s max(luminance - floor_, 0) x its row's sin(theta).
+  float corner(int x, int y) const;
   const Spectrum& texel(int x, int y) const { return texels_[size_t(y) * size_t(width_) + size_t(x)]; }
   // The compensated twin of `full`: its texels shared, its density over max(L - floor, 0).
   EnvironmentMap(const EnvironmentMap& full, float floor);
-  // The sampling distribution over the cells' corners (with floor_ subtracted), and integral_.
-  void build_distribution();
+  // The sampling distribution over the cells' corners (with floor_ subtracted), built on first
+  // use (see build_distribution).
+  const Distribution2D& distribution() const;
+  void build_distribution() const;
 
   int width_ = 1, height_ = 2;      // height >= 2: rows are samples from pole to pole
   // The texels times scale, shared by the map and its compensated twin; texels_ points into it.
@@ -116,10 +128,13 @@ class EnvironmentMap final : public EnvironmentLight {
   glm::mat3 to_world_{1.f}, to_local_{1.f};
   // Cell (x, y) of the distribution spans texels x, x + 1 and rows y, y + 1; in u it starts at
   // texel x's centre, half a texel right of the cell's own coordinate.
-  Distribution2D distribution_;
+  mutable std::once_flag distribution_built_;
+  mutable std::atomic<bool> table_built_{false};
+  mutable Distribution2D distribution_;
   std::vector<float> row_sin_;  // sin(theta) of each texel row (poles: see build_distribution)
   float half_texel_ = 0.f;
   double integral_ = 0.0;
+  float max_luminance_ = 0.f;  // of the brightest texel
   bool uniform_sampling_ = false;
 };
 

@@ -139,6 +139,7 @@ void update_limits(const Film& film, const AdaptiveLimits& limits, std::vector<u
 
 RenderResult render(const Scene& scene, const RenderSettings& settings,
                     const RenderControl& control) {
+  scene.prepare_sampling(settings.integrator);  // (done already if the caller timed it as build)
   const auto start = Clock::now();
   // The camera sees the whole image; the films hold only the window's pixels, film pixel
   // (fx, fy) being image pixel (window.x0 + fx, window.y0 + fy). The sampler and the camera are

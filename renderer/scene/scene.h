@@ -85,6 +85,14 @@ class Scene {
   const EnvironmentLight* mis_environment() const {
     return mis_environment_ ? mis_environment_.get() : environment_;
   }
+  // Builds the tables a render with `integrator` samples and that are otherwise built by its
+  // first sample: the sampling table of the environment map, or of its compensated twin (each
+  // as large as the image; a render needs one of them). render() calls it; a caller that times
+  // the scene's build calls it right after Scene::build, so the table counts as build time.
+  void prepare_sampling(IntegratorKind integrator) const {
+    const EnvironmentLight* env = integrator == IntegratorKind::kDistributed ? environment_ : mis_environment();
+    if (env) env->prepare_sampling();
+  }
 
   // The Embree scene, for the Embree-only benchmark (render/embree_baseline.cpp). Rays that
   // leave a surface must be traced with exact_t_check().context(...) to skip re-hits of it.

@@ -65,6 +65,7 @@ RenderOutcome render_request(const api::SceneRequest& request, const RenderJobOp
   std::unique_ptr<Scene> scene;
   try {
     scene = Scene::build(request.scene);
+    scene->prepare_sampling(settings.integrator);
   } catch (const SceneBuildError& e) {
     out.error = std::string("scene build failed: ") + e.what();
     return out;

@@ -62,7 +62,7 @@ TEST(Info, SceneWithAnEnvironmentMap) {
   EXPECT_TRUE(contains(r.output, "  lights      none; environment map 512 x 256\n")) << r.output;
   EXPECT_TRUE(contains(r.output, "  files       1\n    /environment/map  sky.hdr: 512 x 256, 3 channels, float\n"))
       << r.output;
-  EXPECT_TRUE(contains(r.output, "scene input 1.5 MiB, renderer copies 3.8 MiB")) << r.output;
+  EXPECT_TRUE(contains(r.output, "scene input 1.5 MiB, renderer copies 2.6 MiB")) << r.output;
 }
 
 // Image textures: each file once (the first field naming it), with its header's size, channels

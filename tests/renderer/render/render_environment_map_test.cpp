@@ -172,6 +172,37 @@ TEST(RenderEnvironmentMap, SkyWithASunGivesTheIrradianceOfTheMapsRadiance) {
   }
 }
 
+// A render builds the sampling table of the map it samples and no other: the path integrator the
+// compensated twin's, the distributed integrator the full map's (each table is as large as the
+// image; docs/environment-maps.md). Scene::prepare_sampling builds it before the render, as the
+// CLI and the service do to count it as build time.
+TEST(RenderEnvironmentMap, ARenderBuildsOnlyTheTableItSamples) {
+  SceneInput in = plane_scene(0.5f);
+  in.environment_map = make_map(32, 17, [](int x, int y, int) { return (x == 5 && y == 4) ? 50.f : 0.4f; });
+  for (const IntegratorKind kind : {IntegratorKind::kPath, IntegratorKind::kDistributed}) {
+    SCOPED_TRACE(kind == IntegratorKind::kPath ? "path" : "distributed");
+    const auto scene = Scene::build(in);
+    const auto* full = dynamic_cast<const EnvironmentMap*>(scene->environment());
+    const auto* twin = dynamic_cast<const EnvironmentMap*>(scene->mis_environment());
+    ASSERT_NE(full, nullptr);
+    ASSERT_NE(twin, nullptr);
+    ASSERT_NE(full, twin);
+    EXPECT_FALSE(full->sampling_table_built());
+    EXPECT_FALSE(twin->sampling_table_built());
+    (void)full->radiance(vec3(0, 1, 0));  // a lookup alone builds nothing
+    EXPECT_FALSE(full->sampling_table_built());
+    scene->prepare_sampling(kind);
+    const bool path = kind == IntegratorKind::kPath;
+    EXPECT_EQ(twin->sampling_table_built(), path);
+    EXPECT_EQ(full->sampling_table_built(), !path);
+    RenderSettings s = small_settings(8, 8, 4, 3);
+    s.integrator = kind;
+    EXPECT_EQ(render(*scene, s).stats.nonfinite_samples, 0u);
+    EXPECT_EQ(twin->sampling_table_built(), path);
+    EXPECT_EQ(full->sampling_table_built(), !path);
+  }
+}
+
 TEST(RenderEnvironmentMap, UniformAndImportanceSamplingAgree) {
   SceneInput in = plane_scene(0.5f);
   in.camera = camera_looking({0, 2, 4}, {0, 0.3f, 0}, 45.f);
