@@ -2,8 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstring>
 #include <iterator>
+
+#include <xmmintrin.h>
 
 #include "renderer/core/simd_clones.h"
 #include "renderer/materials/conductor.h"
@@ -586,33 +589,133 @@ void SurfaceStage::add_textured(size_t i, const PathState& s, const SurfaceHit& 
 
 void SurfaceStage::add(uint32_t slot, const PathState& s, const SurfaceHit& hit, const float* x,
                        const float* y, const float* z, size_t stride, bool next_event) {
-  const size_t i = count_++;
-  slot_[i] = slot;
-  if (textured_of_[hit.object])
-    add_textured(i, s, hit);
-  else
-    write_params(i, params_[size_t(params_of_[hit.object])]);
-  for (int c = 0; c < 3; ++c) {
-    p_[c][i] = hit.p[c];
-    p_error_[c][i] = hit.p_error[c];
-    ng_[c][i] = hit.ng[c];
-    ns_[c][i] = hit.ns[c];
-    dir_[c][i] = s.ray.direction[c];
-    beta_[c][i] = s.beta[c];
+  const uint32_t zero = 0;
+  add_many(1, &slot, &zero, &zero, &zero, &s, &hit, x, y, z, stride, next_event);
+}
+
+void SurfaceStage::add_many(size_t n, const uint32_t* slots, const uint32_t* paths,
+                            const uint32_t* hit_of, const uint32_t* columns,
+                            const PathState* states, const SurfaceHit* hits, const float* x,
+                            const float* y, const float* z, size_t stride, bool next_event) {
+  // Field group by field group, each a loop with its arrays' pointers in registers: one call per
+  // path, which stored some 40 fields through as many reloaded pointers, cost a tenth of a
+  // Cornell box render (docs/performance.md, levers, session 35).
+  const size_t base = count_;
+  count_ += n;
+  uint32_t* __restrict slot = slot_.data() + base;
+  for (size_t i = 0; i < n; ++i) slot[i] = slots[i];
+  for (size_t i = 0; i < n; ++i) {
+    const SurfaceHit& hit = hits[hit_of[i]];
+    if (textured_of_[hit.object])
+      add_textured(base + i, states[paths[i]], hit);
+    else
+      write_params(base + i, params_[size_t(params_of_[hit.object])]);
   }
-  time_[i] = s.ray.time;
-  eta_[i] = s.eta;
-  depth_[i] = s.depth;
+  // The hits' points, error bounds and normals and the paths' directions, throughputs, times,
+  // etas and depths into the lanes' arrays.
+  float* __restrict const hit_rows[12] = {
+      p_[0].data() + base,  p_[1].data() + base,       p_[2].data() + base,
+      p_error_[0].data() + base, p_error_[1].data() + base, p_error_[2].data() + base,
+      ng_[0].data() + base, ng_[1].data() + base,      ng_[2].data() + base,
+      ns_[0].data() + base, ns_[1].data() + base,      ns_[2].data() + base};
+  float* __restrict dx = dir_[0].data() + base;
+  float* __restrict dy = dir_[1].data() + base;
+  float* __restrict dz = dir_[2].data() + base;
+  float* __restrict bx = beta_[0].data() + base;
+  float* __restrict by = beta_[1].data() + base;
+  float* __restrict bz = beta_[2].data() + base;
+  float* __restrict time = time_.data() + base;
+  float* __restrict eta = eta_.data() + base;
+  int32_t* __restrict depth = depth_.data() + base;
+  size_t i = 0;
+#if defined(__SSE2__)
+  // Four lanes at a time as 4x4 transposes (SSE2, every x86-64 CPU): a hit's twelve floats
+  // from p to ns are three loads, a path's nine a few more, instead of a scalar load and store
+  // per field (each lane's 21 fields so cost a tenth of a Cornell box render).
+  static_assert(offsetof(SurfaceHit, p) == 4 && offsetof(SurfaceHit, p_error) == 16 &&
+                    offsetof(SurfaceHit, ng) == 28 && offsetof(SurfaceHit, ns) == 40,
+                "SurfaceHit's layout, as the transposes read it");
+  static_assert(offsetof(PathState, ray) == 0 && offsetof(Ray, direction) == 12 &&
+                    offsetof(Ray, time) == 24 && offsetof(PathState, beta) == 44 &&
+                    offsetof(PathState, eta) == 76 && offsetof(PathState, depth) == 80 &&
+                    sizeof(PathState) == 84,
+                "PathState's layout, as the transposes read it");
+  for (; i + 4 <= n; i += 4) {
+    __m128 h[3][4], d[4], b[4], e[4];
+    for (int j = 0; j < 4; ++j) {
+      const float* f = &hits[hit_of[i + size_t(j)]].p.x;
+      h[0][j] = _mm_loadu_ps(f);      // p.x p.y p.z e.x
+      h[1][j] = _mm_loadu_ps(f + 4);  // e.y e.z ng.x ng.y
+      h[2][j] = _mm_loadu_ps(f + 8);  // ng.z ns.x ns.y ns.z
+      const float* g = reinterpret_cast<const float*>(&states[paths[i + size_t(j)]]);
+      d[j] = _mm_loadu_ps(g + 3);   // direction, time
+      b[j] = _mm_loadu_ps(g + 10);  // radiance.z, beta
+      e[j] = _mm_loadu_ps(g + 17);  // prev_p.y, prev_p.z, eta, depth (the struct's last four)
+    }
+    for (int r = 0; r < 3; ++r) {
+      _MM_TRANSPOSE4_PS(h[r][0], h[r][1], h[r][2], h[r][3]);
+      for (int c = 0; c < 4; ++c) _mm_storeu_ps(hit_rows[4 * r + c] + i, h[r][c]);
+    }
+    _MM_TRANSPOSE4_PS(d[0], d[1], d[2], d[3]);
+    _MM_TRANSPOSE4_PS(b[0], b[1], b[2], b[3]);
+    _MM_TRANSPOSE4_PS(e[0], e[1], e[2], e[3]);
+    _mm_storeu_ps(dx + i, d[0]);
+    _mm_storeu_ps(dy + i, d[1]);
+    _mm_storeu_ps(dz + i, d[2]);
+    _mm_storeu_ps(time + i, d[3]);
+    _mm_storeu_ps(bx + i, b[1]);
+    _mm_storeu_ps(by + i, b[2]);
+    _mm_storeu_ps(bz + i, b[3]);
+    _mm_storeu_ps(eta + i, e[2]);
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(depth + i), _mm_castps_si128(e[3]));
+  }
+#endif
+  for (; i < n; ++i) {
+    const SurfaceHit& hit = hits[hit_of[i]];
+    for (int c = 0; c < 3; ++c) {
+      hit_rows[c][i] = hit.p[c];
+      hit_rows[3 + c][i] = hit.p_error[c];
+      hit_rows[6 + c][i] = hit.ng[c];
+      hit_rows[9 + c][i] = hit.ns[c];
+    }
+    const PathState& s = states[paths[i]];
+    dx[i] = s.ray.direction.x;
+    dy[i] = s.ray.direction.y;
+    dz[i] = s.ray.direction.z;
+    bx[i] = s.beta.x;
+    by[i] = s.beta.y;
+    bz[i] = s.beta.z;
+    time[i] = s.ray.time;
+    eta[i] = s.eta;
+    depth[i] = s.depth;
+  }
   // The step's values in the order path_scatter takes them: light choice and point (with next-
   // event estimation; one get_1d_2d pair), lobe and direction (the next pair), roulette.
-  const int d = estimates_light(next_event) ? 2 : 0;
-  u_light_[i] = z[0];
-  u_point_[0][i] = x[stride];
-  u_point_[1][i] = y[stride];
-  u_lobe_[i] = z[size_t(d / 2) * stride];
-  u_dir_[0][i] = x[size_t(d + 1) * stride];
-  u_dir_[1][i] = y[size_t(d + 1) * stride];
-  u_rr_[i] = x[size_t(d + 2) * stride];
+  const size_t d = estimates_light(next_event) ? 2 : 0;
+  const float* __restrict light_z = z;
+  const float* __restrict point_x = x + stride;
+  const float* __restrict point_y = y + stride;
+  const float* __restrict lobe_z = z + d / 2 * stride;
+  const float* __restrict dir_x = x + (d + 1) * stride;
+  const float* __restrict dir_y = y + (d + 1) * stride;
+  const float* __restrict rr_x = x + (d + 2) * stride;
+  float* __restrict u_light = u_light_.data() + base;
+  float* __restrict u_point_x = u_point_[0].data() + base;
+  float* __restrict u_point_y = u_point_[1].data() + base;
+  float* __restrict u_lobe = u_lobe_.data() + base;
+  float* __restrict u_dir_x = u_dir_[0].data() + base;
+  float* __restrict u_dir_y = u_dir_[1].data() + base;
+  float* __restrict u_rr = u_rr_.data() + base;
+  for (size_t i = 0; i < n; ++i) {
+    const size_t j = columns[i];
+    u_light[i] = light_z[j];
+    u_point_x[i] = point_x[j];
+    u_point_y[i] = point_y[j];
+    u_lobe[i] = lobe_z[j];
+    u_dir_x[i] = dir_x[j];
+    u_dir_y[i] = dir_y[j];
+    u_rr[i] = rr_x[j];
+  }
 }
 
 void SurfaceStage::look_up_textures() {

@@ -66,6 +66,12 @@ class SurfaceStage {
   // lobe: the scene has lights), which decides which values are whose.
   void add(uint32_t slot, const PathState& s, const SurfaceHit& hit, const float* x,
            const float* y, const float* z, size_t stride, bool next_event);
+  // add for n paths at once, lane by lane in order: path states[paths[i]] at hits[hit_of[i]]
+  // with slot slots[i] and its sampler values in column columns[i] of x, y, z (x[columns[i] +
+  // j * stride], ...).
+  void add_many(size_t n, const uint32_t* slots, const uint32_t* paths, const uint32_t* hit_of,
+                const uint32_t* columns, const PathState* states, const SurfaceHit* hits,
+                const float* x, const float* y, const float* z, size_t stride, bool next_event);
   // Whether the stage's model picks among lobes with the step's 1D lobe value.
   bool needs_lobe_choice() const {
     return model_ != StageModel::kLambert && model_ != StageModel::kRoughConductor &&

@@ -49,6 +49,12 @@ void make_stages(const Scene& scene, PathBatch& b) {
       b.stages_.push_back(std::move(stage));
     }
   }
+  b.queues_.resize(b.stages_.size());
+  for (PathBatch::StageQueue& q : b.queues_) {
+    q.slots.reserve(b.capacity_);
+    q.paths.reserve(b.capacity_);
+    q.columns.reserve(b.capacity_);
+  }
   // Surfaces no stage takes step through path_scatter, which may pick a lobe.
   for (uint32_t o = 0; o < scene.object_count(); ++o) b.lobe_choices_ = b.lobe_choices_ || b.stage_of_[o] < 0;
   b.staged_scene_ = &scene;
@@ -57,6 +63,11 @@ void make_stages(const Scene& scene, PathBatch& b) {
 template <bool kDistributed, uint32_t kFeatures>
 void integrate_batch(const Scene& scene, const IntegratorSettings& settings, PathBatch& b,
                      PathCounters& counters) {
+  using StageQueue = PathBatch::StageQueue;
+#ifndef PENUMBRA_STAGE_CHUNK
+#define PENUMBRA_STAGE_CHUNK 128
+#endif
+  constexpr size_t kStageChunk = PENUMBRA_STAGE_CHUNK;
   constexpr int kPacket = Scene::kPacketSize;
   std::vector<uint32_t>& live = b.live_;
   live.resize(b.size());
@@ -118,7 +129,7 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
     // each path's results go to its own slot k, and the survivors and shadow queries are then
     // gathered in path order, as the scalar loop would leave them.
     if (kStages)
-      for (auto& stage : b.stages_) stage->start(live.size());
+      for (StageQueue& q : b.queues_) q.clear();
     std::vector<uint8_t>& goes_on = b.goes_on_;
     std::vector<uint8_t>& has_shadow = b.has_shadow_;
     goes_on.assign(live.size(), 0);
@@ -149,9 +160,13 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
       SurfaceHit& hit = b.hits_[k];
       const int stage = kStages ? b.stage_of_[hit.object] : -1;
       if (stage >= 0) {
-        if (path_arrive<kDistributed, kFeatures>(scene, settings, s, hit, first))
-          b.stages_[size_t(stage)]->add(uint32_t(k), s, hit, samples.x(j), samples.y(j),
-                                        samples.z(j), samples.stride(), next_event);
+        // Queued for the stage, which takes its paths' states and hits together below.
+        if (path_arrive<kDistributed, kFeatures>(scene, settings, s, hit, first)) {
+          StageQueue& q = b.queues_[size_t(stage)];
+          q.slots.push_back(uint32_t(k));
+          q.paths.push_back(p);
+          q.columns.push_back(uint32_t(j));
+        }
         continue;
       }
       PrefetchedSampler sampler(*b.samplers_[p], b.cursors_[p], samples, j);
@@ -177,25 +192,35 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
         path_gather_environment<kDistributed>(scene, b.states_[b.escaped_[e]], b.escaped_radiance_[e],
                                               b.escaped_pdf_[e]);
     }
-    for (auto& stage : b.stages_) {
-      if (!kStages) break;
-      stage->compute(settings, next_event);
-      std::vector<uint32_t>& unstaged = b.unstaged_;
-      unstaged.clear();
-      counters.rays += stage->deliver(live.data(), b.states_.data(), b.cursors_.data(),
-                                      goes_on.data(), has_shadow.data(), b.shadows_.data(),
-                                      &unstaged);
-      // Lanes whose parameters leave the model: the step one path at a time.
-      for (const uint32_t lane : unstaged) {
-        const size_t k = stage->slot(lane);
-        const uint32_t p = live[k];
-        PrefetchedSampler sampler(*b.samplers_[p], b.cursors_[p], samples, hit_of[k]);
-        bool shadow;
-        goes_on[k] = path_scatter<kDistributed, kFeatures>(scene, settings, b.states_[p],
-                                                           b.hits_[k], sampler, counters,
-                                                           &b.shadows_[k], &shadow);
-        has_shadow[k] = shadow;
-        b.cursors_[p] = sampler.cursor();
+    // Each stage takes its paths in chunks whose lane arrays stay in the first-level cache from
+    // add_many through compute to deliver.
+    for (size_t g = 0; kStages && g < b.stages_.size(); ++g) {
+      SurfaceStage& stage = *b.stages_[g];
+      const StageQueue& q = b.queues_[g];
+      for (size_t c = 0; c < q.slots.size(); c += kStageChunk) {
+        const size_t m = std::min(kStageChunk, q.slots.size() - c);
+        stage.start(m);
+        stage.add_many(m, q.slots.data() + c, q.paths.data() + c, q.slots.data() + c,
+                       q.columns.data() + c, b.states_.data(), b.hits_.data(), samples.x(0),
+                       samples.y(0), samples.z(0), samples.stride(), next_event);
+        stage.compute(settings, next_event);
+        std::vector<uint32_t>& unstaged = b.unstaged_;
+        unstaged.clear();
+        counters.rays += stage.deliver(live.data(), b.states_.data(), b.cursors_.data(),
+                                       goes_on.data(), has_shadow.data(), b.shadows_.data(),
+                                       &unstaged);
+        // Lanes whose parameters leave the model: the step one path at a time.
+        for (const uint32_t lane : unstaged) {
+          const size_t k = stage.slot(lane);
+          const uint32_t p = live[k];
+          PrefetchedSampler sampler(*b.samplers_[p], b.cursors_[p], samples, hit_of[k]);
+          bool shadow;
+          goes_on[k] = path_scatter<kDistributed, kFeatures>(scene, settings, b.states_[p],
+                                                             b.hits_[k], sampler, counters,
+                                                             &b.shadows_[k], &shadow);
+          has_shadow[k] = shadow;
+          b.cursors_[p] = sampler.cursor();
+        }
       }
     }
     // The shadow queries stay in their slots (copying 44-byte queries into a compact array
