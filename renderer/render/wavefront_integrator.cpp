@@ -60,14 +60,15 @@ void make_stages(const Scene& scene, PathBatch& b) {
   b.staged_scene_ = &scene;
 }
 
+// The paths a surface stage takes at once: its some 60 lane arrays of 128 floats fit the
+// first-level cache with the hits and states they are read from (chunks of 64 and 256 measured
+// the same, the whole bounce's paths at once 2-6% slower: docs/performance.md, session 35).
+constexpr size_t kStageChunk = 128;
+
 template <bool kDistributed, uint32_t kFeatures>
 void integrate_batch(const Scene& scene, const IntegratorSettings& settings, PathBatch& b,
                      PathCounters& counters) {
   using StageQueue = PathBatch::StageQueue;
-#ifndef PENUMBRA_STAGE_CHUNK
-#define PENUMBRA_STAGE_CHUNK 128
-#endif
-  constexpr size_t kStageChunk = PENUMBRA_STAGE_CHUNK;
   constexpr int kPacket = Scene::kPacketSize;
   std::vector<uint32_t>& live = b.live_;
   live.resize(b.size());
