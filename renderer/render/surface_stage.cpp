@@ -6,6 +6,7 @@
 #include <cstring>
 #include <iterator>
 
+#include <emmintrin.h>
 #include <xmmintrin.h>
 
 #include "renderer/core/simd_clones.h"
@@ -597,9 +598,8 @@ void SurfaceStage::add_many(size_t n, const uint32_t* slots, const uint32_t* pat
                             const uint32_t* hit_of, const uint32_t* columns,
                             const PathState* states, const SurfaceHit* hits, const float* x,
                             const float* y, const float* z, size_t stride, bool next_event) {
-  // Field group by field group, each a loop with its arrays' pointers in registers: one call per
-  // path, which stored some 40 fields through as many reloaded pointers, cost a tenth of a
-  // Cornell box render (docs/performance.md, levers, session 35).
+  // Field group by field group, a loop each over the chunk the driver hands in (a call per path
+  // cost a tenth of a Cornell box render: docs/performance.md, levers, session 35).
   const size_t base = count_;
   count_ += n;
   uint32_t* __restrict slot = slot_.data() + base;
@@ -630,8 +630,8 @@ void SurfaceStage::add_many(size_t n, const uint32_t* slots, const uint32_t* pat
   size_t i = 0;
 #if defined(__SSE2__)
   // Four lanes at a time as 4x4 transposes (SSE2, every x86-64 CPU): a hit's twelve floats
-  // from p to ns are three loads, a path's nine a few more, instead of a scalar load and store
-  // per field (each lane's 21 fields so cost a tenth of a Cornell box render).
+  // from p to ns are three 16-byte loads, a path's nine fields three more, and each array gets
+  // one 16-byte store per four lanes, instead of a scalar load and store per field and lane.
   static_assert(offsetof(SurfaceHit, p) == 4 && offsetof(SurfaceHit, p_error) == 16 &&
                     offsetof(SurfaceHit, ng) == 28 && offsetof(SurfaceHit, ns) == 40,
                 "SurfaceHit's layout, as the transposes read it");
