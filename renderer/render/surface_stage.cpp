@@ -192,7 +192,7 @@ template <class Model, bool kNextEvent, bool kMapped>
     duff_frame(nx, ny, nz, fs, ft);
     float sx = fs[0], sy = fs[1], sz = fs[2];
     float tx = ft[0], ty = ft[1], tz = ft[2];
-    // A normal-mapped surface's frame follows dp/du (tangent_frame, computed in add).
+    // A normal-mapped surface's frame follows dp/du (tangent_frame, computed in add_many).
     const Mask mapped = kMapped ? L.mapped[i] : 0;
     if constexpr (kMapped) {
       sx = when(mapped, L.frame_s[0][i], sx);
@@ -474,9 +474,9 @@ SurfaceStage::SurfaceStage(const Scene& scene, StageModel model)
         table_cosines_.insert(table_cosines_.end(), t.cosines.begin(), t.cosines.end());
         table_values_.insert(table_values_.end(), t.transmittance.begin(), t.transmittance.end());
       }
-    // A textured material's parameters are looked up at each hit (add); its own BSDF, built
+    // A textured material's parameters are looked up at each hit (add_many); its own BSDF, built
     // from the textures' factors, has the model its hits have (a textured roughness that
-    // reaches zero makes a hit's lobe smooth: add leaves that hit to path_scatter).
+    // reaches zero makes a hit's lobe smooth: add_many leaves that hit to path_scatter).
     SurfaceParams q;
     if (!fill_params(m.bsdf(), &q)) continue;
     params_of_[o] = int32_t(params_.size());
@@ -588,16 +588,10 @@ void SurfaceStage::add_textured(size_t i, const PathState& s, const SurfaceHit& 
   defer(normal_lookups_of_[hit.object]);
 }
 
-void SurfaceStage::add(uint32_t slot, const PathState& s, const SurfaceHit& hit, const float* x,
-                       const float* y, const float* z, size_t stride, bool next_event) {
-  const uint32_t zero = 0;
-  add_many(1, &slot, &zero, &zero, &zero, &s, &hit, x, y, z, stride, next_event);
-}
-
-void SurfaceStage::add_many(size_t n, const uint32_t* slots, const uint32_t* paths,
-                            const uint32_t* hit_of, const uint32_t* columns,
-                            const PathState* states, const SurfaceHit* hits, const float* x,
-                            const float* y, const float* z, size_t stride, bool next_event) {
+void SurfaceStage::add_many(size_t n, const uint32_t* slots, const uint32_t* live,
+                            const uint32_t* hit_of, const PathState* states,
+                            const SurfaceHit* hits, const float* x, const float* y,
+                            const float* z, size_t stride, bool next_event) {
   // Field group by field group, a loop each over the chunk the driver hands in (a call per path
   // cost a tenth of a Cornell box render: docs/performance.md, levers, session 35).
   const size_t base = count_;
@@ -605,9 +599,9 @@ void SurfaceStage::add_many(size_t n, const uint32_t* slots, const uint32_t* pat
   uint32_t* __restrict slot = slot_.data() + base;
   for (size_t i = 0; i < n; ++i) slot[i] = slots[i];
   for (size_t i = 0; i < n; ++i) {
-    const SurfaceHit& hit = hits[hit_of[i]];
+    const SurfaceHit& hit = hits[slots[i]];
     if (textured_of_[hit.object])
-      add_textured(base + i, states[paths[i]], hit);
+      add_textured(base + i, states[live[slots[i]]], hit);
     else
       write_params(base + i, params_[size_t(params_of_[hit.object])]);
   }
@@ -643,11 +637,12 @@ void SurfaceStage::add_many(size_t n, const uint32_t* slots, const uint32_t* pat
   for (; i + 4 <= n; i += 4) {
     __m128 h[3][4], d[4], b[4], e[4];
     for (int j = 0; j < 4; ++j) {
-      const float* f = &hits[hit_of[i + size_t(j)]].p.x;
+      const uint32_t k = slots[i + size_t(j)];
+      const float* f = &hits[k].p.x;
       h[0][j] = _mm_loadu_ps(f);      // p.x p.y p.z e.x
       h[1][j] = _mm_loadu_ps(f + 4);  // e.y e.z ng.x ng.y
       h[2][j] = _mm_loadu_ps(f + 8);  // ng.z ns.x ns.y ns.z
-      const float* g = reinterpret_cast<const float*>(&states[paths[i + size_t(j)]]);
+      const float* g = reinterpret_cast<const float*>(&states[live[k]]);
       d[j] = _mm_loadu_ps(g + 3);   // direction, time
       b[j] = _mm_loadu_ps(g + 10);  // radiance.z, beta
       e[j] = _mm_loadu_ps(g + 17);  // prev_p.y, prev_p.z, eta, depth (the struct's last four)
@@ -671,14 +666,14 @@ void SurfaceStage::add_many(size_t n, const uint32_t* slots, const uint32_t* pat
   }
 #endif
   for (; i < n; ++i) {
-    const SurfaceHit& hit = hits[hit_of[i]];
+    const SurfaceHit& hit = hits[slots[i]];
     for (int c = 0; c < 3; ++c) {
       hit_rows[c][i] = hit.p[c];
       hit_rows[3 + c][i] = hit.p_error[c];
       hit_rows[6 + c][i] = hit.ng[c];
       hit_rows[9 + c][i] = hit.ns[c];
     }
-    const PathState& s = states[paths[i]];
+    const PathState& s = states[live[slots[i]]];
     dx[i] = s.ray.direction.x;
     dy[i] = s.ray.direction.y;
     dz[i] = s.ray.direction.z;
@@ -707,7 +702,7 @@ void SurfaceStage::add_many(size_t n, const uint32_t* slots, const uint32_t* pat
   float* __restrict u_dir_y = u_dir_[1].data() + base;
   float* __restrict u_rr = u_rr_.data() + base;
   for (size_t i = 0; i < n; ++i) {
-    const size_t j = columns[i];
+    const size_t j = hit_of[slots[i]];
     u_light[i] = light_z[j];
     u_point_x[i] = point_x[j];
     u_point_y[i] = point_y[j];
@@ -739,7 +734,7 @@ void SurfaceStage::look_up_textures() {
     }
     if (l.kind == TextureLookups::kParameters) {
       // bsdf_at without the normal (which its own list looks up): the BSDF of the hit's texels,
-      // taken apart as add takes apart a BSDF (fill_params), a hit whose BSDF leaves the model
+      // taken apart as add_many takes apart a BSDF (fill_params), a hit whose BSDF leaves the model
       // (a smooth texel) left to path_scatter.
       const Material& m = *l.material;
       const ImageSpectrumTexture* colour = m.color_texture();
@@ -802,7 +797,7 @@ void SurfaceStage::compute(const IntegratorSettings& settings, bool scene_next_e
   if (n == 0) return;
   look_up_textures();
   // Lanes are staged unless their parameters leave the model; normal-mapped lanes are marked
-  // (listed by add, which so writes nothing per plain lane).
+  // (listed by add_many, which so writes nothing per plain lane).
   for (size_t i = 0; i < n; ++i) staged_[i] = 1;
   for (const uint32_t i : unfit_) staged_[i] = 0;
   const bool any_mapped = !mapped_lanes_.empty();

@@ -50,34 +50,31 @@ class SurfaceStage {
   StageModel model() const { return model_; }
 
   // Whether the stage can take hits on `object`: its material is one of the stage's model
-  // (textured parameters and a normal map are looked up per hit in add; a hit whose looked-up
+  // (textured parameters and a normal map are looked up per hit in add_many; a hit whose looked-up
   // parameters leave the model, such as a roughness texture at zero, is not `staged`).
   bool takes(uint32_t object) const { return params_of_[object] >= 0; }
 
   // Empty, with room for `paths` lanes.
   void start(size_t paths);
-  // Queues a path after path_arrive: its state, hit, and the step's prefetched sampler values
-  // x[j * stride], y[j * stride] for j = 0..4 and its get_1d_2d pairs' 1D values z[0] and
-  // z[stride] (BounceSamples' dimension-major layout,
-  // with kBouncePairs or kBounceWithoutLightPairs; the stage reads the light pair's only with
-  // more than one light, the lobe pair's only for models with a lobe choice, which the caller
-  // computes: needs_lobe_choice); `slot` is the caller's index for it. `next_event`: whether
-  // the step estimates direct light (path_scatter's condition for a surface with a diffuse
-  // lobe: the scene has lights), which decides which values are whose.
-  void add(uint32_t slot, const PathState& s, const SurfaceHit& hit, const float* x,
-           const float* y, const float* z, size_t stride, bool next_event);
-  // add for n paths at once, lane by lane in order: path states[paths[i]] at hits[hit_of[i]]
-  // with slot slots[i] and its sampler values in column columns[i] of x, y, z (x[columns[i] +
-  // j * stride], ...).
-  void add_many(size_t n, const uint32_t* slots, const uint32_t* paths, const uint32_t* hit_of,
-                const uint32_t* columns, const PathState* states, const SurfaceHit* hits,
-                const float* x, const float* y, const float* z, size_t stride, bool next_event);
+  // Queues n paths after path_arrive, lane by lane in order: lane i takes the driver's slot
+  // k = slots[i], whose path is live[k] (its state states[live[k]]), whose hit is hits[k] and
+  // whose prefetched sampler values are column j = hit_of[k] of the bounce's samples:
+  // x[j + d * stride], y[j + d * stride] for dimensions d = 0..4 and its get_1d_2d pairs' 1D
+  // values z[j] and z[j + stride] (BounceSamples' dimension-major layout, with kBouncePairs or
+  // kBounceWithoutLightPairs; the stage reads the light pair's only with more than one light,
+  // the lobe pair's only for models with a lobe choice, which the caller computes:
+  // needs_lobe_choice). `next_event`: whether the step estimates direct light (path_scatter's
+  // condition for a surface with a diffuse lobe: the scene has lights), which decides which
+  // values are whose.
+  void add_many(size_t n, const uint32_t* slots, const uint32_t* live, const uint32_t* hit_of,
+                const PathState* states, const SurfaceHit* hits, const float* x,
+                const float* y, const float* z, size_t stride, bool next_event);
   // Whether the stage's model picks among lobes with the step's 1D lobe value.
   bool needs_lobe_choice() const {
     return model_ != StageModel::kLambert && model_ != StageModel::kRoughConductor &&
            model_ != StageModel::kSmoothConductor;
   }
-  // Takes every queued path's step (`next_event` as for add).
+  // Takes every queued path's step (`next_event` as for add_many).
   void compute(const IntegratorSettings& settings, bool next_event);
   // (With next_event, the step estimates direct light unless the model's lobes are all Dirac
   // deltas, as path_scatter decides; that also decides which sampler values are whose.)

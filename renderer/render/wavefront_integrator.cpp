@@ -50,11 +50,7 @@ void make_stages(const Scene& scene, PathBatch& b) {
     }
   }
   b.queues_.resize(b.stages_.size());
-  for (PathBatch::StageQueue& q : b.queues_) {
-    q.slots.reserve(b.capacity_);
-    q.paths.reserve(b.capacity_);
-    q.columns.reserve(b.capacity_);
-  }
+  for (PathBatch::StageQueue& q : b.queues_) q.reserve(b.capacity_);
   // Surfaces no stage takes step through path_scatter, which may pick a lobe.
   for (uint32_t o = 0; o < scene.object_count(); ++o) b.lobe_choices_ = b.lobe_choices_ || b.stage_of_[o] < 0;
   b.staged_scene_ = &scene;
@@ -163,10 +159,7 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
       if (stage >= 0) {
         // Queued for the stage, which takes its paths' states and hits together below.
         if (path_arrive<kDistributed, kFeatures>(scene, settings, s, hit, first)) {
-          StageQueue& q = b.queues_[size_t(stage)];
-          q.slots.push_back(uint32_t(k));
-          q.paths.push_back(p);
-          q.columns.push_back(uint32_t(j));
+          b.queues_[size_t(stage)].push_back(uint32_t(k));
         }
         continue;
       }
@@ -198,12 +191,12 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
     for (size_t g = 0; kStages && g < b.stages_.size(); ++g) {
       SurfaceStage& stage = *b.stages_[g];
       const StageQueue& q = b.queues_[g];
-      for (size_t c = 0; c < q.slots.size(); c += kStageChunk) {
-        const size_t m = std::min(kStageChunk, q.slots.size() - c);
+      for (size_t c = 0; c < q.size(); c += kStageChunk) {
+        const size_t m = std::min(kStageChunk, q.size() - c);
         stage.start(m);
-        stage.add_many(m, q.slots.data() + c, q.paths.data() + c, q.slots.data() + c,
-                       q.columns.data() + c, b.states_.data(), b.hits_.data(), samples.x(0),
-                       samples.y(0), samples.z(0), samples.stride(), next_event);
+        stage.add_many(m, q.data() + c, live.data(), hit_of.data(), b.states_.data(),
+                       b.hits_.data(), samples.x(0), samples.y(0), samples.z(0),
+                       samples.stride(), next_event);
         stage.compute(settings, next_event);
         std::vector<uint32_t>& unstaged = b.unstaged_;
         unstaged.clear();

@@ -60,16 +60,9 @@ class PathBatch {
   const Scene* staged_scene_ = nullptr;
   std::vector<std::unique_ptr<SurfaceStage>> stages_;
   std::vector<int8_t> stage_of_;  // per object: its stage in stages_, or -1
-  // Per stage, the bounce's paths it takes, in path order: their slots, paths and columns of
-  // the bounce's samples (SurfaceStage::add_many).
-  struct StageQueue {
-    std::vector<uint32_t> slots, paths, columns;
-    void clear() {
-      slots.clear();
-      paths.clear();
-      columns.clear();
-    }
-  };
+  // Per stage, the slots of the bounce's paths it takes, in path order (SurfaceStage::add_many
+  // finds each one's path, hit and sampler column from its slot).
+  using StageQueue = std::vector<uint32_t>;
   std::vector<StageQueue> queues_;
   bool lobe_choices_ = true;      // whether a surface of the scene may pick among lobes
   std::vector<uint8_t> goes_on_, has_shadow_;  // per live path of the bounce

@@ -11,9 +11,11 @@
 // sampled by their own code).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <initializer_list>
+#include <numeric>
 #include <random>
 #include <string>
 #include <vector>
@@ -211,26 +213,40 @@ Coverage expect_stage_matches_scene(const SceneInput& in, bool lights, uint32_t 
   SurfaceStage stage(*scene, model);
   EXPECT_TRUE(stage.takes(0));
   EXPECT_TRUE(stage.takes(1));
-  stage.start(lanes.size());
-  // Added last slot first: lane i is slot n - 1 - i, so a result put in the lane's place
-  // instead of its slot's shows.
-  for (size_t k = lanes.size(); k-- > 0;)
-    stage.add(uint32_t(k), lanes[k].state, lanes[k].hit, lanes[k].x, lanes[k].y, lanes[k].z, 1, next_event);
-  stage.compute(settings, next_event);
-  EXPECT_EQ(stage.size(), lanes.size());
-
-  // The stage's results in the driver's arrays, one slot and one path per lane here (the flags
-  // start at 2, so a lane the stage did not deliver shows).
-  const size_t n = stage.size();
-  std::vector<uint32_t> live(n);
+  // The lanes in the driver's arrays: slot k's hit in hits[k], its path live[k] (paths in
+  // another order than slots), its sampler values in column hit_of[k] of dimension-major
+  // arrays (columns in a third order). Queued last slot first, in chunks as the driver hands
+  // them over, so that a result put in the lane's place instead of its slot's shows, and so does
+  // a chunk written over another. The flags start at 2, so a lane the stage did not deliver shows.
+  const size_t n = lanes.size();
+  std::vector<uint32_t> live(n), hit_of(n), slots(n);
   std::vector<PathState> states(n);
+  std::vector<SurfaceHit> hits(n);
+  std::vector<float> xs(BounceSamples::kBounce * n), ys(BounceSamples::kBounce * n), zs(2 * n);
+  for (size_t k = 0; k < n; ++k) {
+    live[k] = uint32_t(n - 1 - k);
+    hit_of[k] = uint32_t((k * 7 + 3) % n);
+    slots[k] = uint32_t(n - 1 - k);
+    states[live[k]] = lanes[k].state;
+    hits[k] = lanes[k].hit;
+    for (int d = 0; d < BounceSamples::kBounce; ++d) {
+      xs[size_t(d) * n + hit_of[k]] = lanes[k].x[d];
+      ys[size_t(d) * n + hit_of[k]] = lanes[k].y[d];
+    }
+    zs[hit_of[k]] = lanes[k].z[0];
+    zs[n + hit_of[k]] = lanes[k].z[1];
+  }
+  EXPECT_EQ(std::gcd(size_t(7), n), 1u);  // hit_of a permutation
+  stage.start(n);
+  for (size_t c = 0; c < n; c += 128)
+    stage.add_many(std::min<size_t>(128, n - c), slots.data() + c, live.data(), hit_of.data(),
+                   states.data(), hits.data(), xs.data(), ys.data(), zs.data(), n, next_event);
+  stage.compute(settings, next_event);
+  EXPECT_EQ(stage.size(), n);
+
   std::vector<Sampler::Cursor> cursors(n, Sampler::Cursor{0, 100});
   std::vector<uint8_t> goes_on_of(n, 2), has_shadow_of(n, 2);
   std::vector<ShadowQuery> shadows(n);
-  for (size_t k = 0; k < n; ++k) {
-    live[k] = uint32_t(n - 1 - k);  // paths in another order than slots
-    states[live[k]] = lanes[k].state;
-  }
   std::vector<uint32_t> unstaged;
   const uint64_t delivered_rays =
       stage.deliver(live.data(), states.data(), cursors.data(), goes_on_of.data(),
