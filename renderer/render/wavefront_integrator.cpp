@@ -10,10 +10,20 @@ namespace penumbra {
 
 PathBatch::PathBatch(size_t capacity, bool record_first_hits)
     : capacity_(std::max<size_t>(1, capacity)), record_first_hits_(record_first_hits) {
-  states_.reserve(capacity_);
-  samplers_.reserve(capacity_);
-  cursors_.reserve(capacity_);
-  if (record_first_hits_) firsts_.reserve(capacity_);
+  size_arrays();
+}
+
+void PathBatch::grow() {
+  capacity_ *= 2;
+  size_arrays();
+}
+
+// Every per-path and per-slot array to the capacity.
+void PathBatch::size_arrays() {
+  states_.resize(capacity_);
+  samplers_.resize(capacity_);
+  cursors_.resize(capacity_);
+  if (record_first_hits_) firsts_.resize(capacity_);
   live_.reserve(capacity_);
   hits_.resize(capacity_);
   found_.resize(capacity_);
@@ -22,13 +32,6 @@ PathBatch::PathBatch(size_t capacity, bool record_first_hits)
   shadow_slots_.resize(capacity_);
   hit_slots_.resize(capacity_);
   miss_slots_.resize(capacity_);
-}
-
-void PathBatch::clear() {
-  states_.clear();
-  samplers_.clear();
-  cursors_.clear();
-  firsts_.clear();
 }
 
 // The stages of the models `scene`'s surfaces use, and which object goes to which.

@@ -18,20 +18,24 @@ namespace penumbra {
 
 class PathBatch {
  public:
-  // Paths the batch holds at most (reserved once, so pointers into it stay valid).
+  // Room for `capacity` paths (more grow it).
   explicit PathBatch(size_t capacity, bool record_first_hits);
 
-  size_t size() const { return states_.size(); }
-  bool full() const { return states_.size() >= capacity_; }
-  void clear();
+  size_t size() const { return size_; }
+  bool full() const { return size_ >= capacity_; }
+  void clear() { size_ = 0; }
   // A camera sample: its ray, its pixel's sampler and the sample's cursor after the dimensions
   // the camera took. The sampler must stay on that pixel until the batch is integrated (other
-  // samples of the same pixel share it).
+  // samples of the same pixel share it). The per-path arrays keep their capacity's elements,
+  // so a sample is assigned in place: appended, each of its four arrays checked its capacity
+  // per sample, a twelfth of the furnace's render (docs/performance.md, session 36).
   void add(const Ray& camera_ray, Sampler* sampler, const Sampler::Cursor& cursor) {
-    states_.emplace_back(camera_ray);
-    samplers_.push_back(sampler);
-    cursors_.push_back(cursor);
-    if (record_first_hits_) firsts_.emplace_back();
+    if (size_ == capacity_) grow();
+    states_[size_] = PathState(camera_ray);
+    samplers_[size_] = sampler;
+    cursors_[size_] = cursor;
+    if (record_first_hits_) firsts_[size_] = FirstHit{};
+    ++size_;
   }
 
   // After integrate: the path's radiance and, if recorded, its camera ray's first hit.
@@ -43,8 +47,12 @@ class PathBatch {
   friend void make_stages(const Scene& scene, PathBatch& b);
 
  private:
+  void grow();  // twice the capacity
+  void size_arrays();
+
   size_t capacity_;
   bool record_first_hits_;
+  size_t size_ = 0;  // paths in the batch: the first size_ elements of the per-path arrays
   std::vector<PathState> states_;
   std::vector<Sampler*> samplers_;
   std::vector<Sampler::Cursor> cursors_;

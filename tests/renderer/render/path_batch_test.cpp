@@ -1,0 +1,78 @@
+// PathBatch (renderer/render/wavefront_integrator.h): the wavefront driver's batch keeps its
+// per-path arrays at their capacity and assigns each camera sample in place; a batch handed more
+// samples than its capacity grows, and integrates them exactly as a batch with room for all.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <vector>
+
+#include "renderer/render/wavefront_integrator.h"
+#include "renderer/scene/scene.h"
+#include "tests/renderer/render/render_test_util.h"
+
+namespace penumbra::test {
+namespace {
+
+// The radiance of `count` camera rays through a furnace's sphere (a diffuse white ball: every
+// path bounces, some several times), integrated in a batch of room `capacity`.
+std::vector<Spectrum> integrate_rays(const Scene& scene, size_t capacity, size_t count) {
+  PathBatch batch(capacity, /*record_first_hits=*/false);
+  std::vector<Sampler> samplers(count, Sampler(7));
+  for (size_t i = 0; i < count; ++i) {
+    samplers[i].start_pixel_sample(int(i), 0, 0);
+    // Rays from the camera's place towards points spread over the ball's face and past it.
+    const float x = -1.2f + 2.4f * float(i) / float(count);
+    const vec3 origin(0.f, 0.f, 4.f);
+    const Ray ray{origin, glm::normalize(vec3(x, 0.3f * x, 0.f) - origin), 0.f};
+    batch.add(ray, &samplers[i], Sampler::Cursor{0, 2});
+  }
+  EXPECT_EQ(batch.size(), count);
+  PathCounters counters;
+  select_generic_batch_integrator(IntegratorKind::kPath)(scene, IntegratorSettings{}, batch, counters);
+  std::vector<Spectrum> out;
+  for (size_t i = 0; i < batch.size(); ++i) out.push_back(batch.radiance(i));
+  return out;
+}
+
+TEST(PathBatch, GrowsPastItsCapacityAndIntegratesAsALargerOne) {
+  MaterialParams white;
+  const auto scene = Scene::build(furnace_with_sphere(white));
+  constexpr size_t kCount = 37;
+  const std::vector<Spectrum> roomy = integrate_rays(*scene, 64, kCount);
+  const std::vector<Spectrum> grown = integrate_rays(*scene, 2, kCount);  // grows 2 -> 64
+  ASSERT_EQ(roomy.size(), kCount);
+  ASSERT_EQ(grown.size(), kCount);
+  int lit = 0;
+  for (size_t i = 0; i < kCount; ++i) {
+    EXPECT_EQ(std::memcmp(&roomy[i], &grown[i], sizeof(Spectrum)), 0) << "path " << i;
+    lit += roomy[i].x > 0.f;
+  }
+  EXPECT_EQ(lit, int(kCount));  // every path sees the environment, directly or off the ball
+}
+
+TEST(PathBatch, ClearedBatchTakesNewPathsInPlace) {
+  MaterialParams white;
+  const auto scene = Scene::build(furnace_with_sphere(white));
+  PathBatch batch(4, false);
+  Sampler sampler(1);
+  sampler.start_pixel_sample(0, 0, 0);
+  const Ray away{vec3(0.f, 0.f, 4.f), vec3(0.f, 0.f, 1.f), 0.f};  // escapes: radiance 1
+  for (int i = 0; i < 4; ++i) batch.add(away, &sampler, Sampler::Cursor{0, 2});
+  EXPECT_TRUE(batch.full());
+  PathCounters counters;
+  const IntegrateBatchFn integrate = select_generic_batch_integrator(IntegratorKind::kPath);
+  integrate(*scene, IntegratorSettings{}, batch, counters);
+  EXPECT_EQ(batch.radiance(3).y, 1.f);
+  batch.clear();
+  EXPECT_EQ(batch.size(), 0u);
+  // A path added after clear starts afresh: no radiance or throughput left from the last one.
+  const Ray at_ball{vec3(0.f, 0.f, 4.f), vec3(0.f, 0.f, -1.f), 0.f};
+  batch.add(at_ball, &sampler, Sampler::Cursor{0, 2});
+  integrate(*scene, IntegratorSettings{}, batch, counters);
+  ASSERT_EQ(batch.size(), 1u);
+  EXPECT_GT(batch.radiance(0).y, 0.f);
+  EXPECT_LE(batch.radiance(0).y, 1.f);  // a white ball in a white furnace: at most 1
+}
+
+}  // namespace
+}  // namespace penumbra::test
