@@ -15,9 +15,22 @@ namespace {
 
 // The radiance of `count` camera rays through a furnace's sphere (a diffuse white ball: every
 // path bounces, some several times), integrated in a batch of room `capacity`.
-std::vector<Spectrum> integrate_rays(const Scene& scene, size_t capacity, size_t count) {
+// With `warm_up`, the batch first integrates that many paths (and so makes its surface stages
+// and their queues at its first capacity) and is cleared.
+std::vector<Spectrum> integrate_rays(const Scene& scene, size_t capacity, size_t count,
+                                     size_t warm_up = 0) {
   PathBatch batch(capacity, /*record_first_hits=*/false);
+  const IntegrateBatchFn integrate = select_generic_batch_integrator(IntegratorKind::kPath);
   std::vector<Sampler> samplers(count, Sampler(7));
+  if (warm_up > 0) {
+    Sampler other(3);
+    other.start_pixel_sample(99, 0, 0);
+    for (size_t i = 0; i < warm_up; ++i)
+      batch.add(Ray{vec3(0.f, 0.f, 4.f), vec3(0.f, 0.f, -1.f), 0.f}, &other, Sampler::Cursor{uint32_t(i), 2});
+    PathCounters counters;
+    integrate(scene, IntegratorSettings{}, batch, counters);
+    batch.clear();
+  }
   for (size_t i = 0; i < count; ++i) {
     samplers[i].start_pixel_sample(int(i), 0, 0);
     // Rays from the camera's place towards points spread over the ball's face and past it.
@@ -28,7 +41,7 @@ std::vector<Spectrum> integrate_rays(const Scene& scene, size_t capacity, size_t
   }
   EXPECT_EQ(batch.size(), count);
   PathCounters counters;
-  select_generic_batch_integrator(IntegratorKind::kPath)(scene, IntegratorSettings{}, batch, counters);
+  integrate(scene, IntegratorSettings{}, batch, counters);
   std::vector<Spectrum> out;
   for (size_t i = 0; i < batch.size(); ++i) out.push_back(batch.radiance(i));
   return out;
@@ -40,11 +53,15 @@ TEST(PathBatch, GrowsPastItsCapacityAndIntegratesAsALargerOne) {
   constexpr size_t kCount = 37;
   const std::vector<Spectrum> roomy = integrate_rays(*scene, 64, kCount);
   const std::vector<Spectrum> grown = integrate_rays(*scene, 2, kCount);  // grows 2 -> 64
+  // Grown after a first batch made the stages' queues at the first capacity.
+  const std::vector<Spectrum> grown_later = integrate_rays(*scene, 2, kCount, 2);
   ASSERT_EQ(roomy.size(), kCount);
   ASSERT_EQ(grown.size(), kCount);
+  ASSERT_EQ(grown_later.size(), kCount);
   int lit = 0;
   for (size_t i = 0; i < kCount; ++i) {
     EXPECT_EQ(std::memcmp(&roomy[i], &grown[i], sizeof(Spectrum)), 0) << "path " << i;
+    EXPECT_EQ(std::memcmp(&roomy[i], &grown_later[i], sizeof(Spectrum)), 0) << "path " << i;
     lit += roomy[i].x > 0.f;
   }
   EXPECT_EQ(lit, int(kCount));  // every path sees the environment, directly or off the ball
