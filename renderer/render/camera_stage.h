@@ -17,9 +17,12 @@ class CameraStage {
  public:
   CameraStage(const ThinLensCamera& camera, bool sample_lens, bool sample_time, size_t capacity);
 
-  // Sample `index` of image pixel (x, y), with `sampler` on that pixel.
-  void add(Sampler* sampler, int x, int y, uint32_t index) {
-    queued_.push_back(Queued{sampler, x, y, index});
+  // Samples first, first + 1, ..., first + count - 1 of image pixel (x, y), with `sampler` on
+  // that pixel.
+  void add_run(Sampler* sampler, int x, int y, uint32_t first, uint32_t count) {
+    const size_t base = queued_.size();
+    queued_.resize(base + count);
+    for (uint32_t j = 0; j < count; ++j) queued_[base + j] = Queued{sampler, x, y, first + j};
   }
   size_t size() const { return queued_.size(); }
   // The queued samples' camera rays into `batch`, in the order they were queued; then empty.

@@ -292,16 +292,26 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
               samplers.clear();
               batch_pixels.clear();
             };
-            for_each_sample([&](uint32_t pi, int fx, int fy, uint32_t s) {
-              if (batch_pixels.size() >= capacity) flush();
-              const int x = window.x0 + fx, y = window.y0 + fy;
-              if (samplers.empty() || batch_pixels.back() != pi) {
-                samplers.emplace_back(settings.seed);
-                samplers.back().start_pixel_sample(x, y, s);
+            // for_each_sample's order, a pixel's run of samples queued at once up to the batch's
+            // end (a call per sample was a fifteenth of the furnace's render).
+            for (size_t k = items[item]; k < items[item + 1]; ++k) {
+              const uint32_t pi = order.pixels[k];
+              const uint32_t n0 = taken[pi], n1 = std::min(n0 + uint32_t(s1 - s0), limit[pi]);
+              if (n0 >= n1) continue;
+              taken[pi] = n1;
+              const int x = window.x0 + int(pi % uint32_t(width)), y = window.y0 + int(pi / uint32_t(width));
+              for (uint32_t s = n0; s < n1;) {
+                if (batch_pixels.size() >= capacity) flush();
+                const uint32_t run = uint32_t(std::min<size_t>(n1 - s, capacity - batch_pixels.size()));
+                if (samplers.empty() || batch_pixels.back() != pi) {
+                  samplers.emplace_back(settings.seed);
+                  samplers.back().start_pixel_sample(x, y, s);
+                }
+                camera_stage.add_run(&samplers.back(), x, y, s, run);
+                batch_pixels.insert(batch_pixels.end(), run, pi);
+                s += run;
               }
-              camera_stage.add(&samplers.back(), x, y, s);
-              batch_pixels.push_back(pi);
-            });
+            }
             if (!batch_pixels.empty()) flush();
           } else {
             Sampler sampler(settings.seed);
