@@ -251,15 +251,15 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
             const CameraRay cr = camera.generate_ray(vec2(float(x), float(y)) + cs.film, cs.lens, cs.time);
             return Ray{cr.origin, cr.direction, cr.time};
           };
-          // The item's samples in order: each pixel's next samples of this pass, up to its limit.
-          auto for_each_sample = [&](auto&& take) {
+          // The item's samples in order: each pixel's next samples of this pass, up to its limit,
+          // as a run [n0, n1) of sample indices per pixel.
+          auto for_each_run = [&](auto&& take) {
             for (size_t k = items[item]; k < items[item + 1]; ++k) {
               const uint32_t pi = order.pixels[k];
               const uint32_t n0 = taken[pi], n1 = std::min(n0 + uint32_t(s1 - s0), limit[pi]);
               if (n0 >= n1) continue;
               taken[pi] = n1;
-              const int fx = int(pi % uint32_t(width)), fy = int(pi / uint32_t(width));
-              for (uint32_t s = n0; s < n1; ++s) take(pi, fx, fy, s);
+              take(pi, int(pi % uint32_t(width)), int(pi / uint32_t(width)), n0, n1);
             }
           };
           if (settings.wavefront) {
@@ -292,14 +292,10 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
               samplers.clear();
               batch_pixels.clear();
             };
-            // for_each_sample's order, a pixel's run of samples queued at once up to the batch's
-            // end (a call per sample was a fifteenth of the furnace's render).
-            for (size_t k = items[item]; k < items[item + 1]; ++k) {
-              const uint32_t pi = order.pixels[k];
-              const uint32_t n0 = taken[pi], n1 = std::min(n0 + uint32_t(s1 - s0), limit[pi]);
-              if (n0 >= n1) continue;
-              taken[pi] = n1;
-              const int x = window.x0 + int(pi % uint32_t(width)), y = window.y0 + int(pi / uint32_t(width));
+            // A pixel's run of samples queued at once, up to the batch's end (a call and two
+            // push_backs per sample were 3% of the furnace's profile).
+            for_each_run([&](uint32_t pi, int fx, int fy, uint32_t n0, uint32_t n1) {
+              const int x = window.x0 + fx, y = window.y0 + fy;
               for (uint32_t s = n0; s < n1;) {
                 if (batch_pixels.size() >= capacity) flush();
                 const uint32_t run = uint32_t(std::min<size_t>(n1 - s, capacity - batch_pixels.size()));
@@ -311,16 +307,18 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
                 batch_pixels.insert(batch_pixels.end(), run, pi);
                 s += run;
               }
-            }
+            });
             if (!batch_pixels.empty()) flush();
           } else {
             Sampler sampler(settings.seed);
-            for_each_sample([&](uint32_t, int fx, int fy, uint32_t s) {
-              const Ray ray = camera_ray(sampler, window.x0 + fx, window.y0 + fy, s);
-              const Spectrum L = integrate(scene, isettings, ray, sampler, counters, first);
-              if (!film.add_sample(fx, fy, L)) ++item_nonfinite;
-              if (first) layer_film->add_sample(fx, fy, first_hit);
-              ++item_samples;
+            for_each_run([&](uint32_t, int fx, int fy, uint32_t n0, uint32_t n1) {
+              for (uint32_t s = n0; s < n1; ++s) {
+                const Ray ray = camera_ray(sampler, window.x0 + fx, window.y0 + fy, s);
+                const Spectrum L = integrate(scene, isettings, ray, sampler, counters, first);
+                if (!film.add_sample(fx, fy, L)) ++item_nonfinite;
+                if (first) layer_film->add_sample(fx, fy, first_hit);
+                ++item_samples;
+              }
             });
           }
           rays += counters.rays;

@@ -27,8 +27,8 @@ class PathBatch {
   // A camera sample: its ray, its pixel's sampler and the sample's cursor after the dimensions
   // the camera took. The sampler must stay on that pixel until the batch is integrated (other
   // samples of the same pixel share it). The per-path arrays keep their capacity's elements,
-  // so a sample is assigned in place: appended, each of its four arrays checked its capacity
-  // per sample, a twelfth of the furnace's render (docs/performance.md, session 36).
+  // so a sample is assigned in place (appended, each of four arrays checked its capacity
+  // per sample: 1.5% of the furnace's render, docs/performance.md, session 36).
   void add(const Ray& camera_ray, Sampler* sampler, const Sampler::Cursor& cursor) {
     if (size_ == capacity_) grow();
     states_[size_] = PathState(camera_ray);
