@@ -18,25 +18,28 @@ class CameraStage {
   CameraStage(const ThinLensCamera& camera, bool sample_lens, bool sample_time, size_t capacity);
 
   // Samples first, first + 1, ..., first + count - 1 of image pixel (x, y), with `sampler` on
-  // that pixel.
+  // that pixel. Queued as one run: the stage takes a run's sampler seeds, film offsets and
+  // paths together (a queue entry per sample, written here and read back three times, was a
+  // third of the stage's time on the furnace: docs/performance.md, session 37).
   void add_run(Sampler* sampler, int x, int y, uint32_t first, uint32_t count) {
-    const size_t base = queued_.size();
-    queued_.resize(base + count);
-    for (uint32_t j = 0; j < count; ++j) queued_[base + j] = Queued{sampler, x, y, first + j};
+    if (count == 0) return;
+    runs_.push_back(Run{sampler, x, y, first, count});
+    queued_ += count;
   }
-  size_t size() const { return queued_.size(); }
+  size_t size() const { return queued_; }
   // The queued samples' camera rays into `batch`, in the order they were queued; then empty.
   void generate(PathBatch& batch);
 
  private:
-  struct Queued {
+  struct Run {
     Sampler* sampler;
     int x, y;
-    uint32_t index;
+    uint32_t first, count;
   };
   const ThinLensCamera& camera_;
   bool sample_lens_, sample_time_;
-  std::vector<Queued> queued_;
+  std::vector<Run> runs_;
+  size_t queued_ = 0;  // samples in all runs
   BounceSamples samples_;
   std::vector<float> film_x_, film_y_, lens_x_, lens_y_, time_, rays_[6];
 };

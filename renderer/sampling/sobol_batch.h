@@ -105,20 +105,21 @@ class BounceSamples {
       ++runs_.back().count;
       return;
     }
-    // A new run: its dimensions' seeds from the sampler, now (it may move to another pixel
-    // before compute).
-    runs_.push_back(Run{sampler.pixel_key(), cursor.dimension, k, 1});
-    const size_t r = run_seed_index_.size();
-    run_seed_index_.resize(r + size_t(per_path_));
-    run_seed_x_.resize(r + size_t(per_path_));
-    run_seed_y_.resize(r + size_t(per_path_));
-    if (per_path_ == kBounce)
-      sampler.scrambles<kBounce>(cursor.dimension, &run_seed_index_[r], &run_seed_x_[r], &run_seed_y_[r]);
-    else if (per_path_ == kBounceWithoutLight)
-      sampler.scrambles<kBounceWithoutLight>(cursor.dimension, &run_seed_index_[r], &run_seed_x_[r],
-                                             &run_seed_y_[r]);
-    else
-      sampler.scrambles(cursor.dimension, per_path_, &run_seed_index_[r], &run_seed_x_[r], &run_seed_y_[r]);
+    start_run(sampler, cursor.dimension, k, 1);
+  }
+  // Queues `count` paths of one pixel at once: samples first, first + 1, ... of `sampler`'s
+  // pixel, each at `dimension` (a camera stage's run of one pixel's samples; the same values as
+  // `count` calls of add).
+  void add_run(Sampler& sampler, uint32_t first, size_t count, uint64_t dimension) {
+    if (count == 0) return;
+    const size_t k = paths_;
+    paths_ += count;
+    for (size_t j = 0; j < count; ++j) path_index_[k + j] = first + uint32_t(j);
+    if (!runs_.empty() && runs_.back().pixel == sampler.pixel_key() && runs_.back().dimension == dimension) {
+      runs_.back().count += count;
+      return;
+    }
+    start_run(sampler, dimension, k, count);
   }
   // Computes every queued value.
   void compute() {
@@ -169,6 +170,22 @@ class BounceSamples {
   int pair_index(int j) const { return pairs_below(pairs_, j); }
 
  private:
+  // A new run from path k: its dimensions' seeds from the sampler, now (it may move to another
+  // pixel before compute).
+  void start_run(Sampler& sampler, uint64_t dimension, size_t k, size_t count) {
+    runs_.push_back(Run{sampler.pixel_key(), dimension, k, count});
+    const size_t r = run_seed_index_.size();
+    run_seed_index_.resize(r + size_t(per_path_));
+    run_seed_x_.resize(r + size_t(per_path_));
+    run_seed_y_.resize(r + size_t(per_path_));
+    if (per_path_ == kBounce)
+      sampler.scrambles<kBounce>(dimension, &run_seed_index_[r], &run_seed_x_[r], &run_seed_y_[r]);
+    else if (per_path_ == kBounceWithoutLight)
+      sampler.scrambles<kBounceWithoutLight>(dimension, &run_seed_index_[r], &run_seed_x_[r],
+                                             &run_seed_y_[r]);
+    else
+      sampler.scrambles(dimension, per_path_, &run_seed_index_[r], &run_seed_x_[r], &run_seed_y_[r]);
+  }
   struct Run {
     uint64_t pixel, dimension;  // Sampler::pixel_key(), and the run's first dimension
     size_t first, count;

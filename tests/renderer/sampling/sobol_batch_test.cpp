@@ -173,6 +173,57 @@ TEST(SobolBatch, PrefetchedRunsOfSeveralPixelsSeeTheirSamplers) {
   }
 }
 
+// A camera stage's runs (BounceSamples::add_run): runs of one pixel's consecutive samples, a
+// run continuing the previous run's pixel (merged into its run), runs of other pixels between
+// them, an empty run, and single adds after them: each path's values are its own sampler's, as
+// if every path had been added alone.
+TEST(SobolBatch, RunsOfSamplesSeeTheirSamplers) {
+  struct RunOf {
+    int sampler, x, y;
+    uint32_t first, count;
+  };
+  const std::vector<RunOf> runs = {{0, 1, 2, 0, 5}, {0, 1, 2, 5, 3}, {1, 7, 3, 0, 2}, {1, 7, 3, 2, 0},
+                                   {2, 4, 4, 9, 17}, {0, 1, 2, 8, 1}, {1, 7, 3, 2, 4}};
+  const int pattern[] = {3, 2};  // with motion: the time with the film position, then the lens
+  Sampler samplers[3] = {Sampler(11), Sampler(11), Sampler(11)};
+  struct Path {
+    int sampler, x, y;
+    uint32_t index;
+  };
+  std::vector<Path> paths;
+  for (const RunOf& r : runs)
+    for (uint32_t j = 0; j < r.count; ++j) paths.push_back(Path{r.sampler, r.x, r.y, r.first + j});
+  paths.push_back(Path{1, 7, 3, 6});  // single adds after the runs, the first continuing the last
+  paths.push_back(Path{0, 6, 1, 3});
+  BounceSamples samples;
+  samples.start(paths.size(), 3, 0b001u, 0b001u);
+  for (const RunOf& r : runs) {
+    Sampler& s = samplers[r.sampler];
+    s.start_pixel_sample(r.x, r.y, r.first);
+    samples.add_run(s, r.first, r.count, 0);
+  }
+  for (size_t k = paths.size() - 2; k < paths.size(); ++k) {
+    Sampler& s = samplers[paths[k].sampler];
+    s.start_pixel_sample(paths[k].x, paths[k].y, paths[k].index);
+    samples.add(s, s.cursor());
+  }
+  samples.compute();
+  for (size_t k = 0; k < paths.size(); ++k) {
+    const Path& p = paths[k];
+    Sampler& s = samplers[p.sampler];
+    s.start_pixel_sample(p.x, p.y, p.index);
+    std::vector<float> got, expected;
+    PrefetchedSampler prefetched(s, Sampler::Cursor{p.index, 0}, samples, k);
+    take(prefetched, pattern, 2, &got);
+    Sampler alone(11);
+    alone.start_pixel_sample(p.x, p.y, p.index);
+    take(alone, pattern, 2, &expected);
+    ASSERT_EQ(got.size(), expected.size());
+    for (size_t i = 0; i < got.size(); ++i)
+      ASSERT_EQ(float_bits(got[i]), float_bits(expected[i])) << "path " << k << " value " << i;
+  }
+}
+
 // get_1d_2d pairs through BounceSamples/PrefetchedSampler: a bounce's light pair and lobe pair
 // (pattern 3 at dimensions 0 and 2), a surface with Dirac lobes only (its pair at 0, Russian
 // roulette's plain 1D value at 2, where the layout has the lobe pair), a pair where none was
