@@ -48,11 +48,10 @@ void CameraStage::generate(PathBatch& batch) {
                          rays_[3].data(), rays_[4].data(), rays_[5].data()};
   camera_.generate_rays(n, film_x_.data(), film_y_.data(), lens_x_.data(), lens_y_.data(), out);
   for (size_t i = 0; const Run& r : runs_) {
-    for (uint32_t j = 0; j < r.count; ++j, ++i) {
-      const Ray ray{vec3(rays_[0][i], rays_[1][i], rays_[2][i]),
-                    vec3(rays_[3][i], rays_[4][i], rays_[5][i]), time_[i]};
-      batch.add(ray, r.sampler, Sampler::Cursor{r.first + j, uint64_t(dims)});
-    }
+    const float* const rays[6] = {rays_[0].data() + i, rays_[1].data() + i, rays_[2].data() + i,
+                                  rays_[3].data() + i, rays_[4].data() + i, rays_[5].data() + i};
+    batch.add_camera_run(r.count, rays, time_.data() + i, r.sampler, r.first, uint64_t(dims));
+    i += r.count;
   }
   runs_.clear();
   queued_ = 0;

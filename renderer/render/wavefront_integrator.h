@@ -6,6 +6,7 @@
 // bounce's shadow rays in packets. Paths on plain Lambertian surfaces and rough conductors take
 // their step together in SIMD lanes, one stage per model (surface_stage.h). Per path the steps, sampler dimensions and additions are the
 // scalar driver's, so both give the same image; only the order paths are advanced in differs.
+#include <algorithm>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -36,6 +37,25 @@ class PathBatch {
     cursors_[size_] = cursor;
     if (record_first_hits_) firsts_[size_] = FirstHit{};
     ++size_;
+  }
+
+  // A camera stage's run of `count` samples of one pixel: sample first + j's ray from the arrays'
+  // entry j (origin, direction and time; no t_max), its cursor after `dimensions`. The same
+  // paths as `count` calls of add, each field written once in one loop.
+  void add_camera_run(size_t count, const float* const rays[6], const float* time, Sampler* sampler,
+                      uint32_t first, uint64_t dimensions) {
+    while (capacity_ - size_ < count) grow();
+    PathState* __restrict states = states_.data() + size_;
+    Sampler** __restrict samplers = samplers_.data() + size_;
+    Sampler::Cursor* __restrict cursors = cursors_.data() + size_;
+    for (size_t j = 0; j < count; ++j) {
+      states[j] = PathState(Ray{vec3(rays[0][j], rays[1][j], rays[2][j]),
+                                vec3(rays[3][j], rays[4][j], rays[5][j]), time[j]});
+      samplers[j] = sampler;
+      cursors[j] = Sampler::Cursor{first + uint32_t(j), dimensions};
+    }
+    if (record_first_hits_) std::fill_n(firsts_.data() + size_, count, FirstHit{});
+    size_ += count;
   }
 
   // After integrate: the path's radiance and, if recorded, its camera ray's first hit.

@@ -13,8 +13,18 @@
 namespace penumbra::test {
 namespace {
 
-// The radiance of `count` camera rays through a furnace's sphere (a diffuse white ball: every
-// path bounces, some several times), integrated in a batch of room `capacity`.
+// A furnace's light grey diffuse ball over a coloured floor: a path's radiance depends on the directions
+// its sampler gives (between ball and floor it bounces, some paths several times), so two
+// batches that handed a path other sampler values would differ.
+SceneInput ball_over_floor() {
+  SceneInput in = furnace_with_sphere(DiffuseParams{Spectrum(0.9f)});
+  in.materials.push_back(DiffuseParams{Spectrum(0.5f, 0.4f, 0.3f)});
+  in.objects.push_back(quad_object(vec3(-6.f, -1.f, 6.f), vec3(12.f, 0.f, 0.f), vec3(0.f, 0.f, -12.f), 1));
+  return in;
+}
+
+// The radiance of `count` camera rays through ball_over_floor's ball and past it, integrated in
+// a batch of room `capacity`.
 // With `warm_up`, the batch first integrates that many paths (and so makes its surface stages
 // and their queues at its first capacity) and is cleared.
 std::vector<Spectrum> integrate_rays(const Scene& scene, size_t capacity, size_t count,
@@ -48,8 +58,7 @@ std::vector<Spectrum> integrate_rays(const Scene& scene, size_t capacity, size_t
 }
 
 TEST(PathBatch, GrowsPastItsCapacityAndIntegratesAsALargerOne) {
-  MaterialParams white;
-  const auto scene = Scene::build(furnace_with_sphere(white));
+  const auto scene = Scene::build(ball_over_floor());
   constexpr size_t kCount = 37;
   const std::vector<Spectrum> roomy = integrate_rays(*scene, 64, kCount);
   const std::vector<Spectrum> grown = integrate_rays(*scene, 2, kCount);  // grows 2 -> 64
@@ -65,6 +74,52 @@ TEST(PathBatch, GrowsPastItsCapacityAndIntegratesAsALargerOne) {
     lit += roomy[i].x > 0.f;
   }
   EXPECT_EQ(lit, int(kCount));  // every path sees the environment, directly or off the ball
+}
+
+// A camera stage's runs (add_camera_run: one pixel's consecutive samples, their rays from
+// arrays) are the paths the same samples added one by one give, also where a run is longer than
+// the room left and the batch must grow more than once for it.
+TEST(PathBatch, CameraRunsAreThePathsAddedOneByOne) {
+  const auto scene = Scene::build(ball_over_floor());
+  const IntegrateBatchFn integrate = select_generic_batch_integrator(IntegratorKind::kPath);
+  const uint32_t runs[2][2] = {{3, 5}, {11, 4}};  // first sample, count
+  Sampler samplers[2] = {Sampler(9), Sampler(9)};
+  std::vector<float> rays[2][6], times[2];
+  for (int r = 0; r < 2; ++r) {
+    samplers[r].start_pixel_sample(5 + r, 2, runs[r][0]);
+    for (uint32_t j = 0; j < runs[r][1]; ++j) {
+      const float x = -0.9f + 0.45f * float(j) + 0.1f * float(r);
+      const vec3 origin(0.01f * float(j), 0.f, 4.f);
+      const vec3 d = glm::normalize(vec3(x, 0.2f * x, 0.f) - origin);
+      for (int c = 0; c < 3; ++c) {
+        rays[r][c].push_back(origin[c]);
+        rays[r][3 + c].push_back(d[c]);
+      }
+      times[r].push_back(0.f);
+    }
+  }
+  // by_run grows three times for its first run (1 -> 8) and once for the second (16).
+  PathBatch by_run(1, false), one_by_one(64, false);
+  for (int r = 0; r < 2; ++r) {
+    const float* const arrays[6] = {rays[r][0].data(), rays[r][1].data(), rays[r][2].data(),
+                                    rays[r][3].data(), rays[r][4].data(), rays[r][5].data()};
+    by_run.add_camera_run(runs[r][1], arrays, times[r].data(), &samplers[r], runs[r][0], 2);
+    for (uint32_t j = 0; j < runs[r][1]; ++j)
+      one_by_one.add(Ray{vec3(rays[r][0][j], rays[r][1][j], rays[r][2][j]),
+                         vec3(rays[r][3][j], rays[r][4][j], rays[r][5][j]), times[r][j]},
+                     &samplers[r], Sampler::Cursor{runs[r][0] + j, 2});
+  }
+  ASSERT_EQ(by_run.size(), 9u);
+  ASSERT_EQ(one_by_one.size(), 9u);
+  PathCounters counters;
+  integrate(*scene, IntegratorSettings{}, by_run, counters);
+  integrate(*scene, IntegratorSettings{}, one_by_one, counters);
+  int lit = 0;
+  for (size_t i = 0; i < 9; ++i) {
+    EXPECT_EQ(std::memcmp(&by_run.radiance(i), &one_by_one.radiance(i), sizeof(Spectrum)), 0) << "path " << i;
+    lit += one_by_one.radiance(i).x > 0.f;
+  }
+  EXPECT_EQ(lit, 9);
 }
 
 TEST(PathBatch, ClearedBatchTakesNewPathsInPlace) {
