@@ -19,8 +19,8 @@ class CameraStage {
 
   // Samples first, first + 1, ..., first + count - 1 of image pixel (x, y), with `sampler` on
   // that pixel. Queued as one run: the stage takes a run's sampler seeds, film offsets and
-  // paths together (a queue entry per sample, written here and read back three times, was a
-  // third of the stage's time on the furnace: docs/performance.md, session 37).
+  // paths together (a queue entry per sample, written here and read back three times, was 30%
+  // of the stage's instructions on the furnace: docs/performance.md, levers, session 37).
   void add_run(Sampler* sampler, int x, int y, uint32_t first, uint32_t count) {
     if (count == 0) return;
     runs_.push_back(Run{sampler, x, y, first, count});
