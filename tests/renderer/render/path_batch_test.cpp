@@ -13,13 +13,14 @@
 namespace penumbra::test {
 namespace {
 
-// A furnace's light grey diffuse ball over a coloured floor: a path's radiance depends on the directions
-// its sampler gives (between ball and floor it bounces, some paths several times), so two
-// batches that handed a path other sampler values would differ.
+// A furnace's light grey diffuse ball over a coloured floor: a path's radiance depends on the
+// directions its sampler gives (between ball and floor it bounces, some paths several times), so
+// two batches that handed a path other sampler values would differ.
 SceneInput ball_over_floor() {
   SceneInput in = furnace_with_sphere(DiffuseParams{Spectrum(0.9f)});
   in.materials.push_back(DiffuseParams{Spectrum(0.5f, 0.4f, 0.3f)});
-  in.objects.push_back(quad_object(vec3(-6.f, -1.f, 6.f), vec3(12.f, 0.f, 0.f), vec3(0.f, 0.f, -12.f), 1));
+  in.objects.push_back(
+      quad_object(vec3(-6.f, -1.f, 6.f), vec3(12.f, 0.f, 0.f), vec3(0.f, 0.f, -12.f), 1));
   return in;
 }
 
@@ -116,7 +117,8 @@ TEST(PathBatch, CameraRunsAreThePathsAddedOneByOne) {
   integrate(*scene, IntegratorSettings{}, one_by_one, counters);
   int lit = 0;
   for (size_t i = 0; i < 9; ++i) {
-    EXPECT_EQ(std::memcmp(&by_run.radiance(i), &one_by_one.radiance(i), sizeof(Spectrum)), 0) << "path " << i;
+    EXPECT_EQ(std::memcmp(&by_run.radiance(i), &one_by_one.radiance(i), sizeof(Spectrum)), 0)
+        << "path " << i;
     lit += one_by_one.radiance(i).x > 0.f;
   }
   EXPECT_EQ(lit, 9);
