@@ -25,23 +25,13 @@ class PathBatch {
   size_t size() const { return size_; }
   bool full() const { return size_ >= capacity_; }
   void clear() { size_ = 0; }
-  // A camera sample: its ray, its pixel's sampler and the sample's cursor after the dimensions
-  // the camera took. The sampler must stay on that pixel until the batch is integrated (other
-  // samples of the same pixel share it). The per-path arrays keep their capacity's elements,
-  // so a sample is assigned in place (appended, each of four arrays checked its capacity
-  // per sample: 1.5% of the furnace's render, docs/performance.md, session 36).
-  void add(const Ray& camera_ray, Sampler* sampler, const Sampler::Cursor& cursor) {
-    if (size_ == capacity_) grow();
-    states_[size_] = PathState(camera_ray);
-    samplers_[size_] = sampler;
-    cursors_[size_] = cursor;
-    if (record_first_hits_) firsts_[size_] = FirstHit{};
-    ++size_;
-  }
-
   // A camera stage's run of `count` samples of one pixel: sample first + j's ray from the arrays'
-  // entry j (origin, direction and time; no t_max), its cursor after `dimensions`. The same
-  // paths as `count` calls of add, each field written once in one loop.
+  // entry j (origin, direction and time; no t_max), its pixel's sampler, and its cursor after
+  // the `dimensions` the camera took. The sampler must stay on that pixel until the batch is
+  // integrated (the run's samples share it). The per-path arrays keep their capacity's
+  // elements, so a run is assigned in place, each field once in one loop (appended, each of four
+  // arrays checked its capacity per sample: 1.5% of the furnace's render, docs/performance.md,
+  // session 36).
   void add_camera_run(size_t count, const float* const rays[6], const float* time, Sampler* sampler,
                       uint32_t first, uint64_t dimensions) {
     while (capacity_ - size_ < count) grow();

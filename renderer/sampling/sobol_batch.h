@@ -99,13 +99,7 @@ class BounceSamples {
   }
   // Queues the next path's next per_path dimensions: `sampler` on the path's pixel, at `cursor`.
   void add(Sampler& sampler, const Sampler::Cursor& cursor) {
-    const size_t k = paths_++;
-    path_index_[k] = cursor.index;
-    if (!runs_.empty() && runs_.back().pixel == sampler.pixel_key() && runs_.back().dimension == cursor.dimension) {
-      ++runs_.back().count;
-      return;
-    }
-    start_run(sampler, cursor.dimension, k, 1);
+    add_run(sampler, cursor.index, 1, cursor.dimension);
   }
   // Queues `count` paths of one pixel at once: samples first, first + 1, ... of `sampler`'s
   // pixel, each at `dimension` (a camera stage's run of one pixel's samples; the same values as

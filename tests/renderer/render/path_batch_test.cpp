@@ -13,6 +13,13 @@
 namespace penumbra::test {
 namespace {
 
+// One camera sample into `batch`: a run of one (PathBatch takes its samples as runs).
+void add_sample(PathBatch& batch, const Ray& ray, Sampler* sampler, const Sampler::Cursor& cursor) {
+  const float* const arrays[6] = {&ray.origin.x,    &ray.origin.y,    &ray.origin.z,
+                                  &ray.direction.x, &ray.direction.y, &ray.direction.z};
+  batch.add_camera_run(1, arrays, &ray.time, sampler, cursor.index, cursor.dimension);
+}
+
 // A furnace's light grey diffuse ball over a coloured floor: a path's radiance depends on the
 // directions its sampler gives (between ball and floor it bounces, some paths several times), so
 // two batches that handed a path other sampler values would differ.
@@ -37,7 +44,8 @@ std::vector<Spectrum> integrate_rays(const Scene& scene, size_t capacity, size_t
     Sampler other(3);
     other.start_pixel_sample(99, 0, 0);
     for (size_t i = 0; i < warm_up; ++i)
-      batch.add(Ray{vec3(0.f, 0.f, 4.f), vec3(0.f, 0.f, -1.f), 0.f}, &other, Sampler::Cursor{uint32_t(i), 2});
+      add_sample(batch, Ray{vec3(0.f, 0.f, 4.f), vec3(0.f, 0.f, -1.f), 0.f}, &other,
+                 Sampler::Cursor{uint32_t(i), 2});
     PathCounters counters;
     integrate(scene, IntegratorSettings{}, batch, counters);
     batch.clear();
@@ -48,7 +56,7 @@ std::vector<Spectrum> integrate_rays(const Scene& scene, size_t capacity, size_t
     const float x = -1.2f + 2.4f * float(i) / float(count);
     const vec3 origin(0.f, 0.f, 4.f);
     const Ray ray{origin, glm::normalize(vec3(x, 0.3f * x, 0.f) - origin), 0.f};
-    batch.add(ray, &samplers[i], Sampler::Cursor{0, 2});
+    add_sample(batch, ray, &samplers[i], Sampler::Cursor{0, 2});
   }
   EXPECT_EQ(batch.size(), count);
   PathCounters counters;
@@ -77,8 +85,8 @@ TEST(PathBatch, GrowsPastItsCapacityAndIntegratesAsALargerOne) {
   EXPECT_EQ(lit, int(kCount));  // every path sees the environment, directly or off the ball
 }
 
-// A camera stage's runs (add_camera_run: one pixel's consecutive samples, their rays from
-// arrays) are the paths the same samples added one by one give, also where a run is longer than
+// A camera stage's runs (one pixel's consecutive samples, their rays from arrays) are the paths
+// the same samples added one by one, as runs of one, give, also where a run is longer than
 // the room left and the batch must grow more than once for it.
 TEST(PathBatch, CameraRunsAreThePathsAddedOneByOne) {
   const auto scene = Scene::build(ball_over_floor());
@@ -106,9 +114,10 @@ TEST(PathBatch, CameraRunsAreThePathsAddedOneByOne) {
                                     rays[r][3].data(), rays[r][4].data(), rays[r][5].data()};
     by_run.add_camera_run(runs[r][1], arrays, times[r].data(), &samplers[r], runs[r][0], 2);
     for (uint32_t j = 0; j < runs[r][1]; ++j)
-      one_by_one.add(Ray{vec3(rays[r][0][j], rays[r][1][j], rays[r][2][j]),
-                         vec3(rays[r][3][j], rays[r][4][j], rays[r][5][j]), times[r][j]},
-                     &samplers[r], Sampler::Cursor{runs[r][0] + j, 2});
+      add_sample(one_by_one,
+                 Ray{vec3(rays[r][0][j], rays[r][1][j], rays[r][2][j]),
+                     vec3(rays[r][3][j], rays[r][4][j], rays[r][5][j]), times[r][j]},
+                 &samplers[r], Sampler::Cursor{runs[r][0] + j, 2});
   }
   ASSERT_EQ(by_run.size(), 9u);
   ASSERT_EQ(one_by_one.size(), 9u);
@@ -131,7 +140,7 @@ TEST(PathBatch, ClearedBatchTakesNewPathsInPlace) {
   Sampler sampler(1);
   sampler.start_pixel_sample(0, 0, 0);
   const Ray away{vec3(0.f, 0.f, 4.f), vec3(0.f, 0.f, 1.f), 0.f};  // escapes: radiance 1
-  for (int i = 0; i < 4; ++i) batch.add(away, &sampler, Sampler::Cursor{0, 2});
+  for (int i = 0; i < 4; ++i) add_sample(batch, away, &sampler, Sampler::Cursor{0, 2});
   EXPECT_TRUE(batch.full());
   PathCounters counters;
   const IntegrateBatchFn integrate = select_generic_batch_integrator(IntegratorKind::kPath);
@@ -141,7 +150,7 @@ TEST(PathBatch, ClearedBatchTakesNewPathsInPlace) {
   EXPECT_EQ(batch.size(), 0u);
   // A path added after clear starts afresh: no radiance or throughput left from the last one.
   const Ray at_ball{vec3(0.f, 0.f, 4.f), vec3(0.f, 0.f, -1.f), 0.f};
-  batch.add(at_ball, &sampler, Sampler::Cursor{0, 2});
+  add_sample(batch, at_ball, &sampler, Sampler::Cursor{0, 2});
   integrate(*scene, IntegratorSettings{}, batch, counters);
   ASSERT_EQ(batch.size(), 1u);
   EXPECT_GT(batch.radiance(0).y, 0.f);
