@@ -17,13 +17,14 @@ struct RenderFlag {
   bool numbers = false;     // with list: the items are numbers, read as JSON scalars
 };
 
-constexpr std::array<RenderFlag, 13> kRenderFlags = {{
+constexpr std::array<RenderFlag, 14> kRenderFlags = {{
     {"--width", "width", false},
     {"--height", "height", false},
     {"--spp", "spp", false},
     {"--max-depth", "max_depth", false},
     {"--rr-depth", "rr_depth", false},
     {"--integrator", "integrator", true},
+    {"--sampler", "sampler", true},
     {"--seed", "seed", false},
     {"--noise-threshold", "noise_threshold", false},
     {"--time-limit", "time_limit", false},

@@ -102,6 +102,27 @@ void parse_render(const Json* value, const Limits& limits, RenderSettings& setti
     else
       settings.time_limit = *t;
   }
+  // "auto": correlated multi-jittered points where every pixel takes spp samples, Sobol points
+  // where the count is decided as the render goes (adaptive sampling) or may be cut short (a
+  // time budget: any prefix of a pixel's Sobol points is stratified, a prefix of CMJ's is not).
+  // Resolved here, from the scene alone, so that a service's own cap on render time leaves
+  // the job's image that of the command line.
+  const std::optional<std::string> sampler = r.string("sampler");
+  if (!sampler || *sampler == "auto")
+    settings.sampler = settings.noise_threshold > 0.f || settings.time_limit > 0
+                           ? SamplerKind::kSobol
+                           : SamplerKind::kCorrelatedMultiJitter;
+  else if (*sampler == "sobol")
+    settings.sampler = SamplerKind::kSobol;
+  else if (*sampler == "cmj" && settings.noise_threshold > 0.f)
+    r.error("sampler", "\"cmj\" needs every pixel to take spp samples; adaptive sampling "
+                       "(noise_threshold) takes \"sobol\" or \"auto\"");
+  else if (*sampler == "cmj")
+    settings.sampler = SamplerKind::kCorrelatedMultiJitter;
+  else
+    r.error("sampler", "unknown sampler " + quote_user_string(*sampler) +
+                           did_you_mean(*sampler, {"auto", "cmj", "sobol"}) +
+                           "; expected \"auto\", \"cmj\" or \"sobol\"");
   if (const Json* outputs = r.array("outputs")) parse_outputs(*outputs, r.pointer_of("outputs"), settings, diag);
   if (const Json* denoise = r.get("denoise")) {
     if (denoise->is_boolean())

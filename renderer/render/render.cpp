@@ -20,6 +20,7 @@
 #include "renderer/render/camera_stage.h"
 #include "renderer/render/thin_lens_camera.h"
 #include "renderer/render/wavefront_integrator.h"
+#include "renderer/sampling/cmj.h"
 
 namespace penumbra {
 namespace {
@@ -137,6 +138,16 @@ void update_limits(const Film& film, const AdaptiveLimits& limits, std::vector<u
 
 }  // namespace
 
+// Correlated multi-jittered points where every pixel takes spp samples (less variance at equal
+// samples on most scenes: docs/performance.md, levers, session 38); Sobol points where asked for
+// and with adaptive sampling, whose pixels take prefixes of their samples that must each be well
+// stratified. A time budget does not decide it here: a service's cap on render time must not
+// change a job's image (api/ gives a scene's own budget Sobol points).
+uint32_t sampler_cmj_bits(const RenderSettings& settings) {
+  if (settings.noise_threshold > 0.f || settings.sampler == SamplerKind::kSobol) return 0u;
+  return cmj_bits_for(uint32_t(std::max(1, settings.spp)));
+}
+
 RenderResult render(const Scene& scene, const RenderSettings& settings,
                     const RenderControl& control) {
   scene.prepare_sampling(settings.integrator);  // (done already if the caller timed it as build)
@@ -173,6 +184,7 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
   const bool adaptive = settings.noise_threshold > 0.f;
   const AdaptiveLimits adaptive_limits{settings.noise_threshold, 16, spp};
   const PassPlan plan = plan_passes(settings, control, adaptive, adaptive_limits.min_samples);
+  const uint32_t cmj_bits = sampler_cmj_bits(settings);
 
   std::atomic<uint64_t> rays{0}, samples_done{0}, nonfinite{0};
   std::atomic<bool> stop{false}, timed_out{false}, cancelled{false};
@@ -300,7 +312,7 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
                 if (batch_pixels.size() >= capacity) flush();
                 const uint32_t run = uint32_t(std::min<size_t>(n1 - s, capacity - batch_pixels.size()));
                 if (samplers.empty() || batch_pixels.back() != pi) {
-                  samplers.emplace_back(settings.seed);
+                  samplers.emplace_back(settings.seed, cmj_bits);
                   samplers.back().start_pixel_sample(x, y, s);
                 }
                 camera_stage.add_run(&samplers.back(), x, y, s, run);
@@ -310,7 +322,7 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
             });
             if (!batch_pixels.empty()) flush();
           } else {
-            Sampler sampler(settings.seed);
+            Sampler sampler(settings.seed, cmj_bits);
             for_each_run([&](uint32_t, int fx, int fy, uint32_t n0, uint32_t n1) {
               for (uint32_t s = n0; s < n1; ++s) {
                 const Ray ray = camera_ray(sampler, window.x0 + fx, window.y0 + fy, s);

@@ -69,4 +69,9 @@ struct RenderResult {
 RenderResult render(const Scene& scene, const RenderSettings& settings,
                     const RenderControl& control = {});
 
+// The sampler's points for these settings (the Sampler's cmj_bits, 0 for Sobol points):
+// correlated multi-jittered ones of the power of two at or above spp unless settings.sampler asks
+// for Sobol points or adaptive sampling needs them (renderer/sampling/cmj.h).
+uint32_t sampler_cmj_bits(const RenderSettings& settings);
+
 }  // namespace penumbra

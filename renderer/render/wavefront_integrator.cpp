@@ -113,10 +113,12 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
       // Dirac (it estimates no light: a smooth dielectric picks reflection or refraction there).
       const bool light_pairs = next_event_lights<kDistributed>(scene).cdf().size() > 1;
       samples.start(hit_count, BounceSamples::kBounce, BounceSamples::kBouncePairs,
-                    (light_pairs || lobe_pairs ? 0b00001u : 0u) | (lobe_pairs ? 0b00100u : 0u));
+                    (light_pairs || lobe_pairs ? 0b00001u : 0u) | (lobe_pairs ? 0b00100u : 0u),
+                    BounceSamples::kBounceTwoD);
     } else {
       samples.start(hit_count, BounceSamples::kBounceWithoutLight,
-                    BounceSamples::kBounceWithoutLightPairs, lobe_pairs ? 0b001u : 0u);
+                    BounceSamples::kBounceWithoutLightPairs, lobe_pairs ? 0b001u : 0u,
+                    BounceSamples::kBounceWithoutLightTwoD);
     }
     for (size_t j = 0; j < hit_count; ++j) {
       const uint32_t p = live[hit_slots[j]];

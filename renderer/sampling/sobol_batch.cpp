@@ -29,7 +29,43 @@ void scrambled_sobol_z_kernel(size_t n, const uint32_t* __restrict index,
     z[i] = scrambled_sobol_z(shuffled_sample_index(index[i], seed_index[i]), seed_z[i]);
 }
 
+PENUMBRA_SIMD_CLONES
+void cmj_cells_x_kernel(size_t n, uint32_t bits, const uint32_t* __restrict index,
+                        const uint32_t* __restrict seed_index, const uint32_t* __restrict seed_x,
+                        uint32_t* __restrict cell, float* __restrict x) {
+  for (size_t i = 0; i < n; ++i) {
+    const uint32_t c = cmj_cell(index[i], bits, seed_index[i]);
+    cell[i] = c;
+    x[i] = fixed_to_unit_float(cmj_x(c, bits, seed_x[i]));
+  }
+}
+
+PENUMBRA_SIMD_CLONES
+void cmj_y_kernel(size_t n, uint32_t bits, const uint32_t* __restrict cell, const uint32_t* __restrict seed_y,
+                  float* __restrict y) {
+  for (size_t i = 0; i < n; ++i) y[i] = fixed_to_unit_float(cmj_y(cell[i], bits, seed_y[i]));
+}
+
+PENUMBRA_SIMD_CLONES
+void cmj_z_kernel(size_t n, uint32_t bits, const uint32_t* __restrict cell, const uint32_t* __restrict seed_z,
+                  float* __restrict z) {
+  for (size_t i = 0; i < n; ++i) z[i] = fixed_to_unit_float(cmj_z(cell[i], bits, seed_z[i]));
+}
+
 }  // namespace
+
+void cmj_cells_x_batch(size_t n, uint32_t bits, const uint32_t* index, const uint32_t* seed_index,
+                       const uint32_t* seed_x, uint32_t* cell, float* x) {
+  cmj_cells_x_kernel(n, bits, index, seed_index, seed_x, cell, x);
+}
+
+void cmj_y_batch(size_t n, uint32_t bits, const uint32_t* cell, const uint32_t* seed_y, float* y) {
+  cmj_y_kernel(n, bits, cell, seed_y, y);
+}
+
+void cmj_z_batch(size_t n, uint32_t bits, const uint32_t* cell, const uint32_t* seed_z, float* z) {
+  cmj_z_kernel(n, bits, cell, seed_z, z);
+}
 
 void scrambled_sobol_z_batch_portable(size_t n, const uint32_t* index, const uint32_t* seed_index,
                                       const uint32_t* seed_z, float* z) {

@@ -31,6 +31,16 @@ void scrambled_sobol_batch_portable(size_t n, const uint32_t* index, const uint3
 void scrambled_sobol_z_batch_portable(size_t n, const uint32_t* index, const uint32_t* seed_index,
                                       const uint32_t* seed_z, float* z);
 
+// The same values for correlated multi-jittered points of 2^bits samples (Sampler with
+// cmj_bits = bits; cmj.h), in three steps that share each entry's cell (cmj_cell): the cells and
+// the x values (get_1d's, get_2d's x); the y values from the cells; the 1D values of get_1d_2d
+// pairs from the cells of their 2D dimension. Loops that GCC compiles for baseline x86-64, AVX2
+// and AVX-512.
+void cmj_cells_x_batch(size_t n, uint32_t bits, const uint32_t* index, const uint32_t* seed_index,
+                       const uint32_t* seed_x, uint32_t* cell, float* x);
+void cmj_y_batch(size_t n, uint32_t bits, const uint32_t* cell, const uint32_t* seed_y, float* y);
+void cmj_z_batch(size_t n, uint32_t bits, const uint32_t* cell, const uint32_t* seed_z, float* z);
+
 // How many pairs start below dimension j: the bits of `pairs` under bit j. Shifts and adds
 // rather than std::popcount, which a baseline x86-64 build (no POPCNT) makes a call into
 // libgcc -- on every prefetched 1D-2D pair, about 1% of a mesh scene's samples.
@@ -65,17 +75,25 @@ class BounceSamples {
   // A surface that estimates no light (all lobes Dirac) takes its lobe and direction at
   // dimensions 0 and 1 of a bounce with lights: the same pair.
   static constexpr uint32_t kBouncePairs = 0b00101u, kBounceWithoutLightPairs = 0b001u;
+  // The dimensions a bounce reads as 2D values (the pairs' second dimensions: light point,
+  // direction); the others are 1D values or the 1D halves of pairs.
+  static constexpr uint32_t kBounceTwoD = 0b01010u, kBounceWithoutLightTwoD = 0b010u;
 
   // Room for `paths` paths' values, per_path each, from path 0. `pairs`: where get_1d_2d pairs
   // start; `computed`: those of them whose 1D values are computed here too (z; a pair whose 1D
   // value nobody reads, the light choice with one light or the lobe of single-lobe surfaces,
-  // need not be), besides every dimension's get_1d/get_2d values.
-  void start(size_t paths, int per_path = kBounce, uint32_t pairs = 0, uint32_t computed = 0) {
+  // need not be), besides every dimension's get_1d values and, for the dimensions of `two_d`
+  // (and the pairs' second ones), their get_2d values. A path reading a 2D value elsewhere takes
+  // it from its sampler (PrefetchedSampler): the second coordinate of a correlated
+  // multi-jittered point costs about what the first does, and a bounce reads two of five.
+  void start(size_t paths, int per_path = kBounce, uint32_t pairs = 0, uint32_t computed = 0,
+             uint32_t two_d = ~0u) {
     per_path_ = per_path;
     stride_ = paths;
     // A pair needs its 2D dimension among the prefetched ones.
     pairs_ = per_path > 1 ? pairs & ((uint32_t(1) << (per_path - 1)) - 1u) : 0u;
     computed_ = computed & pairs_;
+    two_d_ = two_d | (pairs_ << 1);
     const size_t nz = paths * size_t(std::popcount(pairs_));
     if (z_seed_index_.size() < nz) {
       z_seed_index_.resize(nz);
@@ -90,8 +108,10 @@ class BounceSamples {
       seed_y_.resize(n);
       x_.resize(n);
       y_.resize(n);
+      cell_.resize(n);
     }
     paths_ = 0;
+    cmj_bits_ = 0;
     runs_.clear();
     run_seed_index_.clear();
     run_seed_x_.clear();
@@ -136,6 +156,21 @@ class BounceSamples {
       }
     }
     // data() + e, not &v[e]: a step with no paths has empty vectors (e = 0).
+    if (cmj_bits_) {
+      for (int j = 0; j < per_path_; ++j) {
+        const size_t e = size_t(j) * stride_;
+        cmj_cells_x_batch(paths_, cmj_bits_, path_index_.data(), seed_index_.data() + e, seed_x_.data() + e,
+                          cell_.data() + e, x_.data() + e);
+        if ((two_d_ >> j) & 1u) cmj_y_batch(paths_, cmj_bits_, cell_.data() + e, seed_y_.data() + e, y_.data() + e);
+      }
+      // A pair's 1D value from its 2D dimension's cells (z_seed_index_ is for the Sobol kernel).
+      for (uint32_t bits = computed_; bits; bits &= bits - 1) {
+        const int j = std::countr_zero(bits);
+        const size_t q = size_t(pair_index(j)) * stride_;
+        cmj_z_batch(paths_, cmj_bits_, cell_.data() + size_t(j + 1) * stride_, z_seed_.data() + q, z_.data() + q);
+      }
+      return;
+    }
     for (int j = 0; j < per_path_; ++j) {
       const size_t e = size_t(j) * stride_;
       scrambled_sobol_batch(paths_, path_index_.data(), seed_index_.data() + e, seed_x_.data() + e,
@@ -159,6 +194,8 @@ class BounceSamples {
   const float* dimension_y(int j) const { return y_.data() + size_t(j) * stride_; }
   int per_path() const { return per_path_; }
   uint32_t pairs() const { return pairs_; }
+  // The dimensions whose 2D values were computed (Sobol points: all of them).
+  uint32_t two_d() const { return cmj_bits_ ? two_d_ : ~0u; }
   uint32_t computed_pairs() const { return computed_; }
   // Which pair starts at dimension j (j a bit of pairs).
   int pair_index(int j) const { return pairs_below(pairs_, j); }
@@ -167,6 +204,7 @@ class BounceSamples {
   // A new run from path k: its dimensions' seeds from the sampler, now (it may move to another
   // pixel before compute).
   void start_run(Sampler& sampler, uint64_t dimension, size_t k, size_t count) {
+    cmj_bits_ = sampler.cmj_bits();  // one pattern per render: every sampler of a batch has it
     runs_.push_back(Run{sampler.pixel_key(), dimension, k, count});
     const size_t r = run_seed_index_.size();
     run_seed_index_.resize(r + size_t(per_path_));
@@ -185,12 +223,13 @@ class BounceSamples {
     size_t first, count;
   };
   int per_path_ = kBounce;
-  uint32_t pairs_ = 0, computed_ = 0;
+  uint32_t pairs_ = 0, computed_ = 0, two_d_ = ~0u, cmj_bits_ = 0;
   size_t paths_ = 0, stride_ = 0;
   std::vector<Run> runs_;
   std::vector<uint32_t> run_seed_index_, run_seed_x_, run_seed_y_;  // per_path per run
   std::vector<uint32_t> seed_index_, seed_x_, seed_y_;
   std::vector<float> x_, y_;
+  std::vector<uint32_t> cell_;  // CMJ points: each entry's cell (cmj_cell)
   std::vector<uint32_t> path_index_, z_seed_index_, z_seed_;
   std::vector<float> z_;
 };
@@ -209,7 +248,8 @@ class PrefetchedSampler {
         stride_(samples.stride()),
         count_(samples.per_path()),
         pairs_(samples.pairs()),
-        computed_(samples.computed_pairs()) {}
+        computed_(samples.computed_pairs()),
+        two_d_(samples.two_d()) {}
 
   // The prefetched values inline, the rare rest out of line: inlined whole, the fallback's
   // sampler code made GCC call these from the bounce step instead.
@@ -221,7 +261,7 @@ class PrefetchedSampler {
     return fallback_1d();
   }
   [[gnu::always_inline]] vec2 get_2d() {
-    if (used_ < count_) {
+    if (used_ < count_ && ((two_d_ >> used_) & 1u)) {
       ++cursor_.dimension;
       const size_t e = size_t(used_++) * stride_;
       return vec2(x_[e], y_[e]);
@@ -260,6 +300,7 @@ class PrefetchedSampler {
     sampler_.resume(cursor_);
     const vec2 u = sampler_.get_2d();
     cursor_ = sampler_.cursor();
+    ++used_;  // (a prefetched dimension whose 2D value was not computed: the next stays aligned)
     return u;
   }
 
@@ -270,7 +311,7 @@ class PrefetchedSampler {
   const float* z_;
   size_t stride_;
   int count_;
-  uint32_t pairs_, computed_;
+  uint32_t pairs_, computed_, two_d_;
   int used_ = 0;
 };
 

@@ -114,6 +114,11 @@ inline constexpr const char* kOutputLayerNames[kOutputLayerCount] = {"albedo", "
 // extra layer after the requested ones, and the image becomes the denoised one.
 inline constexpr const char* kNoisyLayerName = "noisy";
 
+// The sampler's points (renderer/sampling/sampler.h, cmj.h). Correlated multi-jittered points need
+// every pixel to take spp samples: with adaptive sampling the render takes Sobol points whatever
+// this says (api/ resolves the scene's "auto" and rejects "cmj" with a noise threshold).
+enum class SamplerKind { kCorrelatedMultiJitter, kSobol };
+
 struct RenderSettings {
   int width = 256;
   int height = 256;
@@ -121,6 +126,7 @@ struct RenderSettings {
   int max_depth = 8;      // path segments from the camera, Mitsuba 3 convention; -1 = unlimited
   int rr_depth = 5;       // Russian roulette starts at this depth (Mitsuba 3 default)
   IntegratorKind integrator = IntegratorKind::kPath;
+  SamplerKind sampler = SamplerKind::kCorrelatedMultiJitter;
   uint64_t seed = 0;
   int threads = 0;        // 0 = all hardware threads
   int tile_size = 16;

@@ -149,10 +149,17 @@ void expect_no_bias_beyond_noise(const std::string& name, const RenderFn& render
 
 class MitsubaReference : public ::testing::TestWithParam<std::string> {};
 
+// environment_map's floor holds sun caustics through its glass spheres: a few rare paths carry
+// much of some blocks' light, and four renders of 64 samples often miss them in the mean and in
+// the variance estimate alike. At 64 spp a block's |z| passed 5 (or the mean z^2 2) for 2 of 12
+// seed sets with Sobol points and 3 of 12 with CMJ points; at 256 spp for none (largest block
+// |z| 2.8 with CMJ, 4.9 with Sobol; session 38).
+int reference_spp(const std::string& scene) { return scene == "environment_map" ? 256 : kSpp; }
+
 TEST_P(MitsubaReference, NoBiasBeyondNoise) {
-  expect_no_bias_beyond_noise(GetParam(), [](const Scene& scene, const RenderSettings& settings) {
-    return render(scene, settings);
-  });
+  expect_no_bias_beyond_noise(
+      GetParam(), [](const Scene& scene, const RenderSettings& settings) { return render(scene, settings); },
+      reference_spp(GetParam()));
 }
 
 INSTANTIATE_TEST_SUITE_P(Scenes, MitsubaReference, ::testing::ValuesIn(kScenes),

@@ -50,7 +50,7 @@ TEST(Schema, DocumentsEveryField) {
                     "root");
   expect_documented(defs["render"]["properties"],
                     {"width", "height", "spp", "max_depth", "rr_depth", "integrator", "seed",
-                     "noise_threshold", "time_limit", "outputs", "window"},
+                     "noise_threshold", "time_limit", "sampler", "outputs", "window"},
                     "render");
   expect_documented(defs["camera"]["properties"],
                     {"position", "look_at", "up", "fov", "aperture_radius", "focus_distance",

@@ -11,7 +11,7 @@ through the add-on, then checks that
   the multi-layer EXR went through RenderResult.load_from_file intact;
 - geometry and camera match Blender's own: the object mask of penumbra's Depth pass (< 1e9)
   against the alpha (> 0) of Cycles rendering the same scene with a transparent film has an
-  IoU > 0.98 and differs only on silhouette edges.
+  IoU > 0.975 and differs only on silhouette edges.
 """
 from __future__ import annotations
 
@@ -163,7 +163,11 @@ class BlenderAddon(unittest.TestCase):
         inner = [i for i, (a, b) in enumerate(zip(ours, cycles)) if a != b and not edge(i)]
         print(f"{name}: mask IoU {iou:.4f}, {sum(a != b for a, b in zip(ours, cycles))} pixels "
               f"differ, {len(inner)} of them off the edges", file=sys.stderr)
-        self.assertGreater(iou, 0.98, f"{name}: silhouettes differ from Cycles' (IoU {iou:.4f})")
+        # Which edge pixels any of 8 samples hits depends on the sampler's points (and Cycles'
+        # wider pixel filter): on `instances` 83 pixels differ with penumbra's Sobol points (IoU
+        # 0.9807), 91 with its correlated multi-jittered ones (0.9789), all on the edges; an
+        # object missing or moved shows off the edges (below) and in an IoU far under this.
+        self.assertGreater(iou, 0.975, f"{name}: silhouettes differ from Cycles' (IoU {iou:.4f})")
         self.assertEqual(inner, [], f"{name}: pixels off the silhouette edges differ from "
                          f"Cycles' (first: {inner[:5]})")
 

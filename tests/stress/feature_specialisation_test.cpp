@@ -7,6 +7,7 @@
 
 #include "renderer/render/camera_sample.h"
 #include "renderer/render/integrator.h"
+#include "renderer/render/render.h"
 #include "renderer/sampling/sampler.h"
 #include "renderer/scene/scene.h"
 #include "renderer/render/thin_lens_camera.h"
@@ -23,7 +24,7 @@ Image render_generic(const Scene& scene, const RenderSettings& s) {
   const IntegratorSettings is{s.max_depth, s.rr_depth};
   Image img(s.width, s.height);
   PathCounters counters;
-  Sampler sampler(s.seed);
+  Sampler sampler(s.seed, sampler_cmj_bits(s));
   for (int y = 0; y < s.height; ++y)
     for (int x = 0; x < s.width; ++x) {
       double sum[3] = {0, 0, 0};

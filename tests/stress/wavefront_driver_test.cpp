@@ -67,7 +67,10 @@ TEST(WavefrontDriver, SameImagesAsTheScalarDriverOnEveryExampleAndAccuracyScene)
     s.outputs = kOutputAlbedo | kOutputNormal | kOutputDepth;
     for (IntegratorKind kind : {IntegratorKind::kPath, IntegratorKind::kDistributed}) {
       s.integrator = kind;
+      s.time_limit = 0.0;  // a uniform render: correlated multi-jittered points (sampling/cmj.h)
       expect_same_render(*scene, s, file.filename().string() + (kind == IntegratorKind::kPath ? " path" : " distributed"));
+      s.time_limit = 1e6;  // a time budget (never reached): the Sobol points
+      expect_same_render(*scene, s, file.filename().string() + (kind == IntegratorKind::kPath ? " path" : " distributed") + " sobol");
     }
   }
 }

@@ -91,12 +91,42 @@ TEST(SobolBatch, KernelIsTheScalarSamplerToTheBit) {
   }
 }
 
+// The kernels of correlated multi-jittered points (cmj.h) give cmj.h's values to the bit.
+TEST(SobolBatch, CmjKernelsAreTheDefinitionsToTheBit) {
+  for (uint32_t bits : {1u, 2u, 5u, 6u, 11u, 24u}) {
+    for (size_t n : {1u, 7u, 16u, 17u, 37u, 1280u}) {
+      std::vector<uint32_t> index(n), si(n), sx(n), sy(n);
+      XorShift32 random{977u + uint32_t(n) + bits};
+      for (size_t i = 0; i < n; ++i) {
+        index[i] = random.next() & ((1u << bits) - 1u);
+        si[i] = random.next();
+        sx[i] = random.next();
+        sy[i] = random.next();
+      }
+      std::vector<float> x(n + 16, -1.0f), y(n + 16, -1.0f), z(n + 16, -1.0f);
+      std::vector<uint32_t> cells(n + 16, 7u);
+      cmj_cells_x_batch(n, bits, index.data(), si.data(), sx.data(), cells.data(), x.data());
+      cmj_y_batch(n, bits, cells.data(), sy.data(), y.data());
+      cmj_z_batch(n, bits, cells.data(), sx.data(), z.data());
+      for (size_t i = 0; i < n; ++i) {
+        const uint32_t cell = cmj_cell(index[i], bits, si[i]);
+        ASSERT_EQ(cells[i], cell) << bits << " " << i;
+        ASSERT_EQ(float_bits(x[i]), float_bits(fixed_to_unit_float(cmj_x(cell, bits, sx[i])))) << bits << " " << i;
+        ASSERT_EQ(float_bits(y[i]), float_bits(fixed_to_unit_float(cmj_y(cell, bits, sy[i])))) << bits << " " << i;
+        ASSERT_EQ(float_bits(z[i]), float_bits(fixed_to_unit_float(cmj_z(cell, bits, sx[i])))) << bits << " " << i;
+      }
+      for (size_t i = n; i < n + 16; ++i)
+        ASSERT_TRUE(x[i] == -1.0f && y[i] == -1.0f && z[i] == -1.0f && cells[i] == 7u) << "past n";
+    }
+  }
+}
+
 // Paths of one pixel interleaved through BounceSamples/PrefetchedSampler take the values a
 // Sampler gives each path alone: within the prefetched dimensions, past them (the fallback), and
-// across the end of the sampler's cached dimensions (64).
-TEST(SobolBatch, PrefetchedPathsSeeTheSamplersSequence) {
+// across the end of the sampler's cached dimensions (64); with the Sobol points and with CMJ's.
+void expect_prefetched_paths_see_the_samplers_sequence(uint32_t cmj_bits) {
   constexpr int kPaths = 6;
-  Sampler shared(42), alone(42);
+  Sampler shared(42, cmj_bits), alone(42, cmj_bits);
   shared.start_pixel_sample(3, 5, 0);
   std::vector<Sampler::Cursor> cursors;
   for (int p = 0; p < kPaths; ++p) {
@@ -129,6 +159,8 @@ TEST(SobolBatch, PrefetchedPathsSeeTheSamplersSequence) {
       ASSERT_EQ(float_bits(got[p][i]), float_bits(expected[p][i])) << "path " << p << " value " << i;
   }
 }
+TEST(SobolBatch, PrefetchedPathsSeeTheSamplersSequence) { expect_prefetched_paths_see_the_samplers_sequence(0); }
+TEST(SobolBatch, PrefetchedCmjPathsSeeTheSamplersSequence) { expect_prefetched_paths_see_the_samplers_sequence(6); }
 
 // A bounce's paths from several pixels and dimensions, in the orders a batch has them (runs of
 // one pixel's samples, pixels alternating, a path a dimension ahead inside a run, one sampler
@@ -227,15 +259,19 @@ TEST(SobolBatch, RunsOfSamplesSeeTheirSamplers) {
 // get_1d_2d pairs through BounceSamples/PrefetchedSampler: a bounce's light pair and lobe pair
 // (pattern 3 at dimensions 0 and 2), a surface with Dirac lobes only (its pair at 0, Russian
 // roulette's plain 1D value at 2, where the layout has the lobe pair), a pair where none was
-// laid out (dimension 1), with every subset of the pairs computed: the values a Sampler gives.
+// laid out (dimension 1), with every subset of the pairs computed, 2D values computed only where
+// a bounce reads them (2D values at dimensions 0 and 4 come from the sampler, and the values
+// after them from the prefetched ones again): the values a Sampler
+// gives, with the Sobol points and with CMJ's (32 samples).
 TEST(SobolBatch, PrefetchedPairsSeeTheSamplersSequence) {
   constexpr int kPaths = 5;
-  const int patterns[3][4] = {{3, 3, 1, 0}, {3, 1, 1, 2}, {1, 3, 2, 1}};
-  const int takes[3] = {3, 4, 4};
-  for (uint32_t computed = 0; computed < 8; ++computed) {
-    for (int which = 0; which < 3; ++which) {
-      SCOPED_TRACE(testing::Message() << "computed " << computed << ", pattern " << which);
-      Sampler shared(9), alone(9);
+  const int patterns[4][4] = {{3, 3, 1, 0}, {3, 1, 1, 2}, {1, 3, 2, 1}, {2, 2, 1, 1}};
+  const int takes[4] = {3, 4, 4, 4};
+  for (uint32_t computed = 0; computed < 16; ++computed) {
+    for (int which = 0; which < 4; ++which) {
+      const uint32_t cmj_bits = computed >= 8 ? 5u : 0u;
+      SCOPED_TRACE(testing::Message() << "computed " << computed % 8 << ", pattern " << which << ", cmj " << cmj_bits);
+      Sampler shared(9, cmj_bits), alone(9, cmj_bits);
       std::vector<Sampler::Cursor> cursors;
       for (int p = 0; p < kPaths; ++p) {
         shared.start_pixel_sample(4, 1, uint32_t(p * 7 + 1));
@@ -243,7 +279,8 @@ TEST(SobolBatch, PrefetchedPairsSeeTheSamplersSequence) {
         cursors.push_back(shared.cursor());
       }
       BounceSamples samples;
-      samples.start(kPaths, BounceSamples::kBounce, BounceSamples::kBouncePairs, computed);
+      samples.start(kPaths, BounceSamples::kBounce, BounceSamples::kBouncePairs, computed % 8,
+                    BounceSamples::kBounceTwoD);
       for (int p = 0; p < kPaths; ++p) samples.add(shared, cursors[p]);
       samples.compute();
       for (int p = 0; p < kPaths; ++p) {
