@@ -102,14 +102,17 @@ void parse_render(const Json* value, const Limits& limits, RenderSettings& setti
     else
       settings.time_limit = *t;
   }
-  // "auto": correlated multi-jittered points where every pixel takes spp samples, Sobol points
-  // where the count is decided as the render goes (adaptive sampling) or may be cut short (a
-  // time budget: any prefix of a pixel's Sobol points is stratified, a prefix of CMJ's is not).
+  // "auto": correlated multi-jittered points where every pixel takes spp samples, a power of two;
+  // Sobol points where the count is decided as the render goes (adaptive sampling) or may be cut
+  // short (a time budget: any prefix of a pixel's Sobol points is stratified, a prefix of CMJ's
+  // is not), and at other counts (the first spp of the next power of two's CMJ points have more
+  // variance than spp Sobol points: cornell 1.13 at 48 and 100 spp; docs/performance.md).
   // Resolved here, from the scene alone, so that a service's own cap on render time leaves
   // the job's image that of the command line.
   const std::optional<std::string> sampler = r.string("sampler");
+  const bool power_of_two = (settings.spp & (settings.spp - 1)) == 0;
   if (!sampler || *sampler == "auto")
-    settings.sampler = settings.noise_threshold > 0.f || settings.time_limit > 0
+    settings.sampler = settings.noise_threshold > 0.f || settings.time_limit > 0 || !power_of_two
                            ? SamplerKind::kSobol
                            : SamplerKind::kCorrelatedMultiJitter;
   else if (*sampler == "sobol")
@@ -117,6 +120,9 @@ void parse_render(const Json* value, const Limits& limits, RenderSettings& setti
   else if (*sampler == "cmj" && settings.noise_threshold > 0.f)
     r.error("sampler", "\"cmj\" needs every pixel to take spp samples; adaptive sampling "
                        "(noise_threshold) takes \"sobol\" or \"auto\"");
+  else if (*sampler == "cmj" && !power_of_two)
+    r.error("sampler", "\"cmj\" needs spp to be a power of two (" + std::to_string(settings.spp) +
+                           " is not); other counts take \"sobol\" or \"auto\"");
   else if (*sampler == "cmj")
     settings.sampler = SamplerKind::kCorrelatedMultiJitter;
   else

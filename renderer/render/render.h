@@ -70,8 +70,8 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
                     const RenderControl& control = {});
 
 // The sampler's points for these settings (the Sampler's cmj_bits, 0 for Sobol points):
-// correlated multi-jittered ones of the power of two at or above spp unless settings.sampler asks
-// for Sobol points or adaptive sampling needs them (renderer/sampling/cmj.h).
+// correlated multi-jittered ones when spp is a power of two, unless settings.sampler asks for
+// Sobol points or adaptive sampling needs them (renderer/sampling/cmj.h).
 uint32_t sampler_cmj_bits(const RenderSettings& settings);
 
 }  // namespace penumbra

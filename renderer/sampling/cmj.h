@@ -10,9 +10,10 @@
 // samples are not stratified among themselves, so adaptive sampling and time budgets keep the
 // Sobol sampler, whose every power-of-two prefix is a net.
 //
-// Everything here is integer arithmetic on 0.32 fixed point, with N = 2^bits (a render of spp
-// samples takes the first spp of the next power of two's pattern, 2 <= N <= 2^24): the batch
-// kernels (sobol_batch.h) compute the same bits in SIMD lanes.
+// Everything here is integer arithmetic on 0.32 fixed point, with N = 2^bits (2 <= N <= 2^24; a
+// render of one sample takes the first of two): the batch kernels (sobol_batch.h) compute the
+// same bits in SIMD lanes. A render of another count takes the Sobol points: the first spp of the
+// next power of two's pattern have more variance than spp Sobol points (render.cpp).
 #include <cstdint>
 
 namespace penumbra {

@@ -115,8 +115,9 @@ inline constexpr const char* kOutputLayerNames[kOutputLayerCount] = {"albedo", "
 inline constexpr const char* kNoisyLayerName = "noisy";
 
 // The sampler's points (renderer/sampling/sampler.h, cmj.h). Correlated multi-jittered points need
-// every pixel to take spp samples: with adaptive sampling the render takes Sobol points whatever
-// this says (api/ resolves the scene's "auto" and rejects "cmj" with a noise threshold).
+// every pixel to take spp samples, a power of two: otherwise (adaptive sampling, another count)
+// the render takes Sobol points whatever this says (api/ resolves the scene's "auto" and rejects
+// "cmj" where it would not apply).
 enum class SamplerKind { kCorrelatedMultiJitter, kSobol };
 
 struct RenderSettings {

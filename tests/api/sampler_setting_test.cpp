@@ -1,6 +1,7 @@
 // render.sampler (api/scene_parser.cpp): "auto" resolved from the scene alone (correlated
-// multi-jittered points for a uniform render, Sobol points with adaptive sampling or the scene's
-// own time budget), explicit choices, and errors that name the field.
+// multi-jittered points for a uniform render of a power-of-two spp, Sobol points otherwise, with
+// adaptive sampling or the scene's own time budget), explicit choices, and errors that name the
+// field.
 #include "api/render_overrides.h"
 #include "tests/api/scene_test_util.h"
 
@@ -19,7 +20,9 @@ SamplerKind sampler_of(const Json& render) {
 
 TEST(SamplerSetting, AutoIsCmjForAUniformRenderAndSobolWhenTheCountIsDecidedLater) {
   EXPECT_EQ(sampler_of(Json::object()), SamplerKind::kCorrelatedMultiJitter);
-  EXPECT_EQ(sampler_of({{"spp", 100}}), SamplerKind::kCorrelatedMultiJitter);
+  EXPECT_EQ(sampler_of({{"spp", 128}}), SamplerKind::kCorrelatedMultiJitter);
+  EXPECT_EQ(sampler_of({{"spp", 1}}), SamplerKind::kCorrelatedMultiJitter);
+  EXPECT_EQ(sampler_of({{"spp", 100}}), SamplerKind::kSobol);  // not a power of two
   EXPECT_EQ(sampler_of({{"sampler", "auto"}}), SamplerKind::kCorrelatedMultiJitter);
   EXPECT_EQ(sampler_of({{"noise_threshold", 0.05}}), SamplerKind::kSobol);
   EXPECT_EQ(sampler_of({{"time_limit", 2.0}}), SamplerKind::kSobol);
@@ -38,6 +41,8 @@ TEST(SamplerSetting, ErrorsNameTheField) {
   Json scene = base_scene();
   scene["render"] = {{"sampler", "cmj"}, {"noise_threshold", 0.05}};
   EXPECT_ERROR(load(scene), "/render/sampler", "adaptive sampling");
+  scene["render"] = {{"sampler", "cmj"}, {"spp", 100}};
+  EXPECT_ERROR(load(scene), "/render/sampler", "power of two (100 is not)");
   scene["render"] = {{"sampler", "sobl"}};
   EXPECT_ERROR(load(scene), "/render/sampler", "did you mean 'sobol'");
   scene["render"] = {{"sampler", 3}};
