@@ -140,10 +140,9 @@ void update_limits(const Film& film, const AdaptiveLimits& limits, std::vector<u
 
 // Correlated multi-jittered points where every pixel takes spp samples, a power of two (less
 // variance at equal samples on most scenes: docs/performance.md, levers, session 38); Sobol
-// points where asked for
-// and with adaptive sampling, whose pixels take prefixes of their samples that must each be well
-// stratified. A time budget does not decide it here: a service's cap on render time must not
-// change a job's image (api/ gives a scene's own budget Sobol points).
+// points where asked for and with adaptive sampling, whose pixels take prefixes of their samples
+// that must each be well stratified. A time budget does not decide it here: a service's cap on
+// render time must not change a job's image (api/ gives a scene's own budget Sobol points).
 uint32_t sampler_cmj_bits(const RenderSettings& settings) {
   if (settings.noise_threshold > 0.f || settings.sampler == SamplerKind::kSobol) return 0u;
   // At other counts a pixel would take a prefix of a larger pattern, which has more variance

@@ -152,8 +152,8 @@ class MitsubaReference : public ::testing::TestWithParam<std::string> {};
 // environment_map's floor holds sun caustics through its glass spheres: a few rare paths carry
 // much of some blocks' light, and four renders of 64 samples often miss them in the mean and in
 // the variance estimate alike. At 64 spp a block's |z| passed 5 (or the mean z^2 2) for 2 of 12
-// seed sets with Sobol points and 3 of 12 with CMJ points; at 256 spp for none (largest block
-// |z| 2.8 with CMJ, 4.9 with Sobol; session 38).
+// seed sets with Sobol points and 3 of 12 with CMJ points (session 38's first CMJ permutation);
+// at 256 spp for none (largest block |z| 2.8 with CMJ, 4.9 with Sobol).
 int reference_spp(const std::string& scene) { return scene == "environment_map" ? 256 : kSpp; }
 
 TEST_P(MitsubaReference, NoBiasBeyondNoise) {
