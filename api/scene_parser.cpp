@@ -10,6 +10,7 @@
 #include "api/object_parser.h"
 #include "api/render_window.h"
 #include "api/texture_parser.h"
+#include "renderer/sampling/cmj.h"
 
 namespace penumbra::api {
 
@@ -110,7 +111,7 @@ void parse_render(const Json* value, const Limits& limits, RenderSettings& setti
   // Resolved here, from the scene alone, so that a service's own cap on render time leaves
   // the job's image that of the command line.
   const std::optional<std::string> sampler = r.string("sampler");
-  const bool power_of_two = (settings.spp & (settings.spp - 1)) == 0;
+  const bool power_of_two = cmj_takes_count(uint32_t(settings.spp));  // the renderer's own rule
   if (!sampler || *sampler == "auto")
     settings.sampler = settings.noise_threshold > 0.f || settings.time_limit > 0 || !power_of_two
                            ? SamplerKind::kSobol

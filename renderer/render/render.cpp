@@ -148,7 +148,7 @@ uint32_t sampler_cmj_bits(const RenderSettings& settings) {
   // At other counts a pixel would take a prefix of a larger pattern, which has more variance
   // than the Sobol points (cornell 1.13 at 48 and 100 spp, mesh_files 1.31 and 1.21).
   const uint32_t spp = uint32_t(std::max(1, settings.spp));
-  return (spp & (spp - 1)) == 0 ? cmj_bits_for(spp) : 0u;
+  return cmj_takes_count(spp) ? cmj_bits_for(spp) : 0u;
 }
 
 RenderResult render(const Scene& scene, const RenderSettings& settings,

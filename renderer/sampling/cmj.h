@@ -14,6 +14,7 @@
 // render of one sample takes the first of two): the batch kernels (sobol_batch.h) compute the
 // same bits in SIMD lanes. A render of another count takes the Sobol points: the first spp of the
 // next power of two's pattern have more variance than spp Sobol points (render.cpp).
+#include <bit>
 #include <cstdint>
 
 namespace penumbra {
@@ -105,6 +106,11 @@ inline uint32_t cmj_z(uint32_t cell, uint32_t bits, uint32_t seed_z) {
   const uint32_t fine = (pi_column + (seed_rows >> 16)) & ((1u << a) - 1u);
   return cmj_fixed((f << a) | fine, cmj_hash(cell, seed_z), bits);
 }
+
+// Whether a render of spp samples per pixel can take CMJ points: spp a power of two (a prefix of
+// a larger pattern has more variance than the Sobol points; render.cpp) within cmj_bits_for's
+// range. The one rule api/ (render.sampler) and the renderer both apply.
+inline bool cmj_takes_count(uint32_t spp) { return std::has_single_bit(spp) && spp <= (1u << 24); }
 
 // The CMJ size for a render of spp samples per pixel: bits of the smallest power of two >= spp,
 // at least 1 (a shift by 32 is undefined); 0 (the Sobol sampler) above 2^24, where fixed point
