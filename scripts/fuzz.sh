@@ -3,7 +3,7 @@
 # total time, shared equally between the targets:
 #   scene_loader  api::load_scene (plus Scene::build and a 4x4 render of valid scenes)
 #   ply_reader    renderer/io/ply_reader (our own PLY parser)
-#   obj_reader    renderer/io/obj_reader (screening + tinyobjloader)
+#   obj_reader    renderer/io/obj_reader (our own OBJ statement reader)
 #   gltf_reader   renderer/io/gltf_file (GLB checks + tinygltf + accessors, hierarchy)
 #   exr_window    renderer/io/exr_window_file (a frame's window as penumbra merge reads it)
 #   image_asset   renderer/io/image_reader's own readers: PNG, EXR, Radiance HDR, JPEG

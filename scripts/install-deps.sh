@@ -24,7 +24,7 @@ PKGS=(
   build-essential cmake ninja-build pkg-config git ca-certificates curl
   libembree-dev libopenimageio-dev openimageio-tools libglm-dev
   libcpp-httplib-dev nlohmann-json3-dev libtbb-dev libsqlite3-dev
-  libgtest-dev libgmock-dev libbenchmark-dev libtinyobjloader-dev libtinygltf-dev libpng-dev
+  libgtest-dev libgmock-dev libbenchmark-dev libtinygltf-dev libpng-dev
   libopenexr-dev libjpeg62-turbo-dev libssl-dev
   libpq-dev
 )

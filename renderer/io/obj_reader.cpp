@@ -1,9 +1,13 @@
 #include "renderer/io/obj_reader.h"
 
-#include <tiny_obj_loader.h>
+#include <tbb/parallel_for.h>
 
+#include <algorithm>
+#include <charconv>
+#include <cstdlib>
 #include <limits>
-#include <streambuf>
+#include <optional>
+#include <thread>
 #include <unordered_map>
 
 namespace penumbra {
@@ -11,130 +15,280 @@ namespace {
 
 using mesh_file_detail::fail;
 
-// ---- Screening -------------------------------------------------------------------------------
+// ---- Statements ------------------------------------------------------------------------------
 //
-// tinyobjloader allocates from what it reads without limits, and some statements amplify: a
-// 20-byte `t` (subdivision tag) line makes it allocate 8192 ints, floats and strings (~330 KB),
-// `g`/`o` lines copy whole shapes, `l`/`p` lines build their own index lists, `mtllib` opens
-// another file by any path. It stores a face's corner count in an unsigned char (a 256-gon reads
-// back as 0 corners), reads indices with atoi and a number's decimal exponent into an int
-// (both undefined beyond int: "1e99999999999" overflows). So before it sees the
-// bytes, every line goes through the same line and statement rules tinyobjloader uses
-// (safeGetline: '\n', '\r' or "\r\n" ends a line; leading spaces and tabs skipped; a keyword is
-// followed by a space or tab), and
-//  - a line that is not v, vn, vt or f becomes a comment ('#' written over its first character);
-//  - v, vn, vt lines and faces are counted, and each face's corners (the runs of characters other
-//    than space, tab and '\r', which is how tinyobjloader splits them) recorded;
-//  - every digit run of a face and every exponent of a v, vn or vt line must fit an int;
-//  - the counts are held to the limits: then tinyobjloader's memory is a small multiple of them.
-
-struct Screened {
-  uint64_t positions = 0, normals = 0, uvs = 0;
-  std::vector<uint32_t> face_corners;  // per face, in file order
-};
+// One pass over the bytes reads the four statements a mesh needs and skips every other line
+// (materials, groups, smoothing, lines, points, free-form geometry: no statement allocates or
+// opens anything). A line ends at '\n', '\r' or "\r\n"; leading spaces and tabs are skipped; a
+// keyword is followed by a space or tab. Numbers are read by std::from_chars (correctly rounded,
+// no exponent limit: 1e99999 is infinite and reported by check_finite); a face index must fit an
+// int. Every count is held to the limits as it grows, so memory follows the limits and the file.
+//
+// (Until session 39 Debian's tinyobjloader parsed these bytes behind a screening pass that
+// re-implemented its tokenizer to keep hostile input away from it; the two passes took 2.6x
+// Mitsuba 3's OBJ loader on a 1M-triangle file: docs/mesh-files.md.)
 
 bool is_blank(char c) { return c == ' ' || c == '\t'; }
 
-// Steps over the digit run at p; false if its value does not fit an int.
-bool skip_int_digits(const char*& p, const char* end) {
-  uint64_t value = 0;
-  for (; p < end && *p >= '0' && *p <= '9'; ++p) {
-    value = value * 10 + uint64_t(*p - '0');
-    if (value > uint64_t(std::numeric_limits<int>::max())) return false;
-  }
-  return true;
-}
-
-// Counts a face's corners and checks that every number in it fits an int (tinyobjloader reads
-// them with atoi).
-uint64_t face_corners(const char* p, const char* end, uint64_t line, const std::string& name) {
-  uint64_t corners = 0;
-  bool in_corner = false;
-  while (p < end && *p != '\0') {
-    const bool separator = is_blank(*p) || *p == '\r';
-    if (!separator && !in_corner) ++corners;
-    in_corner = !separator;
-    if (*p >= '0' && *p <= '9') {
-      if (!skip_int_digits(p, end))
-        fail(name, "line " + std::to_string(line) + ": a face index is too large");
-    } else {
-      ++p;
-    }
-  }
-  return corners;
-}
-
-// Checks that every exponent on a v, vn or vt line fits an int. tinyobjloader's number parser
-// accumulates the digits after 'e' or 'E' (and an optional sign) in an int; an 'e' right after a
-// digit or '.' is where it can get there. Any other 'e' is not a number to it, so stricter is
-// harmless.
-void check_exponents(const char* p, const char* end, uint64_t line, const std::string& name) {
-  for (const char* begin = p; p < end && *p != '\0'; ++p) {
-    if ((*p != 'e' && *p != 'E') || p == begin) continue;
-    const char before = p[-1];
-    if (!(before >= '0' && before <= '9') && before != '.') continue;
-    const char* q = p + 1;
-    if (q < end && (*q == '+' || *q == '-')) ++q;
-    if (!skip_int_digits(q, end))
-      fail(name, "line " + std::to_string(line) + ": a number's exponent is too large");
-    p = q - 1;
-  }
-}
-
-Screened screen(std::string& bytes, const std::string& name, const MeshFileLimits& limits) {
-  Screened s;
-  uint64_t triangles = 0;
-  const uint64_t max_vertices = uint64_t(limits.max_vertices);
-  char* const data = bytes.data();
-  const size_t size = bytes.size();
-  uint64_t line = 0;
-  for (size_t begin = 0; begin < size;) {
-    size_t end = begin;
-    while (end < size && data[end] != '\n' && data[end] != '\r') ++end;
-    ++line;
-    size_t k = begin;
-    while (k < end && is_blank(data[k])) ++k;
-    const char c0 = k < end ? data[k] : '\0';
-    const char c1 = k + 1 < end ? data[k + 1] : '\0';
-    const char c2 = k + 2 < end ? data[k + 2] : '\0';
-    if (c0 == 'v' && is_blank(c1)) {
-      if (++s.positions > max_vertices)
-        fail(name, "more than " + std::to_string(max_vertices) + " vertex positions (the limit)");
-      check_exponents(data + k + 2, data + end, line, name);
-    } else if (c0 == 'v' && c1 == 'n' && is_blank(c2)) {
-      if (++s.normals > max_vertices)
-        fail(name, "more than " + std::to_string(max_vertices) + " normals (the vertex limit)");
-      check_exponents(data + k + 3, data + end, line, name);
-    } else if (c0 == 'v' && c1 == 't' && is_blank(c2)) {
-      if (++s.uvs > max_vertices)
-        fail(name, "more than " + std::to_string(max_vertices) + " uvs (the vertex limit)");
-      check_exponents(data + k + 3, data + end, line, name);
-    } else if (c0 == 'f' && is_blank(c1)) {
-      const uint64_t corners = face_corners(data + k + 2, data + end, line, name);
-      if (corners < 3)
-        fail(name, "line " + std::to_string(line) + ": a face needs at least 3 vertices");
-      triangles += corners - 2;
-      if (triangles > uint64_t(limits.max_triangles))
-        fail(name, "line " + std::to_string(line) + ": more than " +
-                       std::to_string(limits.max_triangles) + " triangles (the limit)");
-      s.face_corners.push_back(uint32_t(corners));  // corners - 2 <= max_triangles
-    } else if (c0 != '\0' && c0 != '#') {
-      data[k] = '#';
-    }
-    // Past the line's end: '\n', or '\r' with the '\n' that may follow it.
-    begin = end;
-    if (begin < size && data[begin++] == '\r' && begin < size && data[begin] == '\n') ++begin;
-  }
-  if (s.face_corners.empty()) fail(name, "the file has no faces");
-  return s;
-}
-
-// An istream over the screened bytes without copying them.
-struct MemoryBuffer : std::streambuf {
-  explicit MemoryBuffer(std::string& bytes) {
-    setg(bytes.data(), bytes.data(), bytes.data() + bytes.size());
-  }
+// A corner's indices, 0-based: kAbsent where the corner names none. A negative index counts back
+// from the elements read so far; the result may be out of range, which VertexMerger reports.
+constexpr int32_t kAbsent = std::numeric_limits<int32_t>::min();
+struct Corner {
+  int32_t position, uv, normal;
 };
+
+struct Statements {
+  std::vector<float> positions, normals, uvs;  // 3, 3 and 2 floats per element
+  std::vector<Corner> corners;
+  std::vector<uint32_t> face_corners;  // per face, in file order
+  uint64_t triangles = 0;
+  // Corners with a negative index, as (corner, which: 1 position, 2 uv, 4 normal): read from a
+  // part of the file, such an index counted back from that part's elements only, and is moved
+  // by the elements before the part when the parts are joined.
+  std::vector<std::pair<uint64_t, uint32_t>> relative;
+  uint64_t lines = 0;  // lines read
+};
+
+// An error at a line of the part being read (0: of no line), before it becomes a MeshFileError
+// with the line's number in the whole file.
+struct LineError {
+  uint64_t line;
+  std::string reason;
+};
+
+// The statements of the bytes [begin, end), which start at a line's start.
+class StatementReader {
+ public:
+  StatementReader(const char* begin, const char* end, const MeshFileLimits& limits)
+      : p_(begin), end_(end), limits_(limits) {}
+
+  Statements read() {
+    while (p_ < end_) {
+      ++out_.lines;
+      const char* const line_end = find_line_end();
+      const char* k = p_;
+      while (k < line_end && is_blank(*k)) ++k;
+      const size_t n = size_t(line_end - k);
+      if (n >= 2 && k[0] == 'v' && is_blank(k[1])) {
+        count(out_.positions.size() / 3, "vertex positions (the limit)");
+        numbers(k + 2, line_end, 3, out_.positions);
+      } else if (n >= 3 && k[0] == 'v' && k[1] == 'n' && is_blank(k[2])) {
+        count(out_.normals.size() / 3, "normals (the vertex limit)");
+        numbers(k + 3, line_end, 3, out_.normals);
+      } else if (n >= 3 && k[0] == 'v' && k[1] == 't' && is_blank(k[2])) {
+        count(out_.uvs.size() / 2, "uvs (the vertex limit)");
+        numbers(k + 3, line_end, 2, out_.uvs);
+      } else if (n >= 2 && k[0] == 'f' && is_blank(k[1])) {
+        face(k + 2, line_end);
+      }
+      p_ = past_line_end(line_end, end_);
+    }
+    return std::move(out_);
+  }
+
+  // Past a line's end at q: '\n', or '\r' with the '\n' that may follow it.
+  static const char* past_line_end(const char* q, const char* end) {
+    if (q < end && *q++ == '\r' && q < end && *q == '\n') ++q;
+    return q;
+  }
+
+ private:
+  const char* find_line_end() const {
+    const char* q = p_;
+    while (q < end_ && *q != '\n' && *q != '\r') ++q;
+    return q;
+  }
+
+  [[noreturn]] void fail_line(std::string reason) const { throw LineError{out_.lines, std::move(reason)}; }
+
+  // Throws unless one more element (of so_far) is within the vertex limit.
+  void count(size_t so_far, const char* what) const {
+    if (so_far + 1 > uint64_t(limits_.max_vertices))
+      throw LineError{0, "more than " + std::to_string(limits_.max_vertices) + " " + what};
+  }
+
+  // `wanted` numbers of a v, vn or vt line: missing ones are 0 and any after them are ignored
+  // (v's optional w or vertex colour, vt's w), as common readers do.
+  void numbers(const char* q, const char* line_end, int wanted, std::vector<float>& out) const {
+    for (int i = 0; i < wanted; ++i) {
+      while (q < line_end && is_blank(*q)) ++q;
+      const char* const begin = q;
+      while (q < line_end && !is_blank(*q)) ++q;
+      out.push_back(begin == q ? 0.f : number(begin, q));
+    }
+  }
+
+  float number(const char* begin, const char* stop) const {
+    const char* first = begin;
+    if (first + 1 < stop && *first == '+' && first[1] != '-') ++first;  // from_chars takes no '+'
+    float value = 0.f;
+    const auto [ptr, ec] = std::from_chars(first, stop, value);
+    if (ec == std::errc::result_out_of_range) {
+      // Beyond float's range: infinite (check_finite names the element) or, below it, zero.
+      const std::string text(first, stop);
+      return std::strtof(text.c_str(), nullptr);
+    }
+    if (ec != std::errc() || ptr != stop)
+      fail_line("cannot read '" + std::string(begin, std::min(stop, begin + 32)) + "' as a number");
+    return value;
+  }
+
+  // A corner's index at q, up to the next '/', blank or line end (q left there): 1-based, or
+  // negative counting back from the `so_far` read (`relative` set). Digits by hand in the one
+  // pass that finds the corner's end: a million-triangle file has nine million of them.
+  int32_t index(const char*& q, const char* line_end, size_t so_far, bool* relative) const {
+    const char* const begin = q;
+    const bool negative = q < line_end && *q == '-';
+    if (q < line_end && (*q == '-' || *q == '+')) ++q;
+    int64_t value = 0;
+    const char* const digits = q;
+    for (; q < line_end && *q >= '0' && *q <= '9'; ++q) {
+      value = value * 10 + (*q - '0');
+      if (value > std::numeric_limits<int>::max()) value = int64_t(1) << 40;  // stays too large
+    }
+    if (q < line_end && *q != '/' && !is_blank(*q)) {
+      while (q < line_end && *q != '/' && !is_blank(*q)) ++q;
+      bad_index(begin, q);
+    }
+    if (q == begin) fail_line("a face corner has an empty index");
+    if (q == digits) bad_index(begin, q);
+    if (value > std::numeric_limits<int>::max()) fail_line("a face index is too large");
+    if (value == 0) fail_line("a face index is 0 (OBJ counts from 1)");
+    *relative |= negative;
+    // so_far is within the vertex limit and value within int: the result fits an int32 above
+    // kAbsent.
+    return int32_t(negative ? int64_t(so_far) - value : value - 1);
+  }
+  [[noreturn]] void bad_index(const char* begin, const char* stop) const {
+    fail_line("cannot read the face corner index '" + std::string(begin, std::min(stop, begin + 32)) +
+              "'");
+  }
+
+  // A face: corners v, v/vt, v//vn or v/vt/vn. Its triangles are held to the limit corner by
+  // corner, so a face of a hundred million corners stops at the limit, not at the end of memory.
+  void face(const char* q, const char* line_end) {
+    uint64_t n = 0;
+    for (;;) {
+      while (q < line_end && is_blank(*q)) ++q;
+      if (q == line_end) break;
+      if (++n >= 3 && out_.triangles + (n - 2) > uint64_t(limits_.max_triangles))
+        fail_line("more than " + std::to_string(limits_.max_triangles) + " triangles (the limit)");
+      const char* const corner = q;
+      bool p_relative = false, t_relative = false, n_relative = false;
+      Corner c{index(q, line_end, out_.positions.size() / 3, &p_relative), kAbsent, kAbsent};
+      if (q < line_end && *q == '/') {
+        ++q;
+        if (q < line_end && *q != '/') c.uv = index(q, line_end, out_.uvs.size() / 2, &t_relative);
+        if (q < line_end && *q == '/') {
+          ++q;
+          c.normal = index(q, line_end, out_.normals.size() / 3, &n_relative);
+        } else if (c.uv == kAbsent) {
+          fail_line("a face corner has an empty index");
+        }
+        if (q < line_end && *q == '/') {  // a fourth index
+          while (q < line_end && !is_blank(*q)) ++q;
+          bad_index(corner, q);
+        }
+      }
+      if (p_relative || t_relative || n_relative)
+        out_.relative.emplace_back(out_.corners.size(),
+                                   uint32_t(p_relative) | uint32_t(t_relative) << 1 |
+                                       uint32_t(n_relative) << 2);
+      out_.corners.push_back(c);
+    }
+    if (n < 3) fail_line("a face needs at least 3 vertices");
+    out_.triangles += n - 2;
+    out_.face_corners.push_back(uint32_t(n));  // n - 2 <= max_triangles
+  }
+
+  const char* p_;
+  const char* const end_;
+  const MeshFileLimits& limits_;
+  Statements out_;
+};
+
+// Files above this size are read in parts on several threads (below it a thread costs more
+// than it saves).
+constexpr size_t kPartBytes = size_t(4) << 20;
+
+// The whole file's statements: read in `parts` pieces split at line ends, on as many threads;
+// the first part holds every part's elements (positions, normals, uvs), each part its faces.
+// The same statements as one piece gives, and for a file with one error the same
+// message (line numbers count from the file's start; with several errors, a limit exceeded only
+// by the parts together is reported after the other errors).
+std::vector<Statements> read_statements(const std::string& bytes, const std::string& name,
+                                        const MeshFileLimits& limits, size_t parts) {
+  const char* const data = bytes.data();
+  const char* const end = data + bytes.size();
+  std::vector<const char*> cut{data};
+  for (size_t i = 1; i < parts; ++i) {
+    const char* q = std::max(cut.back(), data + bytes.size() * i / parts);
+    while (q < end && *q != '\n' && *q != '\r') ++q;
+    cut.push_back(StatementReader::past_line_end(q, end));
+  }
+  cut.push_back(end);
+  std::vector<Statements> read(parts);
+  std::vector<std::optional<LineError>> errors(parts);
+  const auto read_part = [&](size_t i) {
+    try {
+      read[i] = StatementReader(cut[i], cut[i + 1], limits).read();
+    } catch (LineError& e) {
+      errors[i] = std::move(e);
+    }
+  };
+  // Threads only where the parts are large enough to pay for them (a small file in parts, as
+  // the tests and the fuzzer read them, takes the same steps on this thread).
+  if (bytes.size() >= kPartBytes * 2)
+    tbb::parallel_for(size_t(0), parts, read_part);
+  else
+    for (size_t i = 0; i < parts; ++i) read_part(i);
+  // The first error in the file, its line counted from the file's start (every part before it
+  // was read whole).
+  uint64_t lines = 0;
+  for (size_t i = 0; i < parts; ++i) {
+    if (errors[i]) {
+      const LineError& e = *errors[i];
+      fail(name, e.line ? "line " + std::to_string(lines + e.line) + ": " + e.reason : e.reason);
+    }
+    lines += read[i].lines;
+  }
+  // The parts' elements joined in the first part, each part keeping its own faces (the merge
+  // walks them in order; copying a million triangles' corners costs more than the reading).
+  Statements& all = read[0];
+  for (size_t i = 1; i < parts; ++i) {
+    Statements& part = read[i];
+    const int64_t base[3] = {int64_t(all.positions.size() / 3), int64_t(all.uvs.size() / 2),
+                             int64_t(all.normals.size() / 3)};
+    for (const auto& [corner, which] : part.relative) {
+      // A negative index counted back from this part's elements: the earlier parts' come first.
+      // (It stays at or above -INT_MAX: never kAbsent.)
+      Corner& c = part.corners[corner];
+      if (which & 1u) c.position = int32_t(int64_t(c.position) + base[0]);
+      if (which & 2u) c.uv = int32_t(int64_t(c.uv) + base[1]);
+      if (which & 4u) c.normal = int32_t(int64_t(c.normal) + base[2]);
+    }
+    all.positions.insert(all.positions.end(), part.positions.begin(), part.positions.end());
+    all.normals.insert(all.normals.end(), part.normals.begin(), part.normals.end());
+    all.uvs.insert(all.uvs.end(), part.uvs.begin(), part.uvs.end());
+    all.triangles += part.triangles;
+    std::vector<float>().swap(part.positions);  // lower the peak as the parts are joined
+    std::vector<float>().swap(part.normals);
+    std::vector<float>().swap(part.uvs);
+  }
+  // The limits over the whole file (each part held them alone).
+  const uint64_t max_vertices = uint64_t(limits.max_vertices);
+  if (all.positions.size() / 3 > max_vertices)
+    fail(name, "more than " + std::to_string(max_vertices) + " vertex positions (the limit)");
+  if (all.normals.size() / 3 > max_vertices)
+    fail(name, "more than " + std::to_string(max_vertices) + " normals (the vertex limit)");
+  if (all.uvs.size() / 2 > max_vertices)
+    fail(name, "more than " + std::to_string(max_vertices) + " uvs (the vertex limit)");
+  if (all.triangles > uint64_t(limits.max_triangles))
+    fail(name, "more than " + std::to_string(limits.max_triangles) + " triangles (the limit)");
+  if (std::all_of(read.begin(), read.end(), [](const Statements& p) { return p.face_corners.empty(); }))
+    fail(name, "the file has no faces");
+  return read;
+}
 
 // ---- Vertices --------------------------------------------------------------------------------
 
@@ -144,7 +298,7 @@ struct MemoryBuffer : std::streambuf {
 // through a per-position slot and only seams need the hash map.
 class VertexMerger {
  public:
-  VertexMerger(const tinyobj::attrib_t& attrib, bool normals, bool uvs, const std::string& name,
+  VertexMerger(const Statements& attrib, bool normals, bool uvs, const std::string& name,
                const MeshFileLimits& limits, MeshDesc& mesh)
       : attrib_(attrib),
         normals_(normals),
@@ -152,14 +306,13 @@ class VertexMerger {
         name_(name),
         limits_(limits),
         mesh_(mesh),
-        first_(attrib.vertices.size() / 3, kNone) {}
+        first_(attrib.positions.size() / 3, kNone) {}
 
-  uint32_t vertex(const tinyobj::index_t& corner, int64_t face) {
-    const int64_t p = check(corner.vertex_index, attrib_.vertices.size() / 3, "vertex", face);
+  uint32_t vertex(const Corner& corner, int64_t face) {
+    const int64_t p = check(corner.position, attrib_.positions.size() / 3, "vertex", face);
     const int64_t n =
-        normals_ ? check(corner.normal_index, attrib_.normals.size() / 3, "normal", face) : -1;
-    const int64_t t =
-        uvs_ ? check(corner.texcoord_index, attrib_.texcoords.size() / 2, "uv", face) : -1;
+        normals_ ? check(corner.normal, attrib_.normals.size() / 3, "normal", face) : -1;
+    const int64_t t = uvs_ ? check(corner.uv, attrib_.uvs.size() / 2, "uv", face) : -1;
     uint32_t& first = first_[size_t(p)];
     if (first == kNone) return first = add(p, n, t);
     if (key_of(first) == Key{p, n, t}) return first;
@@ -182,7 +335,7 @@ class VertexMerger {
     }
   };
 
-  int64_t check(int index, size_t count, const char* what, int64_t face) const {
+  int64_t check(int64_t index, size_t count, const char* what, int64_t face) const {
     if (index < 0 || size_t(index) >= count)
       fail(name_, "face " + std::to_string(face + 1) + ": a " + what +
                       " index is out of range (the file has " + std::to_string(count) + ")");
@@ -195,21 +348,21 @@ class VertexMerger {
     if (int64_t(mesh_.positions.size()) >= std::min<int64_t>(limits_.max_vertices, kNone))
       fail(name_,
            "more than " + std::to_string(limits_.max_vertices) + " distinct vertices (the limit)");
-    const auto& v = attrib_.vertices;
+    const auto& v = attrib_.positions;
     mesh_.positions.emplace_back(v[3 * size_t(p)], v[3 * size_t(p) + 1], v[3 * size_t(p) + 2]);
     if (normals_) {
       const auto& vn = attrib_.normals;
       mesh_.normals.emplace_back(vn[3 * size_t(n)], vn[3 * size_t(n) + 1], vn[3 * size_t(n) + 2]);
     }
     if (uvs_) {
-      const auto& vt = attrib_.texcoords;
+      const auto& vt = attrib_.uvs;
       mesh_.uvs.emplace_back(vt[2 * size_t(t)], 1.f - vt[2 * size_t(t) + 1]);  // v flipped
     }
     sources_.push_back({p, n, t});
     return uint32_t(mesh_.positions.size() - 1);
   }
 
-  const tinyobj::attrib_t& attrib_;
+  const Statements& attrib_;
   bool normals_, uvs_;
   const std::string& name_;
   const MeshFileLimits& limits_;
@@ -222,42 +375,35 @@ class VertexMerger {
 }  // namespace
 
 MeshFile parse_obj(std::string bytes, const std::string& name, const MeshFileLimits& limits) {
+  const size_t parts = std::clamp<size_t>(bytes.size() / kPartBytes, 1,
+                                          std::max(1u, std::thread::hardware_concurrency()));
+  return obj_reader_detail::parse_obj_in_parts(std::move(bytes), name, limits, parts);
+}
+
+MeshFile obj_reader_detail::parse_obj_in_parts(std::string bytes, const std::string& name,
+                                               const MeshFileLimits& limits, size_t parts) {
   if (int64_t(bytes.size()) > limits.max_file_bytes)
     fail(name, "the file has " + std::to_string(bytes.size()) + " bytes; at most " +
                    std::to_string(limits.max_file_bytes));
-  const Screened screened = screen(bytes, name, limits);
-
-  tinyobj::attrib_t attrib;
-  std::vector<tinyobj::shape_t> shapes;
-  std::vector<tinyobj::material_t> materials;
-  std::string warnings, errors;
-  {
-    MemoryBuffer buffer(bytes);
-    std::istream in(&buffer);
-    // No material reader: mtllib is a comment by now anyway. No triangulation: tinyobjloader's
-    // splits quads along the shorter diagonal and clips ears; the format promises a fan.
-    if (!tinyobj::LoadObj(&attrib, &shapes, &materials, &warnings, &errors, &in, nullptr,
-                          /*triangulate=*/false, /*default_vcols_fallback=*/false))
-      fail(name, "cannot parse the file: " + errors.substr(0, errors.find('\n')));
-  }
+  const std::vector<Statements> parts_read = read_statements(bytes, name, limits, std::max<size_t>(parts, 1));
   std::string().swap(bytes);  // not needed any more: lower the peak
+  const Statements& elements = parts_read.front();
 
   // Which attributes every corner has; attributes on some corners only are dropped.
   // A corner naming a normal or uv the file lacks is reported by VertexMerger, not ignored.
   bool all_normals = true, all_uvs = true;
   bool some_normals = false, some_uvs = false;
-  size_t corners = 0;
-  for (const tinyobj::shape_t& shape : shapes)
-    for (const tinyobj::index_t& c : shape.mesh.indices) {
-      ++corners;
-      all_normals &= c.normal_index >= 0;
-      all_uvs &= c.texcoord_index >= 0;
-      some_normals |= c.normal_index >= 0;
-      some_uvs |= c.texcoord_index >= 0;
+  uint64_t corners = 0, faces = 0;
+  for (const Statements& part : parts_read) {
+    for (const Corner& c : part.corners) {
+      all_normals &= c.normal != kAbsent;
+      all_uvs &= c.uv != kAbsent;
+      some_normals |= c.normal != kAbsent;
+      some_uvs |= c.uv != kAbsent;
     }
-  uint64_t expected = 0;
-  for (uint32_t n : screened.face_corners) expected += n;
-  if (corners != expected) fail(name, "the faces could not be read consistently");
+    corners += part.corners.size();
+    faces += part.face_corners.size();
+  }
 
   MeshFile out;
   if (some_normals && !all_normals)
@@ -265,24 +411,21 @@ MeshFile parse_obj(std::string bytes, const std::string& name, const MeshFileLim
         name + ": normals are given for some face corners only; the mesh is shaded flat");
   if (some_uvs && !all_uvs)
     out.warnings.push_back(name + ": uvs are given for some face corners only; they are ignored");
-  out.faces = int64_t(screened.face_corners.size());
-  VertexMerger merger(attrib, all_normals, all_uvs, name, limits, out.mesh);
+  out.faces = int64_t(faces);
+  VertexMerger merger(elements, all_normals, all_uvs, name, limits, out.mesh);
   mesh_file_detail::FaceSink sink(name, limits, std::numeric_limits<uint32_t>::max(),
                                   out.mesh.indices);
+  out.mesh.indices.reserve(3 * (corners - 2 * faces));
   std::vector<int64_t> face_vertices;
-  size_t face = 0;
-  for (const tinyobj::shape_t& shape : shapes)
-    for (size_t c = 0; c < shape.mesh.indices.size(); ++face) {
-      // The screened count, not tinyobjloader's unsigned char one.
-      if (face >= screened.face_corners.size() ||
-          screened.face_corners[face] > shape.mesh.indices.size() - c)
-        fail(name, "the faces could not be read consistently");
-      const uint32_t n = screened.face_corners[face];
+  int64_t face = 0;
+  for (const Statements& part : parts_read) {
+    size_t c = 0;
+    for (const uint32_t n : part.face_corners) {
       face_vertices.resize(n);
-      for (uint32_t k = 0; k < n; ++k, ++c)
-        face_vertices[k] = merger.vertex(shape.mesh.indices[c], int64_t(face));
-      sink.add(face_vertices.data(), n, int64_t(face));
+      for (uint32_t k = 0; k < n; ++k, ++c) face_vertices[k] = merger.vertex(part.corners[c], face);
+      sink.add(face_vertices.data(), n, face++);
     }
+  }
   mesh_file_detail::check_finite(name, out.mesh);
   return out;
 }

@@ -1,8 +1,7 @@
 #pragma once
-// Wavefront OBJ through Debian's tinyobjloader (libtinyobjloader-dev 2.0.0rc10), which is not
-// written for hostile input. So it only ever sees bytes this reader has screened first (see
-// obj_reader.cpp): statements other than v, vn, vt and f are turned into comments, every count
-// and index is checked against the limits, and only then does tinyobjloader allocate.
+// Wavefront OBJ, our own reader (obj_reader.cpp; why not tinyobjloader: docs/mesh-files.md):
+// one pass reads v, vn, vt and f statements and skips every other line, with every count held to
+// the limits as it grows and every malformed number or index an error naming its line.
 //
 // Positions, normals and uvs are read; `mtllib` and `usemtl` are ignored (the scene's material
 // applies, and no other file is opened). As Mitsuba 3's obj plugin, v is flipped on load
@@ -15,7 +14,14 @@
 
 namespace penumbra {
 
-// Takes the bytes by value: screening rewrites them in place. Throws MeshFileError.
+// Throws MeshFileError. Files of several megabytes are read in parts on several threads.
 MeshFile parse_obj(std::string bytes, const std::string& name, const MeshFileLimits& limits = {});
+
+namespace obj_reader_detail {
+// parse_obj with the file read in `parts` pieces (for the tests and the fuzzer: any count gives
+// parse_obj's mesh).
+MeshFile parse_obj_in_parts(std::string bytes, const std::string& name, const MeshFileLimits& limits,
+                            size_t parts);
+}  // namespace obj_reader_detail
 
 }  // namespace penumbra
