@@ -322,6 +322,37 @@ bool coincident(const std::vector<std::unique_ptr<TriangleMesh>>& meshes) {
   return has_coincident_triangles(p);
 }
 
+// A mesh large enough that the triangles' hashes are computed in several blocks on threads:
+// a duplicate anywhere is found, in the same mesh or across meshes, and a clean grid passes.
+TEST(ExactTCheck, CoincidentTrianglesAreFoundInLargeMeshes) {
+  MeshDesc grid;
+  const uint32_t n = 120;  // 28,800 triangles
+  for (uint32_t j = 0; j <= n; ++j)
+    for (uint32_t i = 0; i <= n; ++i) grid.positions.emplace_back(float(i), 0.01f * float(i * j), float(j));
+  for (uint32_t j = 0; j < n; ++j)
+    for (uint32_t i = 0; i < n; ++i) {
+      const uint32_t a = j * (n + 1) + i, b = a + 1, c = a + n + 1, d = c + 1;
+      grid.indices.insert(grid.indices.end(), {a, b, d, a, d, c});
+    }
+  std::vector<std::unique_ptr<TriangleMesh>> v;
+  v.push_back(mesh(grid));
+  EXPECT_FALSE(coincident(v));
+  for (const size_t t : {size_t(0), size_t(5000), grid.indices.size() / 3 - 1}) {
+    MeshDesc dup = grid;  // triangle t listed again at the end
+    dup.indices.insert(dup.indices.end(), grid.indices.begin() + 3 * t, grid.indices.begin() + 3 * t + 3);
+    v.clear();
+    v.push_back(mesh(dup));
+    EXPECT_TRUE(coincident(v)) << t;
+  }
+  MeshDesc one;  // one triangle of the grid's middle, as a second mesh
+  one.positions = grid.positions;
+  one.indices.assign(grid.indices.begin() + 3 * 14000, grid.indices.begin() + 3 * 14001);
+  v.clear();
+  v.push_back(mesh(grid));
+  v.push_back(mesh(one));
+  EXPECT_TRUE(coincident(v));
+}
+
 TEST(ExactTCheck, CoincidentTrianglesAreFoundAndNothingElse) {
   const MeshDesc a = box_mesh({-0.6f, -0.6f, -0.6f}, {0.6f, 0.6f, 0.6f});
   std::vector<std::unique_ptr<TriangleMesh>> v;
