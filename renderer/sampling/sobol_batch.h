@@ -151,7 +151,9 @@ class BounceSamples {
       for (uint32_t bits = computed_; bits; bits &= bits - 1) {
         const int j = std::countr_zero(bits);
         const size_t q = size_t(pair_index(j)) * stride_ + run.first;
-        std::fill_n(z_seed_index_.data() + q, run.count, run_seed_index_[seeds + size_t(j) + 1]);
+        // (CMJ points take a pair's 1D value from its 2D dimension's cells, not its shuffle.)
+        if (!cmj_bits_)
+          std::fill_n(z_seed_index_.data() + q, run.count, run_seed_index_[seeds + size_t(j) + 1]);
         std::fill_n(z_seed_.data() + q, run.count, run_seed_x_[seeds + size_t(j)]);
       }
     }
@@ -163,7 +165,7 @@ class BounceSamples {
                           cell_.data() + e, x_.data() + e);
         if ((two_d_ >> j) & 1u) cmj_y_batch(paths_, cmj_bits_, cell_.data() + e, seed_y_.data() + e, y_.data() + e);
       }
-      // A pair's 1D value from its 2D dimension's cells (z_seed_index_ is for the Sobol kernel).
+      // A pair's 1D value from its 2D dimension's cells.
       for (uint32_t bits = computed_; bits; bits &= bits - 1) {
         const int j = std::countr_zero(bits);
         const size_t q = size_t(pair_index(j)) * stride_;
