@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <charconv>
-#include <cstdlib>
 #include <limits>
 #include <optional>
 #include <thread>
@@ -123,14 +122,26 @@ class StatementReader {
     if (first + 1 < stop && *first == '+' && first[1] != '-') ++first;  // from_chars takes no '+'
     float value = 0.f;
     const auto [ptr, ec] = std::from_chars(first, stop, value);
-    if (ec == std::errc::result_out_of_range) {
-      // Beyond float's range: infinite (check_finite names the element) or, below it, zero.
-      const std::string text(first, stop);
-      return std::strtof(text.c_str(), nullptr);
-    }
+    if (ec == std::errc::result_out_of_range) return out_of_float_range(first, stop);
     if (ec != std::errc() || ptr != stop)
       fail_line("cannot read '" + std::string(begin, std::min(stop, begin + 32)) + "' as a number");
     return value;
+  }
+
+  // A number std::from_chars found outside float's range (or, for some, in its subnormal
+  // range): through double, then rounded to float (infinite beyond it: check_finite names the
+  // element; a subnormal or zero below it); beyond double too, infinite or zero by the exponent's
+  // sign. No strtof: it reads the locale's decimal point.
+  float out_of_float_range(const char* first, const char* stop) const {
+    double value = 0.0;
+    const auto [ptr, ec] = std::from_chars(first, stop, value);
+    if (ec == std::errc() && ptr == stop) return float(value);
+    if (ec != std::errc::result_out_of_range || ptr != stop)
+      fail_line("cannot read '" + std::string(first, std::min(stop, first + 32)) + "' as a number");
+    const char* e = first;
+    while (e < stop && *e != 'e' && *e != 'E') ++e;
+    const float magnitude = e + 1 < stop && e[1] == '-' ? 0.f : std::numeric_limits<float>::infinity();
+    return *first == '-' ? -magnitude : magnitude;
   }
 
   // A corner's index at q, up to the next '/', blank or line end (q left there): 1-based, or

@@ -158,6 +158,11 @@ TEST(ObjReader, NumbersOfAnyExponentAndMalformedNumbers) {
   EXPECT_CONTAINS(obj_error("v 0 nan 0\n" + rest), "vertex 1: the position is not finite");
   EXPECT_EQ(obj_error("v 0 0 1e-0000000000000000000038\n" + rest), "");
   EXPECT_EQ(parse_obj("v 0 0 1e-99999999999\n" + rest, kName).mesh.positions[0], vec3(0, 0, 0));
+  // Below float's normal range: the subnormal nearest (through double), or a signed zero.
+  EXPECT_EQ(parse_obj("v 1e-40 -1e-50 0\n" + rest, kName).mesh.positions[0],
+            vec3(float(1e-40), -0.f, 0));
+  EXPECT_TRUE(std::signbit(parse_obj("v 0 -1e-50 0\n" + rest, kName).mesh.positions[0].y));
+  EXPECT_CONTAINS(obj_error("v 0 0 -1e400\n" + rest), "vertex 1: the position is not finite");
   // v's w (or a vertex colour) and anything after it are not read; missing coordinates are 0.
   EXPECT_EQ(obj_error("v 0 0 0 e99999999999\n" + rest), "");
   EXPECT_EQ(parse_obj("v 0.5 +2\n" + rest, kName).mesh.positions[0], vec3(0.5f, 2, 0));
