@@ -263,9 +263,29 @@ std::vector<Statements> read_statements(const std::string& bytes, const std::str
     }
     lines += read[i].lines;
   }
+  // The limits over the whole file (each part held them alone), before the parts are joined.
+  uint64_t sizes[4] = {0, 0, 0, 0};  // positions, normals, uvs, triangles
+  for (const Statements& part : read) {
+    sizes[0] += part.positions.size() / 3;
+    sizes[1] += part.normals.size() / 3;
+    sizes[2] += part.uvs.size() / 2;
+    sizes[3] += part.triangles;
+  }
+  const uint64_t max_vertices = uint64_t(limits.max_vertices);
+  if (sizes[0] > max_vertices)
+    fail(name, "more than " + std::to_string(max_vertices) + " vertex positions (the limit)");
+  if (sizes[1] > max_vertices)
+    fail(name, "more than " + std::to_string(max_vertices) + " normals (the vertex limit)");
+  if (sizes[2] > max_vertices)
+    fail(name, "more than " + std::to_string(max_vertices) + " uvs (the vertex limit)");
+  if (sizes[3] > uint64_t(limits.max_triangles))
+    fail(name, "more than " + std::to_string(limits.max_triangles) + " triangles (the limit)");
   // The parts' elements joined in the first part, each part keeping its own faces (the merge
   // walks them in order; copying a million triangles' corners costs more than the reading).
   Statements& all = read[0];
+  all.positions.reserve(3 * sizes[0]);
+  all.normals.reserve(3 * sizes[1]);
+  all.uvs.reserve(2 * sizes[2]);
   for (size_t i = 1; i < parts; ++i) {
     Statements& part = read[i];
     const int64_t base[3] = {int64_t(all.positions.size() / 3), int64_t(all.uvs.size() / 2),
@@ -286,16 +306,6 @@ std::vector<Statements> read_statements(const std::string& bytes, const std::str
     std::vector<float>().swap(part.normals);
     std::vector<float>().swap(part.uvs);
   }
-  // The limits over the whole file (each part held them alone).
-  const uint64_t max_vertices = uint64_t(limits.max_vertices);
-  if (all.positions.size() / 3 > max_vertices)
-    fail(name, "more than " + std::to_string(max_vertices) + " vertex positions (the limit)");
-  if (all.normals.size() / 3 > max_vertices)
-    fail(name, "more than " + std::to_string(max_vertices) + " normals (the vertex limit)");
-  if (all.uvs.size() / 2 > max_vertices)
-    fail(name, "more than " + std::to_string(max_vertices) + " uvs (the vertex limit)");
-  if (all.triangles > uint64_t(limits.max_triangles))
-    fail(name, "more than " + std::to_string(limits.max_triangles) + " triangles (the limit)");
   if (std::all_of(read.begin(), read.end(), [](const Statements& p) { return p.face_corners.empty(); }))
     fail(name, "the file has no faces");
   return read;
