@@ -218,7 +218,7 @@ class StatementReader {
   Statements out_;
 };
 
-// Files above this size are read in parts on several threads (below it a thread costs more
+// A part of a file read on threads has at least this many bytes (below it a thread costs more
 // than it saves).
 constexpr size_t kPartBytes = size_t(4) << 20;
 

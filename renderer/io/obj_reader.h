@@ -14,7 +14,7 @@
 
 namespace penumbra {
 
-// Throws MeshFileError. Files of several megabytes are read in parts on several threads.
+// Throws MeshFileError. A file of 8 MB or more is read in parts (of at least 4 MB) on threads.
 MeshFile parse_obj(std::string bytes, const std::string& name, const MeshFileLimits& limits = {});
 
 namespace obj_reader_detail {
