@@ -177,8 +177,8 @@ class Sampler {
   vec2 get_2d() {
     const DimensionScramble h = scramble(dimension_++);
     if (cmj_bits_) {
-      const uint32_t cell = cmj_cell(index_, cmj_bits_, h.index);
-      return vec2(fixed_to_unit_float(cmj_x(cell, cmj_bits_, h.x)), fixed_to_unit_float(cmj_y(cell, cmj_bits_, h.y)));
+      uint32_t cell;
+      return cmj_2d(h, &cell);
     }
     const uint32_t shuffled = shuffled_sample_index(index_, h.index);
     return vec2(scrambled_sobol_x(shuffled, h.x), scrambled_sobol_y(shuffled, h.y));
@@ -199,8 +199,8 @@ class Sampler {
     const DimensionScramble h1 = scramble(dimension_++);
     const DimensionScramble h2 = scramble(dimension_++);
     if (cmj_bits_) {
-      const uint32_t cell = cmj_cell(index_, cmj_bits_, h2.index);
-      *u2 = vec2(fixed_to_unit_float(cmj_x(cell, cmj_bits_, h2.x)), fixed_to_unit_float(cmj_y(cell, cmj_bits_, h2.y)));
+      uint32_t cell;
+      *u2 = cmj_2d(h2, &cell);
       *u1 = fixed_to_unit_float(cmj_z(cell, cmj_bits_, h1.x));
       return;
     }
@@ -243,6 +243,14 @@ class Sampler {
 
  private:
   static constexpr uint64_t kCachedDimensions = SamplerDimensionKeys::kCount;
+
+  // The correlated multi-jittered 2D point of the current sample in the dimension scrambled by h,
+  // and its cell (which a get_1d_2d pair's 1D value is stratified with: cmj_z).
+  vec2 cmj_2d(const DimensionScramble& h, uint32_t* cell) const {
+    *cell = cmj_cell(index_, cmj_bits_, h.index);
+    return vec2(fixed_to_unit_float(cmj_x(*cell, cmj_bits_, h.x)),
+                fixed_to_unit_float(cmj_y(*cell, cmj_bits_, h.y)));
+  }
 
   // A dimension's 64-bit hash a gives the index shuffle (low half) and the first coordinate's
   // scramble (high half); mix64(a) the second's.
