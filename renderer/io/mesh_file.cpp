@@ -2,8 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
+#include <optional>
 
+#include "renderer/io/file_bytes.h"
 #include "renderer/io/obj_reader.h"
 #include "renderer/io/ply_reader.h"
 
@@ -67,25 +68,6 @@ std::string lower_extension(const std::filesystem::path& path) {
   return ext;
 }
 
-// The size is checked before the buffer is allocated, and only that many bytes are read, so a
-// file that grows meanwhile cannot make this allocate more.
-std::string read_bytes(const std::filesystem::path& path, const std::string& name,
-                       int64_t max_bytes) {
-  std::ifstream file(path, std::ios::binary);
-  if (!file) mesh_file_detail::fail(name, "cannot open the file");
-  file.seekg(0, std::ios::end);
-  const std::streamoff size = file.tellg();
-  if (size < 0) mesh_file_detail::fail(name, "cannot read the file");
-  if (int64_t(size) > max_bytes)
-    mesh_file_detail::fail(name, "the file has " + std::to_string(size) + " bytes; at most " +
-                                     std::to_string(max_bytes) + " are allowed");
-  std::string bytes(size_t(size), '\0');
-  file.seekg(0);
-  file.read(bytes.data(), size);
-  if (file.gcount() != size) mesh_file_detail::fail(name, "cannot read the file");
-  return bytes;
-}
-
 }  // namespace
 
 bool is_mesh_file_name(const std::filesystem::path& path) {
@@ -98,8 +80,23 @@ MeshFile read_mesh_file(const std::filesystem::path& path, const std::string& na
   const std::string ext = lower_extension(path);
   if (ext != ".ply" && ext != ".obj")
     mesh_file_detail::fail(name, "unknown mesh file type '" + ext + "': expected .ply or .obj");
-  std::string bytes = read_bytes(path, name, limits.max_file_bytes);
-  return ext == ".ply" ? parse_ply(bytes, name, limits) : parse_obj(std::move(bytes), name, limits);
+  FileBytes bytes;
+  try {
+    bytes = FileBytes::map(path, limits.max_file_bytes);
+  } catch (const FileBytesError& e) {
+    mesh_file_detail::fail(name, e.what());
+  }
+  // A file that shrank while it was read (its lost bytes read as zeros) is reported as such,
+  // whatever the parser made of the zeros.
+  std::optional<MeshFile> out;
+  try {
+    out = ext == ".ply" ? parse_ply(bytes.view(), name, limits)
+                        : parse_obj(std::move(bytes), name, limits);  // released when read
+  } catch (const MeshFileError&) {
+    if (bytes.intact()) throw;
+  }
+  if (!bytes.intact()) mesh_file_detail::fail(name, "the file changed while it was read");
+  return std::move(*out);
 }
 
 }  // namespace penumbra

@@ -227,7 +227,7 @@ constexpr size_t kPartBytes = size_t(4) << 20;
 // The same statements as one piece gives, and for a file with one error the same
 // message (line numbers count from the file's start; with several errors, a limit exceeded only
 // by the parts together is reported after the other errors).
-std::vector<Statements> read_statements(const std::string& bytes, const std::string& name,
+std::vector<Statements> read_statements(std::string_view bytes, const std::string& name,
                                         const MeshFileLimits& limits, size_t parts) {
   const char* const data = bytes.data();
   const char* const end = data + bytes.size();
@@ -395,19 +395,20 @@ class VertexMerger {
 
 }  // namespace
 
-MeshFile parse_obj(std::string bytes, const std::string& name, const MeshFileLimits& limits) {
-  const size_t parts = std::clamp<size_t>(bytes.size() / kPartBytes, 1,
+MeshFile parse_obj(FileBytes&& bytes, const std::string& name, const MeshFileLimits& limits) {
+  const size_t parts = std::clamp<size_t>(bytes.view().size() / kPartBytes, 1,
                                           std::max(1u, std::thread::hardware_concurrency()));
   return obj_reader_detail::parse_obj_in_parts(std::move(bytes), name, limits, parts);
 }
 
-MeshFile obj_reader_detail::parse_obj_in_parts(std::string bytes, const std::string& name,
+MeshFile obj_reader_detail::parse_obj_in_parts(FileBytes&& bytes, const std::string& name,
                                                const MeshFileLimits& limits, size_t parts) {
-  if (int64_t(bytes.size()) > limits.max_file_bytes)
-    fail(name, "the file has " + std::to_string(bytes.size()) + " bytes; at most " +
+  if (int64_t(bytes.view().size()) > limits.max_file_bytes)
+    fail(name, "the file has " + std::to_string(bytes.view().size()) + " bytes; at most " +
                    std::to_string(limits.max_file_bytes));
-  const std::vector<Statements> parts_read = read_statements(bytes, name, limits, std::max<size_t>(parts, 1));
-  std::string().swap(bytes);  // not needed any more: lower the peak
+  const std::vector<Statements> parts_read =
+      read_statements(bytes.view(), name, limits, std::max<size_t>(parts, 1));
+  bytes.release();  // not needed any more: lower the peak
   const Statements& elements = parts_read.front();
 
   // Which attributes every corner has; attributes on some corners only are dropped.

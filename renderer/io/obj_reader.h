@@ -10,17 +10,20 @@
 // uv become distinct vertices.
 #include <string>
 
+#include "renderer/io/file_bytes.h"
 #include "renderer/io/mesh_file.h"
 
 namespace penumbra {
 
 // Throws MeshFileError. A file of 8 MB or more is read in parts (of at least 4 MB) on threads.
-MeshFile parse_obj(std::string bytes, const std::string& name, const MeshFileLimits& limits = {});
+// `bytes` is released once its statements are read (before the vertices are merged), to lower
+// the peak memory; the caller may still ask it whether it stayed intact.
+MeshFile parse_obj(FileBytes&& bytes, const std::string& name, const MeshFileLimits& limits = {});
 
 namespace obj_reader_detail {
 // parse_obj with the file read in `parts` pieces (for the tests and the fuzzer: any count gives
 // parse_obj's mesh).
-MeshFile parse_obj_in_parts(std::string bytes, const std::string& name, const MeshFileLimits& limits,
+MeshFile parse_obj_in_parts(FileBytes&& bytes, const std::string& name, const MeshFileLimits& limits,
                             size_t parts);
 }  // namespace obj_reader_detail
 
