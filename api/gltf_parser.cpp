@@ -1,45 +1,35 @@
 #include "api/gltf_parser.h"
 
-#include <cmath>
-#include <fstream>
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <new>
 
 #include "api/diagnostics.h"
+#include "renderer/io/file_bytes.h"
 
 namespace penumbra::api {
 namespace {
 
 namespace fs = std::filesystem;
 
-// Reads at most max_bytes (the size is checked before the buffer is allocated).
+// Reads at most max_bytes (the size is checked before anything is mapped or allocated), through
+// the mesh readers' FileBytes: the same messages, and a file that shrinks meanwhile is an error.
 bool read_capped(const fs::path& path, int64_t max_bytes, std::vector<uint8_t>* out,
                  std::string* reason) {
-  std::ifstream file(path, std::ios::binary);
-  if (!file) {
-    *reason = "cannot open the file";
+  try {
+    const FileBytes file = FileBytes::map(path, max_bytes);
+    const std::string_view bytes = file.view();
+    out->assign(bytes.begin(), bytes.end());
+    if (!file.intact()) {
+      *reason = "the file changed while it was read";
+      return false;
+    }
+    return true;
+  } catch (const FileBytesError& e) {
+    *reason = e.what();
     return false;
   }
-  file.seekg(0, std::ios::end);
-  const std::streamoff size = file.tellg();
-  if (size < 0) {
-    *reason = "cannot read the file";
-    return false;
-  }
-  if (int64_t(size) > max_bytes) {
-    *reason = "the file has " + std::to_string(size) + " bytes; at most " +
-              std::to_string(max_bytes) + " are allowed";
-    return false;
-  }
-  out->resize(size_t(size));
-  file.seekg(0);
-  file.read(reinterpret_cast<char*>(out->data()), size);
-  if (file.gcount() != size) {
-    *reason = "cannot read the file";
-    return false;
-  }
-  return true;
 }
 
 vec3 to_float(const glm::dvec3& v) { return vec3(float(v.x), float(v.y), float(v.z)); }
