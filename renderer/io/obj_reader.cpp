@@ -327,16 +327,19 @@ class VertexMerger {
         name_(name),
         limits_(limits),
         mesh_(mesh),
-        first_(attrib.positions.size() / 3, kNone) {}
+        first_(attrib.positions.size() / 3, First{kNone, 0, 0}) {}
 
   uint32_t vertex(const Corner& corner, int64_t face) {
     const int64_t p = check(corner.position, attrib_.positions.size() / 3, "vertex", face);
     const int64_t n =
         normals_ ? check(corner.normal, attrib_.normals.size() / 3, "normal", face) : -1;
     const int64_t t = uvs_ ? check(corner.uv, attrib_.uvs.size() / 2, "uv", face) : -1;
-    uint32_t& first = first_[size_t(p)];
-    if (first == kNone) return first = add(p, n, t);
-    if (key_of(first) == Key{p, n, t}) return first;
+    First& first = first_[size_t(p)];
+    if (first.vertex == kNone) {
+      first = {add(p, n, t), int32_t(n), int32_t(t)};
+      return first.vertex;
+    }
+    if (first.normal == int32_t(n) && first.uv == int32_t(t)) return first.vertex;
     const auto [it, inserted] = seams_.try_emplace(Key{p, n, t}, 0u);
     if (inserted) it->second = add(p, n, t);
     return it->second;
@@ -363,8 +366,6 @@ class VertexMerger {
     return index;
   }
 
-  Key key_of(uint32_t v) const { return sources_[v]; }
-
   uint32_t add(int64_t p, int64_t n, int64_t t) {
     if (int64_t(mesh_.positions.size()) >= std::min<int64_t>(limits_.max_vertices, kNone))
       fail(name_,
@@ -379,7 +380,6 @@ class VertexMerger {
       const auto& vt = attrib_.uvs;
       mesh_.uvs.emplace_back(vt[2 * size_t(t)], 1.f - vt[2 * size_t(t) + 1]);  // v flipped
     }
-    sources_.push_back({p, n, t});
     return uint32_t(mesh_.positions.size() - 1);
   }
 
@@ -388,8 +388,14 @@ class VertexMerger {
   const std::string& name_;
   const MeshFileLimits& limits_;
   MeshDesc& mesh_;
-  std::vector<uint32_t> first_;  // per position: the output vertex first made from it
-  std::vector<Key> sources_;     // per output vertex
+  // Per position: the output vertex first made from it and that vertex's normal and uv indices
+  // (-1 where the mesh has none), side by side so the common case -- a corner repeating its
+  // position's first triple -- reads one slot.
+  struct First {
+    uint32_t vertex;
+    int32_t normal, uv;
+  };
+  std::vector<First> first_;
   std::unordered_map<Key, uint32_t, KeyHash> seams_;
 };
 
