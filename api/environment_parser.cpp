@@ -42,9 +42,12 @@ std::optional<glm::mat3> parse_orientation(ObjectReader& reader, Diagnostics& di
   return glm::mat3(nearest_orthogonal(transform->linear));
 }
 
-// Reads the image named by "map" into `map` (linear RGB); false after reporting an error.
+// Reads the image named by "map" into `rgb` (linear RGB per texel, each value finite and >= 0, as
+// the light would clean it), its size into `map` and its largest value into `brightest`; false
+// after reporting an error.
 bool read_map(const std::string& relative, const AssetFolder& assets, EnvironmentMapDesc& map,
-              std::vector<AssetUse>* uses, Diagnostics& diag) {
+              std::vector<float>& rgb, float& brightest, std::vector<AssetUse>* uses,
+              Diagnostics& diag) {
   const std::string pointer = child_pointer(kPointer, "map");
   const auto path = resolve_asset_path(assets, relative, pointer, diag);
   if (!path) return false;
@@ -71,13 +74,23 @@ bool read_map(const std::string& relative, const AssetFolder& assets, Environmen
   if (!image.is_float) srgb_to_linear_in_place(image);
   map.width = image.width;
   map.height = image.height;
-  const size_t texels = size_t(image.width) * size_t(image.height);
-  map.rgb.resize(texels * 3);
+  const size_t count = size_t(image.width) * size_t(image.height);
   const int c = image.channels;
-  for (size_t i = 0; i < texels; ++i) {
-    const float* p = &image.pixels[i * size_t(c)];
-    // One or two channels: grey (and alpha, which an environment has no use for).
-    for (int k = 0; k < 3; ++k) map.rgb[i * 3 + size_t(k)] = c >= 3 ? p[k] : p[0];
+  if (c == 3) {
+    // The decoded image's own buffer (an 8192 x 4096 map is 400 MB: no copy of it).
+    rgb = std::move(image.pixels);
+  } else {
+    rgb.resize(count * 3);
+    for (size_t i = 0; i < count; ++i) {
+      const float* p = &image.pixels[i * size_t(c)];
+      // One or two channels: grey (and alpha, which an environment has no use for).
+      for (size_t k = 0; k < 3; ++k) rgb[i * 3 + k] = c >= 3 ? p[k] : p[0];
+    }
+  }
+  brightest = 0.f;
+  for (float& v : rgb) {
+    v = clean_texel(v);
+    brightest = std::max(brightest, v);
   }
   return true;
 }
@@ -114,10 +127,12 @@ bool parse_environment(const Json* value, const AssetFolder& assets, SceneInput&
   if (scale) map.scale = float(*scale);
   if (to_world) map.to_world = *to_world;
   // The file is checked even when other fields are wrong: validation reports every problem.
-  if (!file || !read_map(*file, assets, map, uses, diag) || diag.error_count() != errors_before)
+  std::vector<float> rgb;
+  float brightest = 0.f;
+  if (!file || !read_map(*file, assets, map, rgb, brightest, uses, diag) ||
+      diag.error_count() != errors_before)
     return false;
 
-  const float brightest = map.rgb.empty() ? 0.f : *std::max_element(map.rgb.begin(), map.rgb.end());
   // Scaled radiance must stay finite through the renderer's single-precision arithmetic, as
   // every other radiance in a scene (kMaxMagnitude).
   if (double(brightest) * map.scale > kMaxMagnitude) {
@@ -130,6 +145,12 @@ bool parse_environment(const Json* value, const AssetFolder& assets, SceneInput&
   if (!lit)
     r.warning("map", "the environment map is black (every texel is 0, or scale is 0): it emits "
                      "nothing");
+  // The scale applied here, as the light would (clean(texel x scale), in range by the check
+  // above), so the light shares these texels instead of making a scaled copy.
+  if (map.scale != 1.f)
+    for (float& v : rgb) v = clean_texel(v * map.scale);
+  map.scale = 1.f;
+  map.rgb = std::make_shared<const std::vector<float>>(std::move(rgb));
   scene.environment_map = std::move(map);
   return lit;
 }

@@ -110,7 +110,13 @@ class EnvironmentMap final : public EnvironmentLight {
   Corners corners(int x, int y) const;
   // One corner weight: texel (x, y)'s max(luminance - floor_, 0) x its row's sin(theta).
   float corner(int x, int y) const;
-  const Spectrum& texel(int x, int y) const { return texels_[size_t(y) * size_t(width_) + size_t(x)]; }
+  const float* texel_address(int x, int y) const {
+    return texels_ + (size_t(y) * size_t(width_) + size_t(x)) * 3;
+  }
+  Spectrum texel(int x, int y) const {
+    const float* t = texel_address(x, y);
+    return Spectrum(t[0], t[1], t[2]);
+  }
   // The compensated twin of `full`: its texels shared, its density over max(L - floor, 0).
   EnvironmentMap(const EnvironmentMap& full, float floor);
   // The sampling distribution over the cells' corners (with floor_ subtracted), built on first
@@ -119,9 +125,10 @@ class EnvironmentMap final : public EnvironmentLight {
   void build_distribution() const;
 
   int width_ = 1, height_ = 2;      // height >= 2: rows are samples from pole to pole
-  // The texels times scale, shared by the map and its compensated twin; texels_ points into it.
-  std::shared_ptr<const std::vector<Spectrum>> texel_store_;
-  const Spectrum* texels_ = nullptr;
+  // The texels times scale, shared by the map and its compensated twin (and, where scale is 1
+  // and they are clean, with the scene input's map); texels_ points into it.
+  std::shared_ptr<const std::vector<float>> texel_store_;  // RGB per texel
+  const float* texels_ = nullptr;
   // The luminance the sampling density leaves out: 0, or the map's mean for the compensated twin.
   float floor_ = 0.f;
   bool sampled_nowhere_ = false;

@@ -174,14 +174,26 @@ float Distribution1D::sample(float u, float* pdf, int* cell) const {
 float Distribution1D::pdf(float x) const { return cell_pdf(cell_of(x, int32_t(pdf_.size()))); }
 
 Distribution2D::Distribution2D(std::span<const float> weights, int nu, int nv)
+    : Distribution2D(nu, nv, [&](int j, std::span<float> out) {
+        // A row past the end of `weights` weighs 0.
+        const size_t begin = size_t(j) * out.size();
+        for (size_t i = 0; i < out.size(); ++i)
+          out[i] = begin + out.size() <= weights.size() ? weights[begin + i] : 0.f;
+      }) {}
+
+Distribution2D::Distribution2D(int nu, int nv, const std::function<void(int, std::span<float>)>& row_weights)
     : nu_(std::max(nu, 1)), nv_(std::max(nv, 1)) {
   std::vector<float> row_integrals(static_cast<size_t>(nv_));
+  // Each cell's density within its row; multiplied by its row's marginal density in place below,
+  // it becomes pdf_ (an 8192 x 4096 map's table is 134 MB: one array, not two).
   std::vector<float> row_pdfs(size_t(nu_) * size_t(nv_));
-  const std::vector<float> missing(size_t(nu_), 0.f);  // a row past the end of `weights` weighs 0
+  std::vector<float> row(static_cast<size_t>(nu_));
+  // Reserved whole (the guide's size depends on nu alone), so the tables never grow by copying.
+  cdf_.reserve(size_t(nv_) * size_t(nu_ + 1));
+  guide_.reserve(size_t(nv_) * (std::max<size_t>(std::bit_ceil(size_t(nu_)) / 4, 1) + 1));
   for (int j = 0; j < nv_; ++j) {
     const size_t begin = size_t(j) * size_t(nu_);
-    const std::span<const float> row =
-        begin + size_t(nu_) <= weights.size() ? weights.subspan(begin, size_t(nu_)) : std::span<const float>(missing);
+    row_weights(j, row);
     // Each row built as a Distribution1D of its own, then copied into the flat arrays: the same
     // numbers, so the same samples, as one object per row.
     const Distribution1D d(row);
@@ -193,11 +205,11 @@ Distribution2D::Distribution2D(std::span<const float> weights, int nu, int nv)
   }
   marginal_ = Distribution1D(row_integrals);
   search_steps_ = search_steps(guide_, buckets_);
-  pdf_.resize(row_pdfs.size());
+  pdf_ = std::move(row_pdfs);
   for (int j = 0; j < nv_; ++j)
     for (int i = 0; i < nu_; ++i) {
       const size_t c = size_t(j) * size_t(nu_) + size_t(i);
-      pdf_[c] = marginal_.cell_pdf(j) * row_pdfs[c];
+      pdf_[c] = marginal_.cell_pdf(j) * pdf_[c];
     }
 }
 

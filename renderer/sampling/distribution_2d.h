@@ -15,6 +15,7 @@
 // the pdf must reject pdf == 0; nothing here divides by zero.
 #include <algorithm>
 #include <cstddef>
+#include <functional>
 #include <span>
 #include <vector>
 
@@ -81,6 +82,10 @@ class Distribution2D {
   // [i/nu, (i+1)/nu) x [j/nv, (j+1)/nv). A marginal distribution picks the row (v), then that
   // row's conditional distribution picks u.
   Distribution2D(std::span<const float> weights, int nu, int nv);
+  // The same from the rows' weights as `row(j, out)` writes them (out has nu cells), called once
+  // per row in order: a caller that computes its weights row by row needs no nu x nv array (an
+  // 8192 x 4096 environment map's would be 134 MB).
+  Distribution2D(int nu, int nv, const std::function<void(int, std::span<float>)>& row);
 
   int nu() const { return nu_; }
   int nv() const { return nv_; }

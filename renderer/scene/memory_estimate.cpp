@@ -41,20 +41,23 @@ void add_mesh(const MeshDesc& mesh, bool emissive, bool moving, MemoryEstimate& 
   e.embree_build_peak += triangles * kBvhBuildExtraPerTriangle;
 }
 
-// An environment map: its texels in the input, and in the light (lights/environment_map.h) the
-// scaled texels and one sampling distribution (sampling/distribution_2d.h; the full map's or the
+// An environment map: its texels in the input, and in the light (lights/environment_map.h) a
+// scaled copy of them unless it shares the input's (scale 1 and two rows or more, as the api's
+// maps; the light also copies texels that are not clean, which the api's never are) and one
+// sampling distribution (sampling/distribution_2d.h; the full map's or the
 // path integrator's compensated twin's, whichever the render samples: each is built on first
 // use): per texel a density and a CDF entry, per four texels a guide entry (a row of w texels
 // has bit_ceil(w) / 4 + 1), per row sin(theta) and the marginal's entries.
 void add_environment_map(const EnvironmentMapDesc& map, MemoryEstimate& e) {
   const int64_t w = std::max(map.width, 0), h = std::max(map.height, 0);
-  const int64_t texels = w * h, texel_bytes = int64_t(sizeof(Spectrum));
+  const int64_t texels = w * h, texel_bytes = 3 * int64_t(sizeof(float));
   e.scene_input += texels * texel_bytes;
   const int64_t guide_per_row =
       (int64_t(std::bit_ceil(uint64_t(std::max<int64_t>(w, 1)))) / 4 + 1) * 4;
   // The row's extra CDF entry, guide, sin(theta), the marginal's entries.
   const int64_t row_bytes = 4 + guide_per_row + 4 + 9;
-  e.shapes += texels * (texel_bytes + 4 + 4) + h * row_bytes;
+  const bool shared = map.scale == 1.f && h >= 2;
+  e.shapes += texels * ((shared ? 0 : texel_bytes) + 4 + 4) + h * row_bytes;
 }
 
 }  // namespace

@@ -3,6 +3,8 @@
 // api/ produces it from JSON (applying object transforms) and places the origin at the camera
 // position, computed in double precision, so single-precision rendering keeps its accuracy for
 // scenes far from the JSON origin; tests may build it directly.
+#include <cmath>
+#include <memory>
 #include <optional>
 #include <string>
 #include <variant>
@@ -76,11 +78,20 @@ using LightDesc = std::variant<PointLightDesc, DirectionalLightDesc>;
 // An environment from an equirectangular (latitude-longitude) image, with Mitsuba 3's `envmap`
 // conventions: in map space, direction (x, y, z) looks up u = atan2(x, -z) / 2 pi (mod 1),
 // v = acos(y) / pi, so +y is the top row, +z the centre column, -z the left and right edges.
+// What an environment map's light makes of a texel value: itself if finite and > 0, else +0.
+inline float clean_texel(float v) { return std::isfinite(v) && v > 0.f ? v : 0.f; }
+
 struct EnvironmentMapDesc {
   int width = 0;                // texels per row (>= 1)
   int height = 0;               // rows (>= 1)
-  std::vector<float> rgb;       // width * height * 3 linear radiance values, row 0 = top (+y)
-  float scale = 1.f;            // multiplies every texel
+  // width * height * 3 linear radiance values (RGB per texel), row 0 = top (+y). Shared, not
+  // copied: a render scene reads them in place where it can (scale 1, every value finite and
+  // >= 0, at least two rows), so an 8192 x 4096 map (400 MB) is held once, not once here and once
+  // in the light; the api moves the decoded image's own buffer here.
+  std::shared_ptr<const std::vector<float>> rgb;
+  // Multiplies every texel. The api applies the scene's "scale" to the texels as it reads the
+  // image and leaves 1 here, so the light can share them.
+  float scale = 1.f;
   glm::mat3 to_world{1.f};      // orthogonal: map space -> world (a rotation, maybe a mirror)
   // For bench/environment_sampling_benchmark.cpp only: sample directions uniformly instead of
   // in proportion to the map (the api never sets it).

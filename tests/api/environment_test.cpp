@@ -54,10 +54,11 @@ TEST_F(EnvironmentField, MapIsReadWithDefaults) {
   const EnvironmentMapDesc& m = *in.environment_map;
   EXPECT_EQ(m.width, 4);
   EXPECT_EQ(m.height, 2);
-  ASSERT_EQ(m.rgb.size(), 4u * 2u * 3u);
+  ASSERT_TRUE(m.rgb);
+  ASSERT_EQ(m.rgb->size(), 4u * 2u * 3u);
   // Row 0 of the file is the top row: texel (3, 1) = (3, 1, 1).
-  EXPECT_EQ(m.rgb[(1 * 4 + 3) * 3 + 0], 3.f);
-  EXPECT_EQ(m.rgb[(1 * 4 + 3) * 3 + 1], 1.f);
+  EXPECT_EQ((*m.rgb)[(1 * 4 + 3) * 3 + 0], 3.f);
+  EXPECT_EQ((*m.rgb)[(1 * 4 + 3) * 3 + 1], 1.f);
   EXPECT_EQ(m.scale, 1.f);
   EXPECT_EQ(m.to_world, glm::mat3(1.f));
   EXPECT_FALSE(m.uniform_sampling);
@@ -68,7 +69,10 @@ TEST_F(EnvironmentField, ScaleAndRotateAreApplied) {
       R"({"map": "maps/sky.exr", "scale": 2.5, "rotate": {"axis": [0, 1, 0], "degrees": 90}})"));
   ASSERT_TRUE(r.ok()) << describe(r.errors);
   const EnvironmentMapDesc& m = *r.request->scene.environment_map;
-  EXPECT_EQ(m.scale, 2.5f);
+  // The scale is applied to the texels (so the light can share them) and the map's is 1.
+  EXPECT_EQ(m.scale, 1.f);
+  EXPECT_EQ((*m.rgb)[(1 * 4 + 3) * 3 + 0], 3.f * 2.5f);
+  EXPECT_EQ((*m.rgb)[(1 * 4 + 3) * 3 + 1], 1.f * 2.5f);
   // Right-handed about +y: the map's centre column (+z) faces +x.
   const vec3 z = m.to_world * vec3(0, 0, 1);
   EXPECT_NEAR(z.x, 1.f, 1e-6f);
@@ -170,7 +174,7 @@ TEST_F(EnvironmentField, IntegerImagesAreLinearised) {
   write_image_file((folder_.root / "grey.png").string(), grey);  // stored as sRGB 188/255
   const LoadResult r = load_with({{"map", "grey.png"}});
   ASSERT_TRUE(r.ok()) << describe(r.errors);
-  EXPECT_NEAR(r.request->scene.environment_map->rgb[0], 0.5f, 0.005f);
+  EXPECT_NEAR((*r.request->scene.environment_map->rgb)[0], 0.5f, 0.005f);
 }
 
 TEST(EnvironmentSchema, DocumentsEveryField) {

@@ -4,6 +4,8 @@
 // MIS-compensated twin the path integrator samples (a density over max(L - mean L, 0)).
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include <glm/gtc/matrix_transform.hpp>
 #include <memory>
 #include <vector>
@@ -22,10 +24,11 @@ EnvironmentMapDesc make_map(int width, int height, F f) {
   EnvironmentMapDesc d;
   d.width = width;
   d.height = height;
-  d.rgb.resize(size_t(width) * height * 3);
+  auto rgb = std::make_shared<std::vector<float>>(size_t(width) * height * 3);
   for (int y = 0; y < height; ++y)
     for (int x = 0; x < width; ++x)
-      for (int c = 0; c < 3; ++c) d.rgb[(size_t(y) * width + x) * 3 + c] = f(x, y);
+      for (int c = 0; c < 3; ++c) (*rgb)[(size_t(y) * width + x) * 3 + c] = f(x, y);
+  d.rgb = std::move(rgb);
   return d;
 }
 
@@ -41,7 +44,7 @@ glm::mat3 rotation(float degrees, const vec3& axis) {
   return glm::mat3(glm::rotate(glm::mat4(1.f), glm::radians(degrees), axis));
 }
 
-float value(const EnvironmentMapDesc& d, int x, int y) { return d.rgb[(size_t(y) * d.width + x) * 3]; }
+float value(const EnvironmentMapDesc& d, int x, int y) { return (*d.rgb)[(size_t(y) * d.width + x) * 3]; }
 
 TEST(EnvironmentMap, OrientationMatchesMitsubaEnvmap) {
   // Odd width: +z lands on a texel centre. Rows: 0 at +y, 2 at the horizon, 4 at -y.
@@ -330,6 +333,43 @@ TEST(EnvironmentMap, ScaleAppliesToRadianceSamplesAndPower) {
   EXPECT_TRUE(is_finite(ls.value / ls.pdf));
   EXPECT_GT(ls.value.x, 0.f);
   EXPECT_LE(ls.value.x, kTexel * kScale * 1.0001f);
+}
+
+// The light reads the scene input's texels in place where they are final (scale 1, clean, two
+// rows or more: the api's maps) and makes its own scaled, cleaned copy otherwise; either way a
+// map and its pre-scaled twin give the same radiance and density to the bit.
+TEST(EnvironmentMap, SharesTheInputsTexelsWhereTheyAreFinal) {
+  const auto f = [](int x, int y) { return 0.25f + 0.5f * float(x) + float(y * y) + (x == 5) * 40.f; };
+  EnvironmentMapDesc final_map = make_map(16, 8, f);
+  {
+    const EnvironmentMap map(final_map);
+    EXPECT_EQ(final_map.rgb.use_count(), 2);  // shared
+  }
+  EnvironmentMapDesc scaled = make_map(16, 8, [&](int x, int y) { return f(x, y) / 4.f; });
+  scaled.scale = 4.f;
+  const auto copies = [](const EnvironmentMapDesc& d) {
+    const EnvironmentMap map(d);
+    return d.rgb.use_count() == 1;
+  };
+  EXPECT_TRUE(copies(scaled));
+  EnvironmentMapDesc one_row = make_map(16, 1, f);
+  EXPECT_TRUE(copies(one_row));
+  for (const float bad : {-1.f, -0.f, std::numeric_limits<float>::quiet_NaN(),
+                          std::numeric_limits<float>::infinity()}) {
+    EnvironmentMapDesc unclean = make_map(16, 8, f);
+    auto rgb = std::make_shared<std::vector<float>>(*unclean.rgb);
+    (*rgb)[37 * 3 + 1] = bad;
+    unclean.rgb = std::move(rgb);
+    EXPECT_TRUE(copies(unclean)) << bad;
+  }
+  // Shared or copied, the same light: f / 4 x 4 is f exactly (powers of two).
+  const EnvironmentMap shared(final_map), copied(scaled);
+  for (int i = 0; i < 200; ++i) {
+    const vec3 d = EnvironmentMap::uv_to_direction(vec2((float(i) + 0.3f) / 200.f, (float(i % 17) + 0.5f) / 17.f));
+    float pdf_shared = 0.f, pdf_copied = 0.f;
+    EXPECT_EQ(shared.radiance_and_pdf(d, &pdf_shared), copied.radiance_and_pdf(d, &pdf_copied));
+    EXPECT_EQ(pdf_shared, pdf_copied);
+  }
 }
 
 TEST(EnvironmentMap, OneTexelMapIsConstant) {

@@ -21,10 +21,11 @@ EnvironmentMapDesc make_map(int width, int height, F f) {
   EnvironmentMapDesc d;
   d.width = width;
   d.height = height;
-  d.rgb.resize(size_t(width) * height * 3);
+  auto rgb = std::make_shared<std::vector<float>>(size_t(width) * height * 3);
   for (int y = 0; y < height; ++y)
     for (int x = 0; x < width; ++x)
-      for (int c = 0; c < 3; ++c) d.rgb[(size_t(y) * width + x) * 3 + c] = f(x, y, c);
+      for (int c = 0; c < 3; ++c) (*rgb)[(size_t(y) * width + x) * 3 + c] = f(x, y, c);
+  d.rgb = std::move(rgb);
   return d;
 }
 

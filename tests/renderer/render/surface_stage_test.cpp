@@ -129,11 +129,13 @@ SceneInput floor_scene(Lights lights, const MaterialParams& material) {
   EnvironmentMapDesc map;
   map.width = 32;
   map.height = 16;
+  auto rgb = std::make_shared<std::vector<float>>();
   for (int y = 0; y < map.height; ++y)
     for (int x = 0; x < map.width; ++x)
       for (int c = 0; c < 3; ++c)
-        map.rgb.push_back((x > 20 && x < 24 && y > 3 && y < 6) ? 40.f + float(c)
-                                                                  : 0.05f * float(x + y + c));
+        rgb->push_back((x > 20 && x < 24 && y > 3 && y < 6) ? 40.f + float(c)
+                                                               : 0.05f * float(x + y + c));
+  map.rgb = std::move(rgb);
   map.scale = 0.7f;
   in.environment_map = map;
   ObjectDesc moving = quad_object({-0.5f, 2, -0.5f}, {1, 0, 0}, {0, 0, 1}, 1, Spectrum(5.f));

@@ -88,7 +88,8 @@ TEST(MemoryEstimate, InstancesAddPerCopyAndOneBvhPerMesh) {
 }
 
 // An environment map's texels count in the input and, with its sampling tables (density, CDF
-// and a guide entry per four texels), in the light: about 12 + 21 bytes per texel.
+// and a guide entry per four texels), in the light: about 12 + 21 bytes per texel, or 12 + 9
+// where the light shares the input's texels (scale 1, as the api leaves every map).
 TEST(MemoryEstimate, EnvironmentMapTexelsAndSamplingTables) {
   SceneInput scene;
   RenderSettings settings;
@@ -98,7 +99,8 @@ TEST(MemoryEstimate, EnvironmentMapTexelsAndSamplingTables) {
   EnvironmentMapDesc map;
   map.width = 1024;
   map.height = 512;
-  map.rgb.assign(size_t(1024 * 512 * 3), 1.f);
+  map.rgb = std::make_shared<const std::vector<float>>(size_t(1024 * 512 * 3), 1.f);
+  map.scale = 0.5f;
   scene.environment_map = map;
   const MemoryEstimate e = estimate_memory(scene, settings);
   const int64_t texels = 1024 * 512;
@@ -108,6 +110,11 @@ TEST(MemoryEstimate, EnvironmentMapTexelsAndSamplingTables) {
   EXPECT_GE(e.shapes - none.shapes, texels * 21);
   EXPECT_LE(e.shapes - none.shapes, texels * 22);
   EXPECT_EQ(e.embree, none.embree);
+  // Scale 1: the light reads the input's texels.
+  scene.environment_map->scale = 1.f;
+  const MemoryEstimate shared = estimate_memory(scene, settings);
+  EXPECT_GE(shared.shapes - none.shapes, texels * 9);
+  EXPECT_LE(shared.shapes - none.shapes, texels * 10);
 }
 
 }  // namespace

@@ -73,7 +73,8 @@ TEST(SceneFeatures, PathIntegratorLeavesOnlyTheConstantEnvironmentOut) {
   EnvironmentMapDesc map;
   map.width = 4;
   map.height = 2;
-  map.rgb = {1, 1, 1, 9, 9, 9, 1, 1, 1, 1, 1, 1, 2, 2, 2, 1, 1, 1, 1, 1, 1, 1, 1, 1};
+  map.rgb = std::make_shared<const std::vector<float>>(
+      std::vector<float>{1, 1, 1, 9, 9, 9, 1, 1, 1, 1, 1, 1, 2, 2, 2, 1, 1, 1, 1, 1, 1, 1, 1, 1});
   mapped.environment_map = map;
   const auto with_map = Scene::build(mapped);
   EXPECT_TRUE(with_map->features().mis_lights);
