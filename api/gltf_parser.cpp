@@ -22,7 +22,7 @@ bool read_capped(const fs::path& path, int64_t max_bytes, std::vector<uint8_t>* 
     const std::string_view bytes = file.view();
     out->assign(bytes.begin(), bytes.end());
     if (!file.intact()) {
-      *reason = "the file changed while it was read";
+      *reason = "the file changed while it was read (or a part of it could not be read)";
       return false;
     }
     return true;

@@ -16,7 +16,8 @@ namespace {
 //
 // Each live mapping holds a slot with its address range. A SIGBUS whose address lies in a slot's
 // range is a page the file no longer has (it was truncated after it was mapped; Linux sends
-// SIGBUS for the pages of a file mapping past the file's end): the handler maps anonymous zero
+// SIGBUS for the pages of a file mapping past the file's end) or one the kernel could not read
+// from the disk: the handler maps anonymous zero
 // pages over the rest of the range, marks the slot and returns, so the faulting read is repeated
 // and reads zeros. Any other SIGBUS goes to the handler installed before ours, or ends the
 // process as the default action does. The handler reads only atomics and calls mmap, signal and
@@ -65,7 +66,9 @@ void install_guard() {
   action.sa_sigaction = on_sigbus;
   action.sa_flags = SA_SIGINFO | SA_ONSTACK;
   sigemptyset(&action.sa_mask);
-  sigaction(SIGBUS, &action, &g_previous);
+  // The handler before ours recorded first, so a SIGBUS arriving as ours is installed finds it.
+  sigaction(SIGBUS, nullptr, &g_previous);
+  sigaction(SIGBUS, &action, nullptr);
 }
 
 int claim_slot(uintptr_t begin, uintptr_t end) {

@@ -40,8 +40,8 @@ class FileBytes {
   static FileBytes map(const std::filesystem::path& path, int64_t max_bytes);
 
   std::string_view view() const { return view_; }
-  // False once a page of the mapping was found gone (the file shrank while mapped; those bytes
-  // read as zeros). Kept after release().
+  // False once a page of the mapping was found gone (the file shrank while mapped, or the page
+  // could not be read from the disk; those bytes read as zeros). Kept after release().
   bool intact() const;
   // Unmaps or frees the bytes (view() is empty afterwards), e.g. to lower the peak memory once
   // a parser has what it needs.

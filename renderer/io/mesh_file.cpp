@@ -86,8 +86,8 @@ MeshFile read_mesh_file(const std::filesystem::path& path, const std::string& na
   } catch (const FileBytesError& e) {
     mesh_file_detail::fail(name, e.what());
   }
-  // A file that shrank while it was read (its lost bytes read as zeros) is reported as such,
-  // whatever the parser made of the zeros.
+  // A file that shrank while it was read, or whose pages could not be read from the disk (those
+  // bytes read as zeros), is reported as such, whatever the parser made of the zeros.
   std::optional<MeshFile> out;
   try {
     out = ext == ".ply" ? parse_ply(bytes.view(), name, limits)
@@ -95,7 +95,8 @@ MeshFile read_mesh_file(const std::filesystem::path& path, const std::string& na
   } catch (const MeshFileError&) {
     if (bytes.intact()) throw;
   }
-  if (!bytes.intact()) mesh_file_detail::fail(name, "the file changed while it was read");
+  if (!bytes.intact())
+    mesh_file_detail::fail(name, "the file changed while it was read (or a part of it could not be read)");
   return std::move(*out);
 }
 
