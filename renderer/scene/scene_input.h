@@ -75,12 +75,12 @@ struct DirectionalLightDesc {
 };
 using LightDesc = std::variant<PointLightDesc, DirectionalLightDesc>;
 
-// An environment from an equirectangular (latitude-longitude) image, with Mitsuba 3's `envmap`
-// conventions: in map space, direction (x, y, z) looks up u = atan2(x, -z) / 2 pi (mod 1),
-// v = acos(y) / pi, so +y is the top row, +z the centre column, -z the left and right edges.
 // What an environment map's light makes of a texel value: itself if finite and > 0, else +0.
 inline float clean_texel(float v) { return std::isfinite(v) && v > 0.f ? v : 0.f; }
 
+// An environment from an equirectangular (latitude-longitude) image, with Mitsuba 3's `envmap`
+// conventions: in map space, direction (x, y, z) looks up u = atan2(x, -z) / 2 pi (mod 1),
+// v = acos(y) / pi, so +y is the top row, +z the centre column, -z the left and right edges.
 struct EnvironmentMapDesc {
   int width = 0;                // texels per row (>= 1)
   int height = 0;               // rows (>= 1)
