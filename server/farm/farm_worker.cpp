@@ -65,11 +65,12 @@ constexpr const char* kJobBackToQueue =
 
 // The render statistics of several tasks of one job as the job's "stats": times, rays and samples
 // added up (seconds is render time summed over the workers, not wall time), the least and most
-// sampled pixel over all, the mean weighted by pixels.
+// sampled pixel over all, the mean weighted by pixels; scene_builds: the tasks that read and built
+// the scene (one per worker process that took part, unless a slot ran out of work in between).
 nlohmann::json sum_task_stats(const std::vector<nlohmann::json>& parts) {
   double seconds_sum = 0, build = 0, spp_weighted = 0, pixels = 0;
   uint64_t rays = 0, camera_samples = 0;
-  int spp_min = 0, spp_max = 0, threads = 0;
+  int spp_min = 0, spp_max = 0, threads = 0, scene_builds = 0;
   bool stopped = false;
   for (std::size_t i = 0; i < parts.size(); ++i) {
     const nlohmann::json& p = parts[i];
@@ -85,6 +86,7 @@ nlohmann::json sum_task_stats(const std::vector<nlohmann::json>& parts) {
     pixels += px;
     stopped = stopped || p.value("stopped_by_time_limit", false);
     threads = std::max(threads, p.value("threads", 0));
+    if (!p.value("scene_reused", true)) ++scene_builds;
   }
   return nlohmann::ordered_json{{"seconds", seconds_sum},
                                 {"build_seconds", build},
@@ -96,7 +98,8 @@ nlohmann::json sum_task_stats(const std::vector<nlohmann::json>& parts) {
                                 {"camera_samples", camera_samples},
                                 {"stopped_by_time_limit", stopped},
                                 {"threads", threads},
-                                {"tasks", parts.size()}};
+                                {"tasks", parts.size()},
+                                {"scene_builds", scene_builds}};
 }
 
 std::vector<nlohmann::json> task_stats(PgConnection& db, const std::string& job,
@@ -157,6 +160,7 @@ void FarmWorker::join() {
 
 void FarmWorker::slot_loop() {
   std::unique_ptr<PgConnection> db;
+  KeptScene kept;
   while (!stopping_) {
     try {
       if (!db) {
@@ -165,7 +169,7 @@ void FarmWorker::slot_loop() {
       }
       reap_expired(*db);
       if (auto c = claim(*db)) {
-        run(*db, *c);
+        run(*db, *c, kept);
         continue;  // look again at once: more work may be queued
       }
       if (claimable_tasks_locked(*db)) {
@@ -176,6 +180,8 @@ void FarmWorker::slot_loop() {
         std::this_thread::sleep_for(std::chrono::milliseconds(5 + std::rand() % 20));
         continue;
       }
+      // Out of work: the last task's scene is not kept while the slot waits.
+      kept = {};
       db->exec("UPDATE workers SET heartbeat_at = now() WHERE id = $1", {id_});
       db->wait_notification(kFallbackPollSeconds);
     } catch (const StoreError& e) {
@@ -438,7 +444,24 @@ RenderOutcome FarmWorker::merge_tiles(PgConnection& db, const Claim& c, JobRunti
   return out;
 }
 
-void FarmWorker::run(PgConnection& db, const Claim& c) {
+RenderOutcome FarmWorker::render_piece(const Claim& c, const RenderJobOptions& options,
+                                       JobRuntime& runtime, KeptScene& kept) {
+  const std::string key = scene_cache_key(c.job, c.piece.frame);
+  // Another scene's: let it go before this one is read and built, unless another task holds it.
+  if (kept.key != key) kept = {};
+  const SceneCache::Lookup scene = scenes_.get(key, [&](std::string& error) {
+    return prepare_piece_scene(c.scene, options, c.piece, error);
+  });
+  if (!scene.scene) {
+    RenderOutcome failed;
+    failed.error = scene.error;
+    return failed;
+  }
+  kept = {key, scene.scene};
+  return render_farm_piece(*scene.scene, !scene.reused, options, runtime, c.piece);
+}
+
+void FarmWorker::run(PgConnection& db, const Claim& c, KeptScene& kept) {
   auto runtime = std::make_shared<JobRuntime>();
   {
     std::lock_guard lock(runtimes_mutex_);
@@ -458,12 +481,13 @@ void FarmWorker::run(PgConnection& db, const Claim& c) {
     options.assets.root.clear();
   RenderOutcome outcome;
   try {
+    if (c.kind == "merge" || c.kind == "job") kept = {};  // no piece of a kept scene
     if (c.kind == "merge")
       outcome = merge_tiles(db, c, *runtime);
     else if (c.kind == "job")
       outcome = run_render_job(c.scene, options, *runtime);
     else
-      outcome = render_farm_piece(c.scene, options, *runtime, c.piece);
+      outcome = render_piece(c, options, *runtime, kept);
   } catch (const std::exception& e) {
     outcome.kind = RenderOutcome::Kind::kFailed;
     outcome.error = std::string(c.kind == "merge" ? "cannot merge the tiles: "

@@ -14,6 +14,7 @@
 
 #include "server/farm/farm_tasks.h"
 #include "server/farm/pg_connection.h"
+#include "server/farm/scene_cache.h"
 #include "server/jobs/job_runtime.h"
 #include "server/jobs/render_task.h"
 #include "server/metrics.h"
@@ -43,13 +44,21 @@ class FarmWorker {
     int width = 0, height = 0;  // the job's frame
     int attempt = 0;
   };
+  // The scene a slot keeps from its last task for its next (scene_cache.h).
+  struct KeptScene {
+    std::string key;
+    std::shared_ptr<const PreparedScene> scene;
+  };
   void slot_loop();
   // Returns the tasks of expired leases to the queue; the number returned.
   int reap_expired(PgConnection& db);
   // True when queued tasks of live jobs exist that the last claim passed over (locked rows).
   bool claimable_tasks_locked(PgConnection& db);
   std::optional<Claim> claim(PgConnection& db);
-  void run(PgConnection& db, const Claim& claim);
+  void run(PgConnection& db, const Claim& claim, KeptScene& kept);
+  // A tile's or frame's render, from the job's scene as this worker prepared it once.
+  RenderOutcome render_piece(const Claim& claim, const RenderJobOptions& options,
+                             JobRuntime& runtime, KeptScene& kept);
   // A split frame's last step: the committed tiles merged (bit for bit the single-machine
   // image), denoised if the job asks, stored as the job's result; RenderOutcome as a render's.
   RenderOutcome merge_tiles(PgConnection& db, const Claim& claim, JobRuntime& runtime);
@@ -71,6 +80,7 @@ class FarmWorker {
   std::mutex runtimes_mutex_;
   std::vector<std::shared_ptr<JobRuntime>> runtimes_;
   std::vector<std::thread> slots_;
+  SceneCache scenes_;
 };
 
 }  // namespace penumbra::server

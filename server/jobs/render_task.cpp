@@ -44,34 +44,38 @@ struct FrameProgressMap {
   }
 };
 
-// One frame (or a still): build the scene, render it with the time limit counted from `started`.
 }  // namespace
 
-RenderOutcome render_request(const api::SceneRequest& request, const RenderJobOptions& options,
-                             std::chrono::steady_clock::time_point started, JobRuntime& runtime,
-                             const ProgressMap& progress_map) {
-  const ProgressMap map =
-      progress_map ? progress_map : ProgressMap([](const RenderProgress& p) { return p; });
-  RenderOutcome out;
-  RenderSettings settings = request.settings;
-  settings.threads = options.threads;
-  if (options.max_render_seconds > 0)
-    settings.time_limit = settings.time_limit > 0
-                              ? std::min(settings.time_limit, options.max_render_seconds)
-                              : options.max_render_seconds;
-  out.settings = settings;
-
+BuiltScene build_request_scene(const api::SceneRequest& request) {
+  BuiltScene out;
   const auto build_start = std::chrono::steady_clock::now();
-  std::unique_ptr<Scene> scene;
   try {
-    scene = Scene::build(request.scene);
-    scene->prepare_sampling(settings.integrator);
+    std::unique_ptr<Scene> scene = Scene::build(request.scene);
+    scene->prepare_sampling(request.settings.integrator);
+    out.scene = std::move(scene);
   } catch (const SceneBuildError& e) {
     out.error = std::string("scene build failed: ") + e.what();
     return out;
   }
   out.build_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - build_start).count();
+  return out;
+}
+
+RenderOutcome render_built_scene(const Scene& scene, const RenderSettings& request_settings,
+                                 const RenderJobOptions& options,
+                                 std::chrono::steady_clock::time_point started,
+                                 JobRuntime& runtime, const ProgressMap& progress_map) {
+  const ProgressMap map =
+      progress_map ? progress_map : ProgressMap([](const RenderProgress& p) { return p; });
+  RenderOutcome out;
+  RenderSettings settings = request_settings;
+  settings.threads = options.threads;
+  if (options.max_render_seconds > 0)
+    settings.time_limit = settings.time_limit > 0
+                              ? std::min(settings.time_limit, options.max_render_seconds)
+                              : options.max_render_seconds;
+  out.settings = settings;
   if (settings.time_limit > 0) {
     // What is left for sampling: the limit less the time spent so far (queue to running, scene
     // read and built) and the time the images will take to encode and store. The render loop
@@ -95,12 +99,29 @@ RenderOutcome render_request(const api::SceneRequest& request, const RenderJobOp
     runtime.set_preview(image);
     runtime.set_progress(map(p));
   };
-  RenderResult result = render(*scene, settings, control);
+  RenderResult result = render(scene, settings, control);
   out.stats = result.stats;
   out.image = std::move(result.image);
   out.layers = std::move(result.layers);
   out.kind =
       result.stats.cancelled ? RenderOutcome::Kind::kStopped : RenderOutcome::Kind::kSucceeded;
+  return out;
+}
+
+RenderOutcome render_request(const api::SceneRequest& request, const RenderJobOptions& options,
+                             std::chrono::steady_clock::time_point started, JobRuntime& runtime,
+                             const ProgressMap& progress_map) {
+  BuiltScene built = build_request_scene(request);
+  if (!built.scene) {
+    RenderOutcome out;
+    out.settings = request.settings;
+    out.settings.threads = options.threads;
+    out.error = std::move(built.error);
+    return out;
+  }
+  RenderOutcome out =
+      render_built_scene(*built.scene, request.settings, options, started, runtime, progress_map);
+  out.build_seconds = built.build_seconds;
   return out;
 }
 
@@ -211,6 +232,7 @@ std::string render_stats_json(const RenderOutcome& o, int threads) {
                                 {"camera_samples", s.camera_samples},
                                 {"stopped_by_time_limit", s.stopped_by_time_limit},
                                 {"threads", threads}};
+  if (o.scene_reused) j["scene_reused"] = *o.scene_reused;
   // An animation: how many frames this attempt rendered, and from which (the rest, if any, were
   // rendered by an earlier attempt and kept); the numbers above add up those frames.
   if (o.animation) {

@@ -4,6 +4,7 @@
 // Called on the service's own worker threads, never on HTTP threads.
 #include <chrono>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -11,6 +12,7 @@
 #include "renderer/core/image.h"
 #include "renderer/io/image_io.h"
 #include "renderer/render/render.h"
+#include "renderer/scene/scene.h"
 #include "server/jobs/job_runtime.h"
 
 namespace penumbra::server {
@@ -45,6 +47,9 @@ struct RenderOutcome {
   RenderStats stats;
   RenderSettings settings;
   double build_seconds = 0;
+  // A farm task's piece: whether it rendered a scene its worker had prepared for an earlier task
+  // of the job (server/farm/scene_cache.h); unset elsewhere.
+  std::optional<bool> scene_reused;
   std::string error;  // when failed
   // An animation: the frames were handed to on_frame as they finished (image and layers stay
   // empty); stats add up the frames this attempt rendered.
@@ -66,6 +71,23 @@ api::LoadResult load_job_request(const std::string& scene_json, const RenderJobO
 
 // Maps one render's progress onto its job's (an animation's frame onto all frames); empty: as is.
 using ProgressMap = std::function<RenderProgress(const RenderProgress&)>;
+
+// A request's scene, built and with the sampling tables its integrator reads made (so they count
+// as build time); `error` ("scene build failed: ...") when it cannot be built.
+struct BuiltScene {
+  std::unique_ptr<Scene> scene;
+  double build_seconds = 0;
+  std::string error;
+};
+BuiltScene build_request_scene(const api::SceneRequest& request);
+
+// Renders a built scene with `settings` (the request's, or a piece's of them) and the job's
+// threads and the server's budget; a time limit counts from `started` and keeps back the time to
+// store the images. The scene is only read: several renders may share it.
+RenderOutcome render_built_scene(const Scene& scene, const RenderSettings& settings,
+                                 const RenderJobOptions& options,
+                                 std::chrono::steady_clock::time_point started,
+                                 JobRuntime& runtime, const ProgressMap& progress_map);
 
 // Builds and renders one parsed request (a still, a chosen frame, a window) with the job's
 // threads and the server's budget; a time limit counts from `started` and keeps back the time

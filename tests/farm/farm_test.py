@@ -608,6 +608,16 @@ def split_job(farm, kill_one=False):
     planted = job + "." + "f" * 24 + ".tile.exr"
     check((planted in left) == kill_one, "the merge leaves uncommitted files alone: %s" % left)
     check(j["stats"].get("tasks") == 16, "the job's stats sum its tiles: %s" % j["stats"])
+    if not kill_one:
+        # Each worker reads and builds the scene once and renders all its tiles from it
+        # (server/farm/scene_cache.h): a worker keeps it until it runs out of tiles.
+        check(j["stats"].get("scene_builds") == len(per),
+              "one scene build per worker (%d workers): %s" % (len(per), j["stats"]))
+        built = farm.psql(
+            "SELECT a.worker, count(*) FILTER (WHERE NOT (t.stats_json::jsonb->>'scene_reused')::"
+            "boolean) FROM task_attempts a JOIN tasks t ON t.id = a.task_id WHERE a.job_id = '%s' "
+            "AND t.kind = 'tile' AND a.outcome = 'succeeded' GROUP BY a.worker" % job)
+        check(all(n == "1" for _, n in built), "each worker built the scene once: %s" % built)
     # Where the wall time went: tiles (first start to last end), the merge, from the attempt log.
     (tiles_span, merge_span, tile_sum), = farm.psql(
         "SELECT extract(epoch FROM max(a.ended_at) FILTER (WHERE t.kind = 'tile') - "
