@@ -29,6 +29,11 @@ void Metrics::count_webhook(const std::string& result) {
   ++webhooks_[result];
 }
 
+void Metrics::count_scene_preparation(const std::string& outcome) {
+  std::lock_guard lock(mutex_);
+  ++scene_preparations_[outcome];
+}
+
 void Metrics::observe_render(const std::string& final_state, double seconds, uint64_t rays) {
   std::lock_guard lock(mutex_);
   ++finished_[final_state];
@@ -88,6 +93,13 @@ std::string Metrics::render_text(const Gauges& g) const {
   for (const char* result : {"delivered", "failed_attempt", "gave_up"})
     o << "penumbra_webhook_attempts_total{result=\"" << result << "\"} "
       << (webhooks_.count(result) ? webhooks_.at(result) : 0) << "\n";
+  o << "# HELP penumbra_farm_scene_preparations_total The scenes of a farm worker's tile and frame "
+       "tasks: built by the task, reused from an earlier task or another slot of the worker, "
+       "failed.\n"
+       "# TYPE penumbra_farm_scene_preparations_total counter\n";
+  for (const char* outcome : {"built", "reused", "failed"})
+    o << "penumbra_farm_scene_preparations_total{outcome=\"" << outcome << "\"} "
+      << (scene_preparations_.count(outcome) ? scene_preparations_.at(outcome) : 0) << "\n";
   o << "# HELP penumbra_webhooks_pending Webhook deliveries scheduled or under way.\n"
        "# TYPE penumbra_webhooks_pending gauge\npenumbra_webhooks_pending "
     << g.webhooks_pending << "\n";

@@ -28,6 +28,9 @@ class Metrics {
   void count_connection_refused(const std::string& reason);
   // A webhook attempt's outcome: "delivered", "failed_attempt" (retried), "gave_up".
   void count_webhook(const std::string& result);
+  // A farm task's scene (server/farm/scene_cache.h): "built" by it, "reused" from an earlier task
+  // or another slot of this worker, or "failed".
+  void count_scene_preparation(const std::string& outcome);
 
   struct Gauges {
     std::map<std::string, int64_t> jobs_by_state;
@@ -49,6 +52,7 @@ class Metrics {
   std::map<std::string, uint64_t> stopped_early_;
   std::map<std::string, uint64_t> connections_refused_;
   std::map<std::string, uint64_t> webhooks_;
+  std::map<std::string, uint64_t> scene_preparations_;
   std::array<uint64_t, kRenderSecondsBuckets.size()> render_buckets_{};
   uint64_t render_count_ = 0;
   double render_seconds_sum_ = 0;

@@ -452,6 +452,7 @@ RenderOutcome FarmWorker::render_piece(const Claim& c, const RenderJobOptions& o
   const SceneCache::Lookup scene = scenes_.get(key, [&](std::string& error) {
     return prepare_piece_scene(c.scene, options, c.piece, error);
   });
+  metrics_.count_scene_preparation(!scene.scene ? "failed" : scene.reused ? "reused" : "built");
   if (!scene.scene) {
     RenderOutcome failed;
     failed.error = scene.error;

@@ -618,6 +618,18 @@ def split_job(farm, kill_one=False):
             "boolean) FROM task_attempts a JOIN tasks t ON t.id = a.task_id WHERE a.job_id = '%s' "
             "AND t.kind = 'tile' AND a.outcome = 'succeeded' GROUP BY a.worker" % job)
         check(all(n == "1" for _, n in built), "each worker built the scene once: %s" % built)
+        for w in workers:
+            if w["proc"].poll() is not None:
+                continue
+            status, raw, _ = request(w["base"], "GET", "/metrics")
+            counts = dict(re.findall(
+                r'penumbra_farm_scene_preparations_total\{outcome="(\w+)"\} (\d+)', raw.decode()))
+            mine = [v for k, v in per.items() if k.split("-")[-2] == str(w["proc"].pid)]
+            check(counts.get("built") == ("1" if mine else "0") and
+                  counts.get("reused") == str(len(mine[0]) - 1 if mine else 0) and
+                  counts.get("failed") == "0",
+                  "a worker's metrics count its scene built once, reused for its other tiles: %s"
+                  % counts)
     # Where the wall time went: tiles (first start to last end), the merge, from the attempt log.
     (tiles_span, merge_span, tile_sum), = farm.psql(
         "SELECT extract(epoch FROM max(a.ended_at) FILTER (WHERE t.kind = 'tile') - "
