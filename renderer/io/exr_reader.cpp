@@ -13,10 +13,10 @@
 #include <exception>
 #include <mutex>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "renderer/io/exr_header_check.h"
+#include "renderer/io/exr_threads.h"
 #include "renderer/io/image_io.h"
 #include "renderer/io/image_reader.h"
 
@@ -81,8 +81,6 @@ void limit_openexr_sizes() {
   });
 }
 
-int decode_threads() { return int(std::clamp(std::thread::hardware_concurrency(), 1u, 8u)); }
-
 }  // namespace
 
 struct ExrImage::State {
@@ -118,7 +116,7 @@ std::unique_ptr<ExrImage> ExrImage::open(const ImageSource& source) {
     } else {
       s->stream = std::make_unique<Imf::StdIFStream>(path.c_str());
     }
-    s->file = std::make_unique<Imf::InputFile>(*s->stream, decode_threads());
+    s->file = std::make_unique<Imf::InputFile>(*s->stream, exr_threads());
   } catch (const std::exception& e) {
     throw ImageIoError(path + ": cannot read the image: " + e.what());
   }

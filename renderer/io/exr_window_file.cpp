@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "renderer/io/exr_header_check.h"
+#include "renderer/io/exr_threads.h"
 #include "renderer/io/image_io.h"
 #include "renderer/scene/scene_input.h"
 
@@ -41,7 +42,7 @@ ExrWindowFile read_stream(Imf::IStream& stream, const std::string& path, const E
   ExrWindowFile out;
   out.part.name = path;
   try {
-    Imf::InputFile file(stream, 1);
+    Imf::InputFile file(stream, exr_threads());
     const Imf::Header& header = file.header();
     const Imath::Box2i dw = header.dataWindow(), disp = header.displayWindow();
     // Exclusive ends below must not overflow; anything near INT_MAX is far over the limits anyway.

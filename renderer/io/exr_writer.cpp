@@ -11,6 +11,7 @@
 #include <cstring>
 #include <exception>
 
+#include "renderer/io/exr_threads.h"
 #include "renderer/io/image_io.h"
 
 namespace penumbra {
@@ -63,7 +64,7 @@ std::vector<uint8_t> encode_exr_channels(const std::vector<ExrChannel>& channels
     }
     MemoryStream stream;
     {
-      Imf::OutputFile file(stream, header, 0);
+      Imf::OutputFile file(stream, header, exr_threads());
       file.setFrameBuffer(frame);
       file.writePixels(height);
     }
@@ -90,8 +91,8 @@ std::vector<uint8_t> encode_exr(const float* rgb, int width, int height,
     frame.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), x_stride, y_stride));
     MemoryStream stream;
     {
-      // One thread: the render pool is busy with the next job, and images are small.
-      Imf::OutputFile file(stream, header, 0);
+      // The chunks compressed on OpenEXR's pool (exr_threads.h): the same bytes.
+      Imf::OutputFile file(stream, header, exr_threads());
       file.setFrameBuffer(frame);
       file.writePixels(height);
     }  // the destructor writes the line offset table
