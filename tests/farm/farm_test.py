@@ -15,6 +15,7 @@ worker killed mid-tile), split_progress_and_preview, split_cancel, split_denoise
 split_retention, animation_frames (24 frames over 3 workers equal `penumbra render --frame i`). Exit 77 (ctest: skipped) without a PostgreSQL server, except with
 CI=true, where that is a failure.
 """
+import http.client
 import json
 import os
 import random
@@ -134,7 +135,9 @@ def submit(base, body, key=None, retries=0):
     for attempt in range(retries + 1):
         try:
             status, raw, _ = request(base, "POST", "/v1/jobs", body, headers)
-        except (urllib.error.URLError, ConnectionError, socket.timeout):
+        except (urllib.error.URLError, ConnectionError, socket.timeout,
+                http.client.HTTPException):
+            # No answer, or one cut short (IncompleteRead: the node died while it answered).
             status, raw = 0, b""
         if status == 202:
             return json.loads(raw)["id"]
