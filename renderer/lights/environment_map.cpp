@@ -159,21 +159,28 @@ const Distribution2D& EnvironmentMap::distribution() const {
 // other's table, 8 bytes per texel (280 MB for an 8192 x 4096 map), is never made.
 void EnvironmentMap::build_distribution() const {
   const int nu = width_, nv = height_ - 1;
-  // Each texel's corner weight once, in a pair of row buffers: corner(x, y) is the value
-  // corners() computes for it, to the bit (the warp within a cell reads corners()). The cells'
-  // weights go to the distribution row by row (no nu x nv array of them).
-  std::vector<float> row(static_cast<size_t>(nu)), next(static_cast<size_t>(nu));
   const auto corner_row = [&](int y, std::vector<float>& out) {
     for (int x = 0; x < nu; ++x) out[size_t(x)] = corner(x, y);
   };
-  corner_row(0, row);
-  distribution_ = Distribution2D(nu, nv, [&](int y, std::span<float> weights) {
-    corner_row(y + 1, next);
-    for (int x = 0; x < nu; ++x) {
-      const size_t x0 = size_t(x), x1 = size_t((x + 1) % nu);
-      weights[x0] = float(0.25 * (double(row[x0]) + double(row[x1]) + double(next[x0]) + double(next[x1])));
+  // The cells' weights go to the distribution row by row (no nu x nv array of them), in blocks
+  // of rows on all cores. Within a block each texel's corner weight is computed once, in a pair
+  // of row buffers (a block computes its first row's too, which the block before it computed as
+  // its last): corner(x, y) is the value corners() computes for it, to the bit (the warp within a
+  // cell reads corners()), so the weights do not depend on the blocks.
+  distribution_ = Distribution2D(nu, nv, [&](int begin, int end, const Distribution2D::RowPut& put) {
+    std::vector<float> row(static_cast<size_t>(nu)), next(static_cast<size_t>(nu)), weights(static_cast<size_t>(nu));
+    corner_row(begin, row);
+    for (int y = begin; y < end; ++y) {
+      corner_row(y + 1, next);
+      const auto cell = [&](size_t x0, size_t x1) {
+        return float(0.25 * (double(row[x0]) + double(row[x1]) + double(next[x0]) + double(next[x1])));
+      };
+      // The last cell across the seam (texel 0), apart: no modulo, a division, per cell.
+      for (size_t x = 0; x + 1 < size_t(nu); ++x) weights[x] = cell(x, x + 1);
+      weights[size_t(nu) - 1] = cell(size_t(nu) - 1, 0);
+      put(y, weights);
+      row.swap(next);
     }
-    row.swap(next);
   });
   table_built_.store(true, std::memory_order_release);
 }
