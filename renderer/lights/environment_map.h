@@ -119,6 +119,8 @@ class EnvironmentMap final : public EnvironmentLight {
     const float* t = texel_address(x, y);
     return Spectrum(t[0], t[1], t[2]);
   }
+  // integral_ and max_luminance_ from the texels.
+  void integrate_luminance();
   // The compensated twin of `full`: its texels shared, its density over max(L - floor, 0).
   EnvironmentMap(const EnvironmentMap& full, float floor);
   // The sampling distribution over the cells' corners (with floor_ subtracted), built on first
