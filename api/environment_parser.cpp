@@ -1,9 +1,12 @@
 #include "api/environment_parser.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 
 #include "api/transform.h"
+#include "renderer/core/row_blocks.h"
 #include "renderer/io/image_reader.h"
 
 namespace penumbra::api {
@@ -42,12 +45,10 @@ std::optional<glm::mat3> parse_orientation(ObjectReader& reader, Diagnostics& di
   return glm::mat3(nearest_orthogonal(transform->linear));
 }
 
-// Reads the image named by "map" into `rgb` (linear RGB per texel, each value finite and >= 0, as
-// the light would clean it), its size into `map` and its largest value into `brightest`; false
-// after reporting an error.
+// Reads the image named by "map" into `rgb` (linear RGB per texel, as decoded) and its size into
+// `map`; false after reporting an error.
 bool read_map(const std::string& relative, const AssetFolder& assets, EnvironmentMapDesc& map,
-              std::vector<float>& rgb, float& brightest, std::vector<AssetUse>* uses,
-              Diagnostics& diag) {
+              std::vector<float>& rgb, std::vector<AssetUse>* uses, Diagnostics& diag) {
   const std::string pointer = child_pointer(kPointer, "map");
   const auto path = resolve_asset_path(assets, relative, pointer, diag);
   if (!path) return false;
@@ -87,12 +88,43 @@ bool read_map(const std::string& relative, const AssetFolder& assets, Environmen
       for (size_t k = 0; k < 3; ++k) rgb[i * 3 + k] = c >= 3 ? p[k] : p[0];
     }
   }
-  brightest = 0.f;
-  for (float& v : rgb) {
-    v = clean_texel(v);
-    brightest = std::max(brightest, v);
-  }
   return true;
+}
+
+// Makes every value what the light would make of it, in place: clean (finite and >= 0), then,
+// for a scale other than 1, clean(value x scale). Returns the largest clean value before the
+// scale (for the check on the brightest texel; where it fails, the values are dropped). One pass
+// over the texels in blocks on all cores: each value is its own, and the largest of the blocks'
+// largest values is the largest, whatever the blocks (an 8192 x 4096 map is 100M values).
+float clean_and_scale(std::vector<float>& rgb, float scale) {
+  // clean_texel by the bits, branch-free so that the loop vectorises: a value is finite and > 0,
+  // or +0, exactly when its bits are below +infinity's (a sign bit, infinity and NaN are at or
+  // above them); what is not becomes +0, as clean_texel makes it. Clean values order as their
+  // bits do, so the largest is found among the bits (integer compares, which vectorise).
+  constexpr uint32_t kInfinityBits = 0x7f800000u;
+  const auto clean = [](float v) { return std::bit_cast<uint32_t>(v) < kInfinityBits ? v : 0.f; };
+  const size_t per_block = kRowBlockCells;
+  std::vector<uint32_t> block_brightest((rgb.size() + per_block - 1) / per_block, 0u);
+  for_row_blocks(rgb.size(), per_block, [&](size_t begin, size_t end) {
+    uint32_t brightest = 0;
+    float* v = rgb.data();
+    if (scale == 1.f) {
+      for (size_t i = begin; i < end; ++i) {
+        v[i] = clean(v[i]);
+        brightest = std::max(brightest, std::bit_cast<uint32_t>(v[i]));
+      }
+    } else {
+      for (size_t i = begin; i < end; ++i) {
+        const float c = clean(v[i]);
+        brightest = std::max(brightest, std::bit_cast<uint32_t>(c));
+        v[i] = clean(c * scale);
+      }
+    }
+    block_brightest[begin / per_block] = brightest;
+  });
+  uint32_t brightest = 0;
+  for (const uint32_t b : block_brightest) brightest = std::max(brightest, b);
+  return std::bit_cast<float>(brightest);
 }
 
 }  // namespace
@@ -128,10 +160,11 @@ bool parse_environment(const Json* value, const AssetFolder& assets, SceneInput&
   if (to_world) map.to_world = *to_world;
   // The file is checked even when other fields are wrong: validation reports every problem.
   std::vector<float> rgb;
-  float brightest = 0.f;
-  if (!file || !read_map(*file, assets, map, rgb, brightest, uses, diag) ||
-      diag.error_count() != errors_before)
+  if (!file || !read_map(*file, assets, map, rgb, uses, diag) || diag.error_count() != errors_before)
     return false;
+  // The scale applied here, as the light would (clean(texel x scale), in range by the check
+  // below), so the light shares these texels instead of making a scaled copy.
+  const float brightest = clean_and_scale(rgb, map.scale);
 
   // Scaled radiance must stay finite through the renderer's single-precision arithmetic, as
   // every other radiance in a scene (kMaxMagnitude).
@@ -145,10 +178,6 @@ bool parse_environment(const Json* value, const AssetFolder& assets, SceneInput&
   if (!lit)
     r.warning("map", "the environment map is black (every texel is 0, or scale is 0): it emits "
                      "nothing");
-  // The scale applied here, as the light would (clean(texel x scale), in range by the check
-  // above), so the light shares these texels instead of making a scaled copy.
-  if (map.scale != 1.f)
-    for (float& v : rgb) v = clean_texel(v * map.scale);
   map.scale = 1.f;
   map.rgb = std::make_shared<const std::vector<float>>(std::move(rgb));
   scene.environment_map = std::move(map);

@@ -4,9 +4,14 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <memory>
 #include <string>
 #include <vector>
 
+#include <tbb/parallel_pipeline.h>
+#include <tbb/task_arena.h>
+
+#include "renderer/core/row_blocks.h"
 #include "renderer/io/image_io.h"
 #include "renderer/io/image_reader.h"
 
@@ -109,62 +114,111 @@ std::unique_ptr<HdrImage> HdrImage::open(const ImageSource& source) {
   return image;
 }
 
+namespace {
+
+// Reads one scanline of w pixels into `rgbe` (4 bytes a pixel, RGBE interleaved): run-length
+// encoded or flat. `flat_file` carries from scanline to scanline: widths outside [8, 32767]
+// cannot be run-length encoded, and a file whose first scanline is not is flat to its end
+// (Radiance's reader reads it so; a flat pixel may look like an RLE mark). `component` is
+// scratch of w bytes.
+template <class Fail>
+void read_scanline(SourceReader& in, size_t w, bool& flat_file, uint8_t* rgbe, uint8_t* component,
+                   const Fail& fail) {
+  uint8_t head[4];
+  bool flat = flat_file;
+  if (!flat) {
+    if (!in.read(head, 4)) throw fail("the file ends early");
+    flat = flat_file = !(head[0] == 2 && head[1] == 2 && (head[2] & 0x80) == 0);
+    if (flat) {
+      std::memcpy(rgbe, head, 4);  // the first pixel of a flat scanline
+      if (!in.read(rgbe + 4, 4 * (w - 1))) throw fail("the file ends early");
+    } else if ((size_t(head[2]) << 8 | head[3]) != w) {
+      throw fail("a scanline's width differs from the image's");
+    }
+  } else if (!in.read(rgbe, 4 * w)) {
+    throw fail("the file ends early");
+  }
+  if (flat) return;
+  // Each of the four components in turn: runs (count > 128: one value count - 128 times) and
+  // literals (count <= 128 values), never past the scanline's end.
+  for (size_t c = 0; c < 4; ++c) {
+    size_t x = 0;
+    while (x < w) {
+      const int count = in.get();
+      if (count < 0) throw fail("the file ends early");
+      if (count > 128) {
+        const size_t n = size_t(count - 128);
+        const int v = in.get();
+        if (v < 0) throw fail("the file ends early");
+        if (n > w - x) throw fail("a run overruns its scanline");
+        std::memset(component + x, v, n);
+        x += n;
+      } else {
+        const size_t n = size_t(count);
+        if (n == 0 || n > w - x) throw fail("bad run length");
+        if (!in.read(component + x, n)) throw fail("the file ends early");
+        x += n;
+      }
+    }
+    for (size_t i = 0; i < w; ++i) rgbe[4 * i + c] = component[i];
+  }
+}
+
+// The first `channels` components of n RGBE pixels as floats.
+void rgbe_to_float(const uint8_t* rgbe, size_t n, int channels, float* out) {
+  for (size_t i = 0; i < n; ++i)
+    for (int c = 0; c < channels; ++c)
+      out[i * size_t(channels) + size_t(c)] = rgbe_component(rgbe[4 * i + size_t(c)], rgbe[4 * i + 3]);
+}
+
+}  // namespace
+
+// A pipeline over blocks of scanlines: the file is read and its runs decoded in order, one block
+// after the other (scanlines have no index: each starts where the one before it ends), while
+// the blocks already read are turned into floats on the other cores. A value's float is its
+// RGBE bytes' alone, so the pixels are the same to the bit.
 void HdrImage::read(int channels, float* pixels) {
   check_read_channels(spec_, channels, state_->path);
-  const size_t w = size_t(spec_.width);
+  const size_t w = size_t(spec_.width), h = size_t(spec_.height);
   SourceReader& in = *state_->in;
   auto fail = [&](const char* why) {
     return ImageIoError(state_->path + ": cannot decode the image: " + why);
   };
-  std::vector<uint8_t> row(4 * w);  // one scanline's pixels, RGBE interleaved
+  struct Block {
+    size_t begin = 0, end = 0;  // scanlines
+    std::vector<uint8_t> rgbe;  // theirs, 4 bytes a pixel
+  };
+  using BlockPtr = std::shared_ptr<Block>;
+  const size_t per_block = rows_per_block(w);
   std::vector<uint8_t> component(w);
-  // Widths outside [8, 32767] cannot be run-length encoded; a file whose first scanline is not is
-  // flat to its end (Radiance's reader reads it so; a flat pixel may look like an RLE mark).
   bool flat_file = w < 8 || w > 0x7fff;
-  for (size_t y = 0; y < size_t(spec_.height); ++y) {
-    uint8_t head[4];
-    bool flat = flat_file;
-    if (!flat) {
-      if (!in.read(head, 4)) throw fail("the file ends early");
-      flat = flat_file = !(head[0] == 2 && head[1] == 2 && (head[2] & 0x80) == 0);
-      if (flat) {
-        std::memcpy(row.data(), head, 4);  // the first pixel of a flat scanline
-        if (!in.read(row.data() + 4, 4 * (w - 1))) throw fail("the file ends early");
-      } else if ((size_t(head[2]) << 8 | head[3]) != w) {
-        throw fail("a scanline's width differs from the image's");
-      }
-    } else if (!in.read(row.data(), 4 * w)) {
-      throw fail("the file ends early");
+  size_t next = 0;  // the first scanline not read yet
+  // The pipeline's stages: the next block's scanlines read in file order (null after the last),
+  // and a block's pixels turned into floats.
+  const auto read_block = [&](tbb::flow_control& control) -> BlockPtr {
+    if (next >= h) {
+      control.stop();
+      return nullptr;
     }
-    if (!flat) {
-      // Each of the four components in turn: runs (count > 128: one value count - 128 times) and
-      // literals (count <= 128 values), never past the scanline's end.
-      for (size_t c = 0; c < 4; ++c) {
-        size_t x = 0;
-        while (x < w) {
-          const int count = in.get();
-          if (count < 0) throw fail("the file ends early");
-          if (count > 128) {
-            const size_t n = size_t(count - 128);
-            const int v = in.get();
-            if (v < 0) throw fail("the file ends early");
-            if (n > w - x) throw fail("a run overruns its scanline");
-            std::memset(component.data() + x, v, n);
-            x += n;
-          } else {
-            const size_t n = size_t(count);
-            if (n == 0 || n > w - x) throw fail("bad run length");
-            if (!in.read(component.data() + x, n)) throw fail("the file ends early");
-            x += n;
-          }
-        }
-        for (size_t i = 0; i < w; ++i) row[4 * i + c] = component[i];
-      }
-    }
-    float* out = pixels + y * w * size_t(channels);
-    for (size_t i = 0; i < w; ++i)
-      for (int c = 0; c < channels; ++c) out[i * size_t(channels) + size_t(c)] = rgbe_component(row[4 * i + size_t(c)], row[4 * i + 3]);
-  }
+    auto b = std::make_shared<Block>();
+    b->begin = next;
+    b->end = next = std::min(h, next + per_block);
+    b->rgbe.resize((b->end - b->begin) * 4 * w);
+    for (size_t y = b->begin; y < b->end; ++y)
+      read_scanline(in, w, flat_file, b->rgbe.data() + (y - b->begin) * 4 * w, component.data(), fail);
+    return b;
+  };
+  const auto convert_block = [&](const BlockPtr& b) {
+    rgbe_to_float(b->rgbe.data(), (b->end - b->begin) * w, channels, pixels + b->begin * w * size_t(channels));
+  };
+  // Isolated, as renderer/core/row_blocks.h's blocks (a caller may hold a lock); a few blocks in
+  // flight per core (256 KB each for an 8192-wide map). An error thrown while reading ends the
+  // pipeline and reaches the caller.
+  tbb::this_task_arena::isolate([&] {
+    tbb::parallel_pipeline(size_t(2 * tbb::this_task_arena::max_concurrency()),
+                           tbb::make_filter<void, BlockPtr>(tbb::filter_mode::serial_in_order, read_block) &
+                               tbb::make_filter<BlockPtr, void>(tbb::filter_mode::parallel, convert_block));
+  });
 }
 
 void HdrImage::read(int, uint8_t*) {

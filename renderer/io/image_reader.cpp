@@ -1,8 +1,11 @@
 #include "renderer/io/image_reader.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 
+#include "renderer/core/row_blocks.h"
 #include "renderer/io/exr_reader.h"
 #include "renderer/io/hdr_reader.h"
 #include "renderer/io/jpeg_reader.h"
@@ -75,8 +78,13 @@ AssetImage read_asset_image(const ImageSource& source, const ImageReadLimits& li
   img.is_float = info.is_float;
   img.pixels.resize(size_t(img.width) * size_t(img.height) * size_t(img.channels));
   in->read(img.channels, img.pixels.data());
-  for (float& v : img.pixels)
-    if (!std::isfinite(v)) v = 0.f;
+  // Non-finite values to 0, in blocks on all cores (an 8192 x 4096 map is 100M values); by the
+  // exponent's bits, branch-free, so that the loop vectorises.
+  for_row_blocks(img.pixels.size(), kRowBlockCells, [&](size_t begin, size_t end) {
+    float* v = img.pixels.data();
+    for (size_t i = begin; i < end; ++i)
+      v[i] = (std::bit_cast<uint32_t>(v[i]) & 0x7f800000u) == 0x7f800000u ? 0.f : v[i];
+  });
   return img;
 }
 

@@ -63,6 +63,8 @@ class EnvironmentMap final : public EnvironmentLight {
   // Whether the sampling table has been built (by a sample, a density or prepare_sampling; a
   // radiance lookup alone builds nothing): for tests and memory accounting.
   bool sampling_table_built() const { return table_built_.load(std::memory_order_acquire); }
+  // The sampling table (built now if it was not): for tests.
+  const Distribution2D& sampling_table() const { return distribution(); }
   // A compensated map with nothing above its mean (a constant one) has no density anywhere: it
   // is left to BSDF sampling, as a constant environment is.
   bool left_to_bsdf_sampling() const override { return sampled_nowhere_; }
@@ -117,6 +119,8 @@ class EnvironmentMap final : public EnvironmentLight {
     const float* t = texel_address(x, y);
     return Spectrum(t[0], t[1], t[2]);
   }
+  // integral_ and max_luminance_ from the texels.
+  void integrate_luminance();
   // The compensated twin of `full`: its texels shared, its density over max(L - floor, 0).
   EnvironmentMap(const EnvironmentMap& full, float floor);
   // The sampling distribution over the cells' corners (with floor_ subtracted), built on first

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 
+#include "renderer/core/row_blocks.h"
 #include "renderer/core/simd_clones.h"
 
 namespace penumbra {
@@ -79,7 +80,7 @@ void cdf_sample_lanes(size_t m, const float* __restrict cdf, const int* __restri
 }
 
 // The number of halvings that bring the widest of a guide's ranges to one cell.
-int search_steps(std::span<const int> guide, size_t buckets) {
+int guide_search_steps(std::span<const int> guide, size_t buckets) {
   int widest = 1;
   for (size_t start = 0; start + buckets < guide.size(); start += buckets + 1)
     for (size_t k = 0; k < buckets; ++k) widest = std::max(widest, guide[start + k + 1] - guide[start + k]);
@@ -87,6 +88,11 @@ int search_steps(std::span<const int> guide, size_t buckets) {
   for (int len = widest; len > 1; len -= len >> 1) ++steps;
   return steps;
 }
+
+// The guide's number of buckets for n cells: about one entry per four cells, so a search spans
+// ~4 cells on average (two comparisons), for a quarter more memory than the CDF alone; a power
+// of two (see Distribution1D::guide_).
+size_t guide_buckets(size_t n) { return std::max<size_t>(std::bit_ceil(n) / 4, 1); }
 
 }  // namespace
 
@@ -105,9 +111,7 @@ Distribution1D::Distribution1D(std::span<const float> weights) {
   cdf_[n] = 1.f;
   pdf_.resize(n);
   for (size_t i = 0; i < n; ++i) pdf_[i] = integral_ > 0.0 ? float(double(func[i]) / integral_) : 0.f;
-  // About one guide entry per four cells: a search spans ~4 cells on average (two comparisons),
-  // for a quarter more memory than the CDF alone.
-  const size_t buckets = std::max<size_t>(std::bit_ceil(n) / 4, 1);
+  const size_t buckets = guide_buckets(n);
   guide_.resize(buckets + 1);
   size_t i = 0;
   for (size_t k = 0; k <= buckets; ++k) {
@@ -115,7 +119,7 @@ Distribution1D::Distribution1D(std::span<const float> weights) {
     while (i + 1 < n && cdf_[i + 1] <= t) ++i;
     guide_[k] = int(i);
   }
-  search_steps_ = search_steps(guide_, buckets);
+  search_steps_ = guide_search_steps(guide_, buckets);
 }
 
 void Distribution1D::sample_many(size_t m, const float* u, int* cell, float* x) const {
@@ -174,43 +178,54 @@ float Distribution1D::sample(float u, float* pdf, int* cell) const {
 float Distribution1D::pdf(float x) const { return cell_pdf(cell_of(x, int32_t(pdf_.size()))); }
 
 Distribution2D::Distribution2D(std::span<const float> weights, int nu, int nv)
-    : Distribution2D(nu, nv, [&](int j, std::span<float> out) {
-        // A row past the end of `weights` weighs 0.
-        const size_t begin = size_t(j) * out.size();
-        for (size_t i = 0; i < out.size(); ++i)
-          out[i] = begin + out.size() <= weights.size() ? weights[begin + i] : 0.f;
+    : Distribution2D(nu, nv, [&](int begin, int end, const RowPut& put) {
+        std::vector<float> row(size_t(std::max(nu, 1)));
+        for (int j = begin; j < end; ++j) {
+          // A row past the end of `weights` weighs 0.
+          const size_t first = size_t(j) * row.size();
+          for (size_t i = 0; i < row.size(); ++i)
+            row[i] = first + row.size() <= weights.size() ? weights[first + i] : 0.f;
+          put(j, row);
+        }
       }) {}
 
-Distribution2D::Distribution2D(int nu, int nv, const std::function<void(int, std::span<float>)>& row_weights)
+Distribution2D::Distribution2D(int nu, int nv, const RowBlock& rows, int rows_per_block)
     : nu_(std::max(nu, 1)), nv_(std::max(nv, 1)) {
+  const size_t n = size_t(nu_);
+  buckets_ = guide_buckets(n);  // the same for every row: it depends on nu alone
+  // Sized whole, so that each row's block writes its own slices of them. pdf_ holds each cell's
+  // density within its row at first; multiplied by its row's marginal density in place below,
+  // it becomes the joint density (an 8192 x 4096 map's table is 134 MB: one array, not two).
+  cdf_.resize(size_t(nv_) * (n + 1));
+  guide_.resize(size_t(nv_) * (buckets_ + 1));
+  pdf_.resize(size_t(nv_) * n);
   std::vector<float> row_integrals(static_cast<size_t>(nv_));
-  // Each cell's density within its row; multiplied by its row's marginal density in place below,
-  // it becomes pdf_ (an 8192 x 4096 map's table is 134 MB: one array, not two).
-  std::vector<float> row_pdfs(size_t(nu_) * size_t(nv_));
-  std::vector<float> row(static_cast<size_t>(nu_));
-  // Reserved whole (the guide's size depends on nu alone), so the tables never grow by copying.
-  cdf_.reserve(size_t(nv_) * size_t(nu_ + 1));
-  guide_.reserve(size_t(nv_) * (std::max<size_t>(std::bit_ceil(size_t(nu_)) / 4, 1) + 1));
-  for (int j = 0; j < nv_; ++j) {
-    const size_t begin = size_t(j) * size_t(nu_);
-    row_weights(j, row);
+  std::vector<int> row_steps(static_cast<size_t>(nv_));
+  const RowPut put = [&](int j, std::span<const float> weights) {
     // Each row built as a Distribution1D of its own, then copied into the flat arrays: the same
     // numbers, so the same samples, as one object per row.
-    const Distribution1D d(row);
-    cdf_.insert(cdf_.end(), d.cdf().begin(), d.cdf().end());
-    guide_.insert(guide_.end(), d.guide().begin(), d.guide().end());
-    buckets_ = d.guide().size() - 1;  // the same for every row: it depends on nu alone
-    for (int i = 0; i < nu_; ++i) row_pdfs[begin + size_t(i)] = d.cell_pdf(i);
+    const Distribution1D d(weights);  // nu cells (the contract of RowBlock)
+    std::copy(d.cdf().begin(), d.cdf().end(), cdf_.begin() + std::ptrdiff_t(size_t(j) * (n + 1)));
+    std::copy(d.guide().begin(), d.guide().end(), guide_.begin() + std::ptrdiff_t(size_t(j) * (buckets_ + 1)));
+    float* pdf = pdf_.data() + size_t(j) * n;
+    for (size_t i = 0; i < n; ++i) pdf[i] = d.cell_pdf(int(i));
     row_integrals[size_t(j)] = float(d.integral());
-  }
+    row_steps[size_t(j)] = d.search_steps();
+  };
+  for_row_blocks(size_t(nv_), rows_per_block > 0 ? size_t(rows_per_block) : penumbra::rows_per_block(n),
+                 [&](size_t begin, size_t end) { rows(int(begin), int(end), put); });
+  // The rows' integrals are all in: the marginal, then the joint densities (each cell's product
+  // on its own, so again by blocks of rows).
   marginal_ = Distribution1D(row_integrals);
-  search_steps_ = search_steps(guide_, buckets_);
-  pdf_ = std::move(row_pdfs);
-  for (int j = 0; j < nv_; ++j)
-    for (int i = 0; i < nu_; ++i) {
-      const size_t c = size_t(j) * size_t(nu_) + size_t(i);
-      pdf_[c] = marginal_.cell_pdf(j) * pdf_[c];
+  // (The most halvings any row needs: the same as counting them for the widest range of all.)
+  search_steps_ = *std::max_element(row_steps.begin(), row_steps.end());
+  for_row_blocks(size_t(nv_), penumbra::rows_per_block(n), [&](size_t begin, size_t end) {
+    for (size_t j = begin; j < end; ++j) {
+      float* pdf = pdf_.data() + j * n;
+      const float row_pdf = marginal_.cell_pdf(int(j));
+      for (size_t i = 0; i < n; ++i) pdf[i] = row_pdf * pdf[i];
     }
+  });
 }
 
 float Distribution2D::sample_column(int row, float u, int* column) const {

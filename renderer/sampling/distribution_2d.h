@@ -19,6 +19,7 @@
 #include <span>
 #include <vector>
 
+#include "renderer/core/default_init_allocator.h"
 #include "renderer/core/math.h"
 
 namespace penumbra {
@@ -57,6 +58,8 @@ class Distribution1D {
   float cell_pdf(int i) const { return pdf_[size_t(i)]; }
   // The guide table, one entry per bucket plus the end (see guide_).
   std::span<const int> guide() const { return guide_; }
+  // The halvings sample_many's search takes (the widest range of the guide).
+  int search_steps() const { return search_steps_; }
 
  private:
   CdfSearch search() const {
@@ -82,10 +85,16 @@ class Distribution2D {
   // [i/nu, (i+1)/nu) x [j/nv, (j+1)/nv). A marginal distribution picks the row (v), then that
   // row's conditional distribution picks u.
   Distribution2D(std::span<const float> weights, int nu, int nv);
-  // The same from the rows' weights as `row(j, out)` writes them (out has nu cells), called once
-  // per row in order: a caller that computes its weights row by row needs no nu x nv array (an
-  // 8192 x 4096 environment map's would be 134 MB).
-  Distribution2D(int nu, int nv, const std::function<void(int, std::span<float>)>& row);
+  // The same from the rows' weights as a caller computes them, block by block: rows(begin, end,
+  // put) computes rows begin..end - 1 in order and hands each to put(j, weights) (nu cells), so a
+  // caller needs no nu x nv array (an 8192 x 4096 environment map's would be 134 MB). The blocks
+  // (of rows_per_block rows; 0: renderer/core/row_blocks.h's choice) run concurrently on all
+  // cores, each row's conditional distribution built as its block puts it; the marginal over the
+  // rows is built after them all, in row order. A caller keeps whatever it carries from row to
+  // row local to its block. Every number is the same to the bit however the rows are split.
+  using RowPut = std::function<void(int, std::span<const float>)>;
+  using RowBlock = std::function<void(int, int, const RowPut&)>;
+  Distribution2D(int nu, int nv, const RowBlock& rows, int rows_per_block = 0);
 
   int nu() const { return nu_; }
   int nv() const { return nv_; }
@@ -106,6 +115,12 @@ class Distribution2D {
   float pdf(const vec2& p) const;
   // Density of cell (i, j), constant over it.
   float cell_pdf(int i, int j) const { return pdf_[size_t(j) * size_t(nu_) + size_t(i)]; }
+  // Row j's conditional CDF (nu + 1 values) and guide table: for tests.
+  std::span<const float> row_cdf(int j) const { return {cdf_.data() + size_t(j) * size_t(nu_ + 1), size_t(nu_ + 1)}; }
+  std::span<const int> row_guide(int j) const { return {guide_.data() + size_t(j) * (buckets_ + 1), buckets_ + 1}; }
+  const Distribution1D& marginal() const { return marginal_; }
+  // The halvings sample_columns' search takes (the widest range of any row's guide).
+  int search_steps() const { return search_steps_; }
   // Hints that cell_pdf(i, j), or sample_column(row, u)'s first load, will be read soon: a caller
   // with many samples issues them for all before it reads any, so their cache misses overlap.
   void prefetch_cell(int i, int j) const { __builtin_prefetch(&pdf_[size_t(j) * size_t(nu_) + size_t(i)]); }
@@ -128,13 +143,14 @@ class Distribution2D {
   // guide_[j * (buckets + 1) ...]. One array per kind instead of a Distribution1D per row
   // saves a sample the load of the row's own pointers before the search can start (the map's
   // sampling is a chain of dependent loads).
-  std::vector<float> cdf_;
-  std::vector<int> guide_;
+  // (Uninitialised when sized: every value is written once, by its row's block.)
+  std::vector<float, DefaultInitAllocator<float>> cdf_;
+  std::vector<int, DefaultInitAllocator<int>> guide_;
   size_t buckets_ = 0;
   int search_steps_ = 0;  // halvings that bring the widest range of any row's guide to one cell
   // The joint density of every cell, marginal x conditional (the product sample and pdf return),
   // so a pdf is one load.
-  std::vector<float> pdf_;
+  std::vector<float, DefaultInitAllocator<float>> pdf_;
   Distribution1D marginal_;  // over rows, weighted by each row's integral
 };
 

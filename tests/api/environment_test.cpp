@@ -2,6 +2,7 @@
 // image read through the scene's asset folder, and every refusal named by its field.
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -175,6 +176,34 @@ TEST_F(EnvironmentField, IntegerImagesAreLinearised) {
   const LoadResult r = load_with({{"map", "grey.png"}});
   ASSERT_TRUE(r.ok()) << describe(r.errors);
   EXPECT_NEAR((*r.request->scene.environment_map->rgb)[0], 0.5f, 0.005f);
+}
+
+// The texels are cleaned and scaled in blocks of 65536 values on all cores
+// (renderer/core/row_blocks.h): a map of 300 x 80 texels is one full block and a shorter one.
+// Values to clean and the brightest texel in the last, shorter block are found there too: the
+// check on the brightest texel x scale sees it, and every value is clean(value) x scale.
+TEST_F(EnvironmentField, EveryBlockOfTexelsIsCleanedScaledAndChecked) {
+  const int w = 300, h = 80;
+  Image sky(w, h);
+  for (size_t i = 0; i < sky.rgb.size(); ++i) sky.rgb[i] = 0.25f + float(i % 37);
+  const size_t last = sky.rgb.size() - 1;
+  sky.rgb[10] = -2.f;
+  sky.rgb[last - 1] = -1.f;
+  sky.rgb[last - 2] = -0.f;
+  sky.rgb[last] = 60000.f;  // the brightest, in the last block
+  write_image_file((folder_.root / "blocks.exr").string(), sky);
+  const LoadResult r = load_with(Json::parse(R"({"map": "blocks.exr", "scale": 0.5})"));
+  ASSERT_TRUE(r.ok()) << describe(r.errors);
+  const std::vector<float>& rgb = *r.request->scene.environment_map->rgb;
+  ASSERT_EQ(rgb.size(), sky.rgb.size());
+  for (size_t i = 0; i < rgb.size(); ++i) {
+    const float expected = sky.rgb[i] > 0.f ? sky.rgb[i] * 0.5f : 0.f;
+    ASSERT_EQ(rgb[i], expected) << i;
+    ASSERT_FALSE(std::signbit(rgb[i])) << i;  // -0 is cleaned to +0
+  }
+  // 60000 x 2e25 is over the limit of 1e30; the other texels (at most 36.25) x 2e25 are not.
+  EXPECT_ERROR(load_with(Json::parse(R"({"map": "blocks.exr", "scale": 2e25})")), "/environment/scale",
+               "brightest texel");
 }
 
 TEST(EnvironmentSchema, DocumentsEveryField) {

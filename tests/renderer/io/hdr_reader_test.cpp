@@ -70,10 +70,11 @@ TEST(HdrReader, HdrFilesDoNotLoadTheOpenImageIoPlugin) {
 
 TEST(HdrReader, RunLengthEncodedFilesDecodeAsOpenImageIoDoesBitForBit) {
   TempFolder dir("hdr_rle");
-  for (const int w : {8, 61, 300}) {  // 8: the narrowest RLE scanline
+  // 8: the narrowest RLE scanline. 300 x 500: scanlines are decoded in blocks of 218
+  // (renderer/core/row_blocks.h), here two and a shorter third, turned into floats on all cores.
+  for (const auto& [w, h] : {std::pair{8, 13}, std::pair{61, 13}, std::pair{300, 13}, std::pair{300, 500}}) {
     SCOPED_TRACE(w);
-    const std::string path = dir.file("rle" + std::to_string(w) + ".hdr");
-    const int h = 13;
+    const std::string path = dir.file("rle" + std::to_string(w) + "x" + std::to_string(h) + ".hdr");
     write_test_image(path, w, h, 3, radiance(w, h));
     ASSERT_NE(open_hdr(path), nullptr);
     const AssetImage ours = read_asset_image(path);
@@ -89,8 +90,9 @@ TEST(HdrReader, RunLengthEncodedFilesDecodeAsOpenImageIoDoesBitForBit) {
 
 TEST(HdrReader, FlatFilesAndNarrowImagesDecodeAsOpenImageIoDoes) {
   TempFolder dir("hdr_flat");
-  for (const auto& [w, h] : {std::pair{5, 4}, std::pair{64, 3}}) {  // 5: too narrow for RLE
-    const std::string path = dir.file("flat" + std::to_string(w) + ".hdr");
+  // 5: too narrow for RLE; 5 x 30000: three blocks of scanlines (13107 a block), the last shorter.
+  for (const auto& [w, h] : {std::pair{5, 4}, std::pair{64, 3}, std::pair{5, 30000}}) {
+    const std::string path = dir.file("flat" + std::to_string(w) + "x" + std::to_string(h) + ".hdr");
     std::ofstream(path, std::ios::binary) << flat_hdr(w, h);
     expect_same_bits(read_asset_image(path).pixels, plugin_pixels(path));
   }
@@ -108,11 +110,17 @@ TEST(HdrReader, BrokenFilesFailWithTheSourceNamed) {
   const std::string whole = dir.file("whole.hdr");
   write_test_image(whole, 40, 10, 3, radiance(40, 10));
   const std::string bytes = file_bytes(whole);
+  // Scanlines are read in blocks (218 of 300 pixels): cut short or broken in a later block too.
+  const std::string tall = dir.file("tall.hdr");
+  write_test_image(tall, 300, 500, 3, radiance(300, 500));
+  const std::string tall_bytes = file_bytes(tall);
   const std::string one_row = "#?RADIANCE\n\n-Y 1 +X 8\n";  // then an RLE scanline's bytes
   expect_files_refused(dir, ".hdr", {
       bytes.substr(0, 12),                 // inside the header
       bytes.substr(0, bytes.size() / 2),   // inside the pixels
       bytes.substr(0, bytes.size() - 1),
+      tall_bytes.substr(0, tall_bytes.size() * 3 / 4),  // in the second block
+      tall_bytes.substr(0, tall_bytes.size() - 1),       // in the last, shorter block
       "#?RADIANCE\n\n-Y 2 +X\n",           // bad resolution line
       "#?RADIANCE\n\n-Y -2 +X 4\n",
       one_row + std::string("\x02\x02\x00\x09", 4),              // a scanline wider than the image

@@ -4,7 +4,13 @@
 // MIS-compensated twin the path integrator samples (a density over max(L - mean L, 0)).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <bit>
+#include <cmath>
 #include <limits>
+#include <span>
+#include <string>
+#include <utility>
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <memory>
@@ -370,6 +376,117 @@ TEST(EnvironmentMap, SharesTheInputsTexelsWhereTheyAreFinal) {
     EXPECT_EQ(shared.radiance_and_pdf(d, &pdf_shared), copied.radiance_and_pdf(d, &pdf_copied));
     EXPECT_EQ(pdf_shared, pdf_copied);
   }
+}
+
+// An 8192 x 4096 map's loading runs in blocks of rows on all cores (renderer/core/row_blocks.h:
+// 65536 cells a block): the texels' check (shared or copied) and the sampling table's rows.
+// Against a reference computed here one row at a time, the way the light did before, to the bit:
+// the luminance integral (summed in row-major order) and every number of both tables (full map
+// and twin), for maps whose rows make several blocks with a shorter last one (1000 x 200: 65 rows
+// a block, and 4 left; 3000 x 50: 21 and 7), one column (65536 rows a block: two blocks), rows
+// wider than a block (one row a block), one row, and two rows.
+void expect_table_is_one_row_at_a_time(const EnvironmentMap& map, const std::vector<float>& lum, int nu,
+                                       int height, float floor, const std::string& where) {
+  const int nv = height - 1;
+  std::vector<float> row_sin(static_cast<size_t>(height));
+  const double pole_sin = std::sin(M_PI / (4.0 * nv));
+  for (int y = 0; y < height; ++y) row_sin[size_t(y)] = float(std::max(std::sin(M_PI * y / nv), pole_sin));
+  const auto corner = [&](int x, int y) {
+    return std::max(lum[size_t(y) * size_t(nu) + size_t(x)] - floor, 0.f) * row_sin[size_t(y)];
+  };
+  std::vector<float> weights(size_t(nu) * size_t(nv));
+  for (int y = 0; y < nv; ++y)
+    for (int x = 0; x < nu; ++x) {
+      const int x1 = (x + 1) % nu;
+      weights[size_t(y) * size_t(nu) + size_t(x)] =
+          float(0.25 * (double(corner(x, y)) + double(corner(x1, y)) + double(corner(x, y + 1)) + double(corner(x1, y + 1))));
+    }
+  // One block of every row: built one row after the other (Distribution2D's own test checks that
+  // against Distribution1D rows).
+  const Distribution2D reference(nu, nv, [&](int begin, int end, const Distribution2D::RowPut& put) {
+    for (int y = begin; y < end; ++y) put(y, std::span<const float>(weights).subspan(size_t(y) * size_t(nu), size_t(nu)));
+  }, nv);
+  const Distribution2D& table = map.sampling_table();
+  const auto bits = [](float v) { return std::bit_cast<uint32_t>(v); };
+  ASSERT_EQ(table.nu(), nu) << where;
+  ASSERT_EQ(table.nv(), nv) << where;
+  ASSERT_EQ(table.integral(), reference.integral()) << where;
+  ASSERT_EQ(table.search_steps(), reference.search_steps()) << where;
+  for (int y = 0; y <= nv; ++y) ASSERT_EQ(bits(table.marginal().cdf()[size_t(y)]), bits(reference.marginal().cdf()[size_t(y)])) << where;
+  for (int y = 0; y < nv; ++y) {
+    for (int x = 0; x <= nu; ++x)
+      ASSERT_EQ(bits(table.row_cdf(y)[size_t(x)]), bits(reference.row_cdf(y)[size_t(x)])) << where << " row " << y;
+    ASSERT_TRUE(std::ranges::equal(table.row_guide(y), reference.row_guide(y))) << where << " row " << y;
+    for (int x = 0; x < nu; ++x) ASSERT_EQ(bits(table.cell_pdf(x, y)), bits(reference.cell_pdf(x, y))) << where << " cell " << x << ", " << y;
+  }
+}
+
+TEST(EnvironmentMap, BlocksOfRowsGiveTheOneRowAtATimeIntegralAndTablesToTheBit) {
+  for (const auto& [width, height] : std::vector<std::pair<int, int>>{
+           {1000, 200}, {3000, 50}, {1, 70000}, {70000, 3}, {16, 1}, {9, 2}}) {
+    const std::string where = std::to_string(width) + " x " + std::to_string(height);
+    uint32_t state = uint32_t(width * 31 + height);
+    const auto next = [&] {
+      state = state * 1664525u + 1013904223u;
+      return float(state >> 8) * 0x1p-24f;
+    };
+    EnvironmentMapDesc desc = make_map(width, height, [&](int x, int y) {
+      // A sky with texture, a sun and a black patch (corners at 0, and below the twin's floor).
+      return (x * 7 + y * 3) % 50 == 0 ? 0.f : 0.1f + next() * float(1 + y % 5) + (x == width / 3 && y == height / 2) * 1e4f;
+    });
+    auto rgb = std::make_shared<std::vector<float>>(*desc.rgb);
+    for (size_t i = 1; i < rgb->size(); i += 3) (*rgb)[i] *= 0.5f + next();  // green unlike red and blue
+    desc.rgb = rgb;
+    const EnvironmentMap map(desc);
+    // Shared where final (held by desc, rgb and the light), copied for one row.
+    EXPECT_EQ(desc.rgb.use_count(), height >= 2 ? 3 : 2) << where;
+    // The reference: each texel's luminance (a one-row map stands at both poles), the integral
+    // summed cell by cell in row-major order.
+    const int rows = std::max(height, 2), nu = width, nv = rows - 1;
+    std::vector<float> lum(size_t(nu) * size_t(rows));
+    for (int y = 0; y < rows; ++y)
+      for (int x = 0; x < nu; ++x) {
+        const float* t = &(*rgb)[(size_t(std::min(y, height - 1)) * size_t(nu) + size_t(x)) * 3];
+        lum[size_t(y) * size_t(nu) + size_t(x)] = luminance(Spectrum(t[0], t[1], t[2]));
+      }
+    double sum = 0.0;
+    for (int y = 0; y < nv; ++y) {
+      const double band = std::cos(M_PI * y / nv) - std::cos(M_PI * (y + 1) / nv);
+      for (int x = 0; x < nu; ++x) {
+        const size_t x0 = size_t(x), x1 = size_t((x + 1) % nu), r = size_t(y) * size_t(nu), n = r + size_t(nu);
+        sum += 0.25 * (double(lum[r + x0]) + lum[r + x1] + lum[n + x0] + lum[n + x1]) * band;
+      }
+    }
+    const double integral = sum * (2.0 * M_PI / nu);
+    ASSERT_EQ(map.luminance_integral(), integral) << where;
+    expect_table_is_one_row_at_a_time(map, lum, nu, rows, 0.f, where);
+    const auto twin = map.compensated();
+    ASSERT_TRUE(twin) << where;
+    // The twin samples somewhere exactly when a texel is brighter than the mean: the brightest.
+    EXPECT_FALSE(twin->left_to_bsdf_sampling()) << where;
+    expect_table_is_one_row_at_a_time(*twin, lum, nu, rows, float(integral / (4.0 * M_PI)), where + " (twin)");
+  }
+}
+
+// The texels' check in blocks (4096 values a chunk, 16 chunks a block): a value the light would
+// clean anywhere, in the first chunk, a middle one or the last, shorter chunk of the last,
+// shorter block, makes it copy the texels.
+TEST(EnvironmentMap, AnUncleanTexelInAnyBlockIsCopied) {
+  const auto f = [](int x, int y) { return 0.5f + float((x + y) % 7); };
+  const size_t n = size_t(1000) * 200 * 3;  // 146 full chunks and one of 1984 values
+  for (const size_t at : {size_t(0), size_t(65536), n / 2 + 1, n - 1984, n - 1}) {
+    EnvironmentMapDesc unclean = make_map(1000, 200, f);
+    auto rgb = std::make_shared<std::vector<float>>(*unclean.rgb);
+    (*rgb)[at] = -0.f;
+    unclean.rgb = std::move(rgb);
+    {
+      const EnvironmentMap map(unclean);
+      EXPECT_EQ(unclean.rgb.use_count(), 1) << at;
+    }
+  }
+  const EnvironmentMapDesc clean = make_map(1000, 200, f);
+  const EnvironmentMap map(clean);
+  EXPECT_EQ(clean.rgb.use_count(), 2);
 }
 
 TEST(EnvironmentMap, OneTexelMapIsConstant) {

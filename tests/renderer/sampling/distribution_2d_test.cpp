@@ -7,6 +7,9 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <mutex>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "renderer/sampling/distribution_2d.h"
@@ -281,6 +284,79 @@ TEST(Distribution2D, OneHotCellAndAllZeroAreHarmless) {
   // A single cell is the uniform distribution.
   const Distribution2D one(std::vector<float>{2.f}, 1, 1);
   EXPECT_EQ(one.pdf(vec2(0.1f, 0.9f)), 1.f);
+}
+
+// The table built from blocks of rows on all cores (the form an environment map uses) is the
+// one-row-at-a-time table to the bit, whatever the blocks: a reference built here row by row
+// (each row a Distribution1D, the marginal over their integrals in row order, the joint density
+// their product), against blocks of 1, 2, 3 and 7 rows (the last one shorter where nv is no
+// multiple), one block of all rows, more rows per block than there are, and the automatic
+// choice; one-row and one-column tables, and sizes around the guide's powers of two. Every row
+// must be put exactly once, by the block that holds it.
+TEST(Distribution2D, BlocksOfRowsGiveTheOneRowAtATimeTableToTheBit) {
+  uint32_t state = 11u;
+  const auto bits = [](float v) { return std::bit_cast<uint32_t>(v); };
+  for (const auto& [nu, nv] : std::vector<std::pair<int, int>>{
+           {1, 1}, {1, 23}, {7, 1}, {64, 1}, {5, 23}, {64, 37}, {257, 9}, {3, 100}, {1000, 70}}) {
+    std::vector<std::vector<float>> rows;
+    for (int j = 0; j < nv; ++j) rows.push_back(shaped_weights(nu, (j * 7 + nu) % 4, &state));
+    if (nv > 2) rows[size_t(nv / 2)].assign(size_t(nu), 0.f);  // a row that weighs nothing
+    // The reference, one row at a time.
+    std::vector<Distribution1D> conditional;
+    std::vector<float> integrals;
+    for (const auto& w : rows) {
+      conditional.emplace_back(w);
+      integrals.push_back(float(conditional.back().integral()));
+    }
+    const Distribution1D marginal(integrals);
+    for (const int per_block : {1, 2, 3, 7, nv, nv + 5, 0}) {
+      std::mutex mutex;
+      std::vector<int> put_count(size_t(nv), 0);
+      std::vector<std::pair<int, int>> blocks;
+      const Distribution2D d(nu, nv, [&](int begin, int end, const Distribution2D::RowPut& put) {
+        {
+          std::lock_guard<std::mutex> lock(mutex);
+          blocks.emplace_back(begin, end);
+        }
+        for (int j = begin; j < end; ++j) {
+          put(j, rows[size_t(j)]);
+          std::lock_guard<std::mutex> lock(mutex);
+          ++put_count[size_t(j)];
+        }
+      }, per_block);
+      const std::string where = "nu " + std::to_string(nu) + " nv " + std::to_string(nv) +
+                                " rows per block " + std::to_string(per_block);
+      // The blocks tile [0, nv) in order of their starts, each of per_block rows but the last.
+      std::sort(blocks.begin(), blocks.end());
+      ASSERT_FALSE(blocks.empty()) << where;
+      EXPECT_EQ(blocks.front().first, 0) << where;
+      EXPECT_EQ(blocks.back().second, nv) << where;
+      for (size_t b = 0; b + 1 < blocks.size(); ++b) {
+        EXPECT_EQ(blocks[b].second, blocks[b + 1].first) << where;
+        if (per_block > 0) EXPECT_EQ(blocks[b].second - blocks[b].first, per_block) << where;
+      }
+      for (int j = 0; j < nv; ++j) ASSERT_EQ(put_count[size_t(j)], 1) << where << " row " << j;
+      // Every number of the table.
+      ASSERT_EQ(d.nu(), nu);
+      ASSERT_EQ(d.nv(), nv);
+      EXPECT_EQ(d.integral(), marginal.integral()) << where;
+      for (int j = 0; j <= nv; ++j) ASSERT_EQ(bits(d.marginal().cdf()[size_t(j)]), bits(marginal.cdf()[size_t(j)])) << where;
+      int steps = 0;
+      for (int j = 0; j < nv; ++j) {
+        const Distribution1D& c = conditional[size_t(j)];
+        steps = std::max(steps, c.search_steps());
+        ASSERT_EQ(d.row_cdf(j).size(), c.cdf().size()) << where;
+        for (size_t i = 0; i < c.cdf().size(); ++i)
+          ASSERT_EQ(bits(d.row_cdf(j)[i]), bits(c.cdf()[i])) << where << " row " << j << " edge " << i;
+        ASSERT_TRUE(std::equal(c.guide().begin(), c.guide().end(), d.row_guide(j).begin(), d.row_guide(j).end()))
+            << where << " row " << j;
+        for (int i = 0; i < nu; ++i)
+          ASSERT_EQ(bits(d.cell_pdf(i, j)), bits(marginal.cell_pdf(j) * c.cell_pdf(i)))
+              << where << " cell " << i << ", " << j;
+      }
+      EXPECT_EQ(d.search_steps(), steps) << where;
+    }
+  }
 }
 
 }  // namespace
