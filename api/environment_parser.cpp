@@ -97,12 +97,8 @@ bool read_map(const std::string& relative, const AssetFolder& assets, Environmen
 // over the texels in blocks on all cores: each value is its own, and the largest of the blocks'
 // largest values is the largest, whatever the blocks (an 8192 x 4096 map is 100M values).
 float clean_and_scale(std::vector<float>& rgb, float scale) {
-  // clean_texel by the bits, branch-free so that the loop vectorises: a value is finite and > 0,
-  // or +0, exactly when its bits are below +infinity's (a sign bit, infinity and NaN are at or
-  // above them); what is not becomes +0, as clean_texel makes it. Clean values order as their
-  // bits do, so the largest is found among the bits (integer compares, which vectorise).
-  constexpr uint32_t kInfinityBits = 0x7f800000u;
-  const auto clean = [](float v) { return std::bit_cast<uint32_t>(v) < kInfinityBits ? v : 0.f; };
+  // clean_texel is branch-free, so the loops vectorise. Clean values order as their bits do, so
+  // the largest is found among the bits (integer compares, which vectorise too).
   const size_t per_block = kRowBlockCells;
   std::vector<uint32_t> block_brightest((rgb.size() + per_block - 1) / per_block, 0u);
   for_row_blocks(rgb.size(), per_block, [&](size_t begin, size_t end) {
@@ -110,14 +106,14 @@ float clean_and_scale(std::vector<float>& rgb, float scale) {
     float* v = rgb.data();
     if (scale == 1.f) {
       for (size_t i = begin; i < end; ++i) {
-        v[i] = clean(v[i]);
+        v[i] = clean_texel(v[i]);
         brightest = std::max(brightest, std::bit_cast<uint32_t>(v[i]));
       }
     } else {
       for (size_t i = begin; i < end; ++i) {
-        const float c = clean(v[i]);
+        const float c = clean_texel(v[i]);
         brightest = std::max(brightest, std::bit_cast<uint32_t>(c));
-        v[i] = clean(c * scale);
+        v[i] = clean_texel(c * scale);
       }
     }
     block_brightest[begin / per_block] = brightest;

@@ -3,7 +3,9 @@
 // api/ produces it from JSON (applying object transforms) and places the origin at the camera
 // position, computed in double precision, so single-precision rendering keeps its accuracy for
 // scenes far from the JSON origin; tests may build it directly.
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
@@ -75,8 +77,12 @@ struct DirectionalLightDesc {
 };
 using LightDesc = std::variant<PointLightDesc, DirectionalLightDesc>;
 
+// Whether a texel value is one an environment map's light keeps as it is, to the bit: +0 or a
+// finite positive number, i.e. its bits lie below +infinity's (a sign bit, infinity and NaN lie
+// at or above them; -0 is not clean). By the bits, branch-free, so loops over a map vectorise.
+inline bool texel_is_clean(float v) { return std::bit_cast<uint32_t>(v) < 0x7f800000u; }
 // What an environment map's light makes of a texel value: itself if finite and > 0, else +0.
-inline float clean_texel(float v) { return std::isfinite(v) && v > 0.f ? v : 0.f; }
+inline float clean_texel(float v) { return texel_is_clean(v) ? v : 0.f; }
 
 // An environment from an equirectangular (latitude-longitude) image, with Mitsuba 3's `envmap`
 // conventions: in map space, direction (x, y, z) looks up u = atan2(x, -z) / 2 pi (mod 1),
