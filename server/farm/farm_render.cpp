@@ -1,7 +1,5 @@
 #include "server/farm/farm_render.h"
 
-#include <chrono>
-
 #include "api/animation_parser.h"
 #include "api/diagnostics.h"
 
@@ -11,7 +9,6 @@ std::shared_ptr<const PreparedScene> prepare_piece_scene(const std::string& scen
                                                          const RenderJobOptions& options,
                                                          const TaskPiece& piece,
                                                          std::string& error) {
-  const auto load_start = std::chrono::steady_clock::now();
   api::LoadResult loaded = load_job_request(scene_json, options, error);
   if (!loaded.ok()) return nullptr;
   api::SceneRequest& request = *loaded.request;
@@ -24,8 +21,6 @@ std::shared_ptr<const PreparedScene> prepare_piece_scene(const std::string& scen
       return nullptr;
     }
   }
-  const double load_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - load_start).count();
   BuiltScene built = build_request_scene(request);
   if (!built.scene) {
     error = std::move(built.error);
@@ -36,7 +31,6 @@ std::shared_ptr<const PreparedScene> prepare_piece_scene(const std::string& scen
   auto prepared = std::make_shared<PreparedScene>();
   prepared->settings = request.settings;
   prepared->scene = std::move(built.scene);
-  prepared->load_seconds = load_seconds;
   prepared->build_seconds = built.build_seconds;
   return prepared;
 }

@@ -27,7 +27,6 @@ namespace penumbra::server {
 struct PreparedScene {
   RenderSettings settings;              // the request's (its frame chosen), before any piece's
   std::unique_ptr<const Scene> scene;   // never null
-  double load_seconds = 0;              // reading and validating the text and its files
   double build_seconds = 0;             // Scene::build and the sampling tables
 };
 
