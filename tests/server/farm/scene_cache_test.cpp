@@ -25,6 +25,17 @@ std::shared_ptr<const PreparedScene> marked(int width) {
   return p;
 }
 
+// What `slots` threads asking the cache for "job" at once get.
+std::vector<SceneCache::Lookup> get_from_slots(SceneCache& cache, int slots,
+                                               const SceneCache::Prepare& prepare) {
+  std::vector<SceneCache::Lookup> got(static_cast<std::size_t>(slots));
+  std::vector<std::thread> threads;
+  for (int i = 0; i < slots; ++i)
+    threads.emplace_back([&, i] { got[size_t(i)] = cache.get("job", prepare); });
+  for (auto& t : threads) t.join();
+  return got;
+}
+
 TEST(SceneCache, OneSlotPreparesWhileTheOthersWait) {
   SceneCache cache;
   std::atomic<int> prepared{0};
@@ -33,12 +44,7 @@ TEST(SceneCache, OneSlotPreparesWhileTheOthersWait) {
     std::this_thread::sleep_for(50ms);  // long enough for every thread to ask meanwhile
     return marked(7);
   };
-  constexpr int kSlots = 4;
-  std::vector<SceneCache::Lookup> got(kSlots);
-  std::vector<std::thread> slots;
-  for (int i = 0; i < kSlots; ++i)
-    slots.emplace_back([&, i] { got[i] = cache.get("job", prepare); });
-  for (auto& t : slots) t.join();
+  const std::vector<SceneCache::Lookup> got = get_from_slots(cache, 4, prepare);
   EXPECT_EQ(prepared.load(), 1);
   int built = 0;
   for (const auto& g : got) {
@@ -97,10 +103,7 @@ TEST(SceneCache, AFailureReachesTheWaitersAndIsNotKept) {
     error = "mesh.ply: not a PLY file";
     return nullptr;
   };
-  std::vector<SceneCache::Lookup> got(3);
-  std::vector<std::thread> slots;
-  for (int i = 0; i < 3; ++i) slots.emplace_back([&, i] { got[i] = cache.get("job", failing); });
-  for (auto& t : slots) t.join();
+  const std::vector<SceneCache::Lookup> got = get_from_slots(cache, 3, failing);
   for (const auto& g : got) {
     EXPECT_FALSE(g.scene);
     EXPECT_FALSE(g.reused);
@@ -119,10 +122,7 @@ TEST(SceneCache, AThrowingPrepareFailsWithoutHangingItsWaiters) {
     std::this_thread::sleep_for(50ms);
     throw std::runtime_error("out of memory");
   };
-  std::vector<SceneCache::Lookup> got(3);
-  std::vector<std::thread> slots;
-  for (int i = 0; i < 3; ++i) slots.emplace_back([&, i] { got[i] = cache.get("job", throwing); });
-  for (auto& t : slots) t.join();
+  const std::vector<SceneCache::Lookup> got = get_from_slots(cache, 3, throwing);
   for (const auto& g : got) {
     EXPECT_FALSE(g.scene);
     EXPECT_EQ(g.error, "out of memory");
