@@ -20,6 +20,15 @@ class AreaLight final : public Light {
   // unbiased for any texture, only noisier for a very uneven one.
   bool sample(const vec3& ref, float time, const vec2& u, LightSample* out) const override;
   float power(float scene_radius) const override;
+  // The shape's box over the shutter and its normals' cone; light leaves each point into the
+  // hemisphere of its normal.
+  std::optional<LightBounds> place() const override {
+    LightBounds b;
+    b.bounds = shape_.bounds();
+    b.normals = shape_.normal_cone();
+    b.cos_theta_e = 0.f;
+    return b;
+  }
 
   // Radiance leaving the front side at a point of the surface.
   Spectrum radiance(const TextureQuery& q) const {

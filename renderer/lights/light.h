@@ -4,7 +4,10 @@
 //
 // Adding a light: a file pair here (a class deriving from Light), its input struct in
 // scene/scene_input.h, one line in lights/make_light.cpp, and its tests (docs/architecture.md).
+#include <optional>
+
 #include "renderer/core/math.h"
+#include "renderer/lights/light_bounds.h"
 
 namespace penumbra {
 
@@ -38,6 +41,10 @@ class Light {
   // shadow ray, and a BSDF-sampled ray that reaches it counts with MIS weight 1 (pbrt-v4's
   // "allowIncompletePDF"; Karlik et al. 2019, "MIS compensation").
   virtual bool left_to_bsdf_sampling() const { return false; }
+  // Where the light is and which way it shines, for choosing among many lights by the shading
+  // point (lights/light_tree.h; phi is left 0: the sampler uses power()); none for a light
+  // without a place (an environment, a distant sun), which is chosen by its power alone.
+  virtual std::optional<LightBounds> place() const { return std::nullopt; }
 };
 
 }  // namespace penumbra

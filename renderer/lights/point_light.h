@@ -12,6 +12,12 @@ class PointLight final : public Light {
   bool sample(const vec3& ref, float time, const vec2& u, LightSample* out) const override;
   float power(float) const override { return 4.f * kPi * luminance(intensity_); }
   const vec3& position() const { return position_; }
+  // A point shining every way.
+  std::optional<LightBounds> place() const override {
+    LightBounds b;
+    b.bounds.extend(position_);
+    return b;
+  }
   const Spectrum& intensity() const { return intensity_; }
 
  private:

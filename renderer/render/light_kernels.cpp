@@ -172,6 +172,14 @@ StagedLights::StagedLights(const Scene& scene) {
     index[l] = int32_t(quads.size());
     quads.push_back(q);
   }
+  // Each staged quad or point light is a pass over all of a stage's lanes: past a few of them
+  // (a scene of many lights, chosen by the light tree) the lanes sample their lights one by one.
+  if (quads.size() + points.size() > kMaxStaged) {
+    for (size_t l = 0; l < lights; ++l)
+      if (kind[l] == kQuad || kind[l] == kPoint) kind[l] = kOwnCode, index[l] = -1;
+    quads.clear();
+    points.clear();
+  }
 }
 
 }  // namespace penumbra

@@ -45,6 +45,9 @@ struct StagedLights {
   struct DistantSource {
     float wi[3], irradiance[3];
   };
+  // Lights with kernels at most: more quad and point lights than this are all sampled lane by
+  // lane (their kernels run over every lane once per light).
+  static constexpr size_t kMaxStaged = 8;
   std::vector<QuadLight> quads;
   std::vector<PointSource> points;
   std::vector<DistantSource> distant;

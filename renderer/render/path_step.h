@@ -228,7 +228,7 @@ template <bool kDistributed, uint32_t kFeatures>
   if (obj.area_light && front) {
     float w = 1.f;
     if (!s.prev_delta)
-      w = power_heuristic(s.prev_pdf, lights.pmf(obj.light) *
+      w = power_heuristic(s.prev_pdf, lights.pmf(obj.light, s.prev_p) *
                                           obj.area_light->pdf(s.prev_p, hit.p, hit.ng, ray.time));
     s.radiance += s.beta * obj.area_light->radiance(TextureQuery{hit.p, hit.uv, ray.time}) * w;
   }
@@ -267,9 +267,10 @@ inline bool path_scatter(const Scene& scene, const IntegratorSettings& settings,
     vec2 u_point;
     sampler.get_1d_2d(&u_light, &u_point);  // one 3D point (Sampler::get_1d_2d)
     LightSample ls;
-    const int light = lights.choose(u_light);
-    if (next_event_light<kDistributed>(scene, light).sample(hit.p, ray.time, u_point, &ls)) {
-      ls.pdf *= lights.pmf(light);
+    float light_pmf;
+    const int light = lights.choose(u_light, hit.p, &light_pmf);
+    if (light >= 0 && next_event_light<kDistributed>(scene, light).sample(hit.p, ray.time, u_point, &ls)) {
+      ls.pdf *= light_pmf;
       const vec3 wo = frame.to_local(ls.wi);
       if (geometry_agrees(wi_world, ls.wi, hit.ng, wi, wo)) {
         // The BSDF's value and, for MIS against its own sampling, its pdf, from one call that

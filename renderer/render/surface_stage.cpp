@@ -807,8 +807,16 @@ void SurfaceStage::compute(const IntegratorSettings& settings, bool scene_next_e
   }
   const LightSampler& sampler = scene_.mis_light_sampler();  // stages: path integrator
   if (next_event) {
-    choose_lights(sampler.cdf().data(), int32_t(sampler.cdf().size()), n, u_light_.data(),
-                  light_.data());
+    if (sampler.spatial()) {
+      // Chosen by the light tree at each lane's point (LightSampler::choose, lane by lane); a
+      // lane none of whose lights can reach its point has no light (-1, no light sample).
+      choose_p_.resize(n);
+      for (size_t i = 0; i < n; ++i) choose_p_[i] = vec3(p_[0][i], p_[1][i], p_[2][i]);
+      sampler.choose_many(n, choose_p_.data(), u_light_.data(), light_.data(), l_pmf_.data());
+    } else {
+      choose_lights(sampler.cdf().data(), int32_t(sampler.cdf().size()), n, u_light_.data(),
+                    light_.data());
+    }
     for (const StagedLights::QuadLight& q : lights_.quads)
       quad_light_samples(q.origin, q.u, q.v, q.n, q.area, q.light, n, light_.data(), p_[0].data(),
                          p_[1].data(), p_[2].data(), u_point_[0].data(), u_point_[1].data(),
@@ -826,11 +834,16 @@ void SurfaceStage::compute(const IntegratorSettings& settings, bool scene_next_e
     // and error; a directional light's whole sample. Point and directional lights are deltas:
     // no MIS weight. (No constant environment: the path integrator, the stages' only user,
     // leaves it to BSDF sampling and never chooses it.)
+    const bool spatial = sampler.spatial();
     for (size_t i = 0; i < n; ++i) {
       const int32_t light = light_[i];
-      const size_t index = size_t(lights_.index[size_t(light)]);
-      l_pmf_[i] = sampler.pmf(light);
       l_delta_[i] = 0;
+      if (light < 0) {
+        light_ok_[i] = 0;
+        continue;
+      }
+      const size_t index = size_t(lights_.index[size_t(light)]);
+      if (!spatial) l_pmf_[i] = sampler.pmf(light);
       switch (lights_.kind[size_t(light)]) {
         case StagedLights::kQuad: {
           const StagedLights::QuadLight& q = lights_.quads[index];

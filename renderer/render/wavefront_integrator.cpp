@@ -111,7 +111,8 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
     if (next_event) {
       // Dimensions 0 and 1 are also the lobe and direction of a surface whose lobes are all
       // Dirac (it estimates no light: a smooth dielectric picks reflection or refraction there).
-      const bool light_pairs = next_event_lights<kDistributed>(scene).cdf().size() > 1;
+      const LightSampler& lights = next_event_lights<kDistributed>(scene);
+      const bool light_pairs = lights.cdf().size() > 1 || lights.spatial();
       samples.start(hit_count, BounceSamples::kBounce, BounceSamples::kBouncePairs,
                     (light_pairs || lobe_pairs ? 0b00001u : 0u) | (lobe_pairs ? 0b00100u : 0u),
                     BounceSamples::kBounceTwoD);

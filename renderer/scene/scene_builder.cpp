@@ -155,12 +155,14 @@ class SceneBuilder {
     const float radius = std::max(0.5f * glm::length(s_.bounds_.hi - s_.bounds_.lo), 1e-6f);
     std::vector<float> powers;
     std::vector<bool> mis_sampled;
+    std::vector<std::optional<LightBounds>> places;
     for (int l = 0; l < s_.light_count(); ++l) {
       powers.push_back(s_.light(l).power(radius));
       mis_sampled.push_back(!s_.mis_light(l).left_to_bsdf_sampling());
+      places.push_back(s_.light(l).place());
     }
-    s_.light_sampler_ = LightSampler(powers);
-    s_.mis_light_sampler_ = LightSampler(powers, mis_sampled);
+    s_.light_sampler_ = LightSampler(powers, std::vector<bool>(powers.size(), true), places);
+    s_.mis_light_sampler_ = LightSampler(powers, mis_sampled, places);
     s_.features_.mis_lights = !s_.mis_light_sampler_.empty();
   }
 

@@ -10,6 +10,7 @@
 #include <span>
 
 #include "renderer/core/bounds.h"
+#include "renderer/core/direction_cone.h"
 #include "renderer/core/motion.h"
 #include "renderer/core/ray.h"
 #include "renderer/embree/handles.h"
@@ -87,6 +88,10 @@ class Shape {
   virtual float pdf(const vec3& ref, const vec3& p, const vec3& n, float time) const = 0;
   // A point on the shape at time 0 (the Embree-only benchmark aims its shadow rays at it).
   virtual vec3 reference_point() const = 0;
+  // A cone holding the geometric normals of every point (the side a surface emits from as an
+  // area light), for choosing among many lights (lights/light_bounds.h); the whole sphere when
+  // the shape does not bound them more tightly. Motion is a translation: the same at every time.
+  virtual DirectionCone normal_cone() const { return DirectionCone::whole_sphere(); }
   // The shape as Embree triangles (meshes and quads), else nullptr: the scene build decides
   // where their exact-t test runs (scene/exact_t_check.h) and looks for coincident triangles.
   virtual TriangleMesh* triangle_mesh() { return nullptr; }

@@ -133,6 +133,30 @@ TriangleMesh::TriangleMesh(const MeshDesc& desc, const ShapeContext& ctx)
   }
 }
 
+DirectionCone TriangleMesh::normal_cone() const {
+  const size_t n = triangle_count();
+  const auto face = [&](size_t t) {
+    const vec3 p0 = positions_[indices_[3 * t]], p1 = positions_[indices_[3 * t + 1]],
+               p2 = positions_[indices_[3 * t + 2]];
+    return glm::cross(p1 - p0, p2 - p0);  // area-weighted: twice the area, along the normal
+  };
+  vec3 sum(0.f);
+  for (size_t t = 0; t < n; ++t) sum += face(t);
+  const float len = glm::length(sum);
+  if (!(len > 0.f) || !std::isfinite(len)) return DirectionCone::whole_sphere();
+  DirectionCone cone;
+  cone.axis = sum / len;
+  float cos_theta = 1.f;
+  for (size_t t = 0; t < n; ++t) {
+    const vec3 f = face(t);
+    const float l = glm::length(f);
+    if (l > 0.f && std::isfinite(l)) cos_theta = std::min(cos_theta, glm::dot(cone.axis, f) / l);
+  }
+  // A little wider than the farthest normal, for the rounding of the normals at the hits.
+  cone.cos_theta = std::max(-1.f, cos_theta - 1e-4f);
+  return cone;
+}
+
 vec3 TriangleMesh::interpolated_displacement(float time) const {
   // Embree interpolates vertex buffers linearly between evenly spread time steps.
   const float f = std::clamp(time, 0.f, 1.f) * float(time_steps_ - 1);

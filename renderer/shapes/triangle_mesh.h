@@ -26,6 +26,8 @@ class TriangleMesh : public Shape {
   bool sample(const vec3& ref, float time, const vec2& u, ShapeSample* out) const override;
   float pdf(const vec3& ref, const vec3& p, const vec3& n, float time) const override;
   vec3 reference_point() const override { return positions_[indices_[0]]; }
+  // Around the area-weighted mean of the face normals, as wide as the farthest face normal.
+  DirectionCone normal_cone() const override;
   // Not Embree triangles while traced as parallelograms.
   TriangleMesh* triangle_mesh() override { return face_pairs_.shapes.empty() ? this : nullptr; }
   std::span<Parallelogram> parallelograms() override { return face_pairs_.shapes; }

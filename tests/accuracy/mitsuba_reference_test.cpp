@@ -39,7 +39,7 @@ const std::vector<std::string> kScenes = {"all_lights", "conductors",   "cornell
                                           "furnace",    "glass_rough",  "glass_smooth", "kitchen_sink",
                                           "mesh_100k",  "mesh_files",   "motion_blur",  "plastics",
                                           "environment_map", "textured_diffuse", "textured_roughness",
-                                          "normal_map", "instances"};
+                                          "normal_map", "instances", "many_lights"};
 
 std::string accuracy_dir() { return std::string(PENUMBRA_SOURCE_DIR) + "/tests/accuracy/"; }
 

@@ -30,6 +30,10 @@ textured_roughness  rough conductors with roughness maps (nearest), textured con
                     textured plastic base, rough glass with a roughness map
 normal_map          normal maps on a diffuse floor, a rough plastic wall, a conductor and a
                     textured diffuse sphere (quad and sphere tangent frames)
+many_lights         a 16 m hall lit by 48 ceiling panels and 16 coloured lamp spheres of different
+                    powers, with diffuse, plastic and conductor objects: where each point is lit
+                    mostly by the few lights near it (penumbra's light tree; Mitsuba chooses
+                    emitters uniformly)
 instances           a smooth-shaded, checker-textured lumpy mesh and copies of it placed by an
                     ``instances`` object (rotated, non-uniformly scaled and sheared, mirrored),
                     and a cube copied by a second one; Mitsuba: ``shapegroup`` + ``instance``
@@ -539,10 +543,49 @@ def instances() -> dict:
         width=96, height=72, max_depth=6, cam_pos=(0, 1.3, 3.8), look=(0, 0.45, 0), fov=38)
 
 
+def many_lights() -> dict:
+    """A hall 4 m wide, 3 m high and 16 m deep along -z: 2 x 24 small ceiling panels 5 cm below
+    the ceiling (clear of it by far more than Mitsuba's ray offset), 16 lamp spheres along the
+    walls in four colours and three powers, a few objects on the floor."""
+    objects = [
+        quad([-2, 0, 1], [0, 0, -16], [4, 0, 0], "floor"),     # floor, front +y
+        quad([-2, 3, 1], [4, 0, 0], [0, 0, -16], "white"),     # ceiling, front -y
+        quad([-2, 0, -15], [4, 0, 0], [0, 3, 0], "white"),     # end wall, front +z
+        quad([-2, 0, 1], [0, 3, 0], [0, 0, -16], "red"),       # left wall, front +x
+        quad([2, 0, 1], [0, 0, -16], [0, 3, 0], "blue"),       # right wall, front -x
+    ]
+    for row in range(24):
+        z = 0.5 - 0.65 * row
+        for x in (-1.0, 0.7):
+            # front -y: u x v = (0, 0, 0.12) x (0.3, 0, 0) points down
+            objects.append(quad([x, 2.95, z - 0.12], [0, 0, 0.12], [0.3, 0, 0], "white", emission=[30, 28, 24]))
+    colours = [[40, 12, 4], [6, 30, 10], [8, 14, 44], [30, 30, 30]]
+    for k in range(16):
+        z = 0.2 - 0.95 * k
+        x = -1.75 if k % 2 == 0 else 1.75
+        scale = (0.5, 1.0, 2.0)[k % 3]
+        objects.append(sphere([x, 1.4, z], 0.06, "white", emission=[c * scale for c in colours[k % 4]]))
+    objects += [
+        sphere([-0.6, 0.5, -2.0], 0.5, "coat"),
+        sphere([0.7, 0.4, -4.5], 0.4, "gold"),
+        sphere([-0.5, 0.6, -8.0], 0.6, "white"),
+        sphere([0.6, 0.35, -11.0], 0.35, "coat"),
+    ]
+    return {"version": 1, "render": render(128, 96, max_depth=6),
+            "camera": camera([0, 1.5, 0.8], [0, 1.1, -8], 55),
+            "materials": {"white": {"type": "diffuse", "color": [0.75, 0.75, 0.75]},
+                          "floor": {"type": "diffuse", "color": [0.5, 0.45, 0.4]},
+                          "red": {"type": "diffuse", "color": [0.6, 0.15, 0.1]},
+                          "blue": {"type": "diffuse", "color": [0.15, 0.25, 0.6]},
+                          "coat": {"type": "plastic", "color": [0.1, 0.5, 0.2], "ior": 1.5, "roughness": 0.2},
+                          "gold": {"type": "conductor", "color": [1.0, 0.78, 0.34], "roughness": 0.25}},
+            "objects": objects}
+
+
 SCENES = {f.__name__: f for f in (cornell, glass_smooth, glass_rough, furnace, conductors, plastics,
                                   dof, motion_blur, all_lights, mesh_100k, mesh_files, kitchen_sink,
                                   environment_map, textured_diffuse, textured_roughness, normal_map,
-                                  instances)}
+                                  instances, many_lights)}
 
 
 def write(name: str, scene: dict) -> str:

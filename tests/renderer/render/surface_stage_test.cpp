@@ -279,12 +279,15 @@ Coverage expect_stage_matches_scene(const SceneInput& in, bool lights, uint32_t 
     scatter_rays += counters.rays;
     if (next_event) {
       LightSample ls;
-      const int chosen = scene->mis_light_sampler().choose(lanes[k].x[0]);
-      const Light& light = scene->mis_light(chosen);
-      cover.delta_lights += light.sample(hit.p, 0.f, vec2(0.5f), &ls) && ls.is_delta;
-      cover.own_code_lights += staged_lights.kind[size_t(chosen)] == StagedLights::kOwnCode;
-      cover.textured_lights += staged_lights.kind[size_t(chosen)] == StagedLights::kQuad &&
-                               staged_lights.quads[size_t(staged_lights.index[size_t(chosen)])].texture;
+      float pmf;
+      const int chosen = scene->mis_light_sampler().choose(lanes[k].z[0], hit.p, &pmf);
+      if (chosen >= 0) {  // (-1: no light reaches the point, a light tree's choice)
+        const Light& light = scene->mis_light(chosen);
+        cover.delta_lights += light.sample(hit.p, 0.f, vec2(0.5f), &ls) && ls.is_delta;
+        cover.own_code_lights += staged_lights.kind[size_t(chosen)] == StagedLights::kOwnCode;
+        cover.textured_lights += staged_lights.kind[size_t(chosen)] == StagedLights::kQuad &&
+                                 staged_lights.quads[size_t(staged_lights.index[size_t(chosen)])].texture;
+      }
     }
     cover.back += glm::dot(lanes[k].state.ray.direction, hit.ng) > 0.f;
     cover.ball += hit.object == 1;
@@ -407,9 +410,31 @@ TEST(SurfaceStage, LambertStepIsPathScatterToTheBitWithTexturedQuadLights) {
   const Coverage c = expect_stage_matches_scene(in, true, 57, StageModel::kLambert);
   EXPECT_GT(c.staged, 1000);
   EXPECT_EQ(c.fallback, 0);
-  EXPECT_GT(c.textured_lights, 200);
+  EXPECT_GT(c.textured_lights, 150);  // (the light tree chooses the floor's own light more)
   EXPECT_GT(c.shadows, 500);
   EXPECT_GT(c.alive, 500);
+}
+
+TEST(SurfaceStage, LambertStepIsPathScatterToTheBitWithManyLights) {
+  // More quad and point lights than have kernels (StagedLights::kMaxStaged): every lane samples
+  // its light by the light's own code, chosen by the light tree at its point.
+  SceneInput in = floor_scene(true, DiffuseParams{Spectrum(0.7f, 0.5f, 0.3f)});
+  for (int i = 0; i < 12; ++i) {
+    const float x = -3.f + 0.5f * float(i);
+    in.objects.push_back(quad_object({x, 1.5f + 0.1f * float(i % 3), -1.f + 0.2f * float(i % 4)}, {0.3f, 0, 0},
+                                     {0, 0, 0.3f}, 1, Spectrum(1.f + 0.5f * float(i % 5))));
+    in.lights.push_back(PointLightDesc{{x, 0.8f, 1.5f}, Spectrum(0.2f + 0.1f * float(i % 3))});
+  }
+  const auto scene = Scene::build(in);
+  ASSERT_TRUE(scene->mis_light_sampler().spatial());
+  const StagedLights staged(*scene);
+  EXPECT_TRUE(staged.quads.empty());
+  EXPECT_TRUE(staged.points.empty());
+  const Coverage c = expect_stage_matches_scene(in, true, 61, StageModel::kLambert);
+  EXPECT_GT(c.staged, 1000);
+  EXPECT_EQ(c.fallback, 0);
+  EXPECT_GT(c.own_code_lights, 1000);
+  EXPECT_GT(c.shadows, 500);
 }
 
 TEST(SurfaceStage, LambertStepIsPathScatterToTheBitWithoutLights) {

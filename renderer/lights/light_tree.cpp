@@ -1,0 +1,322 @@
+#include "renderer/lights/light_tree.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "renderer/core/simd_clones.h"
+
+namespace penumbra {
+namespace {
+
+float safe_acos(float x) { return std::acos(std::clamp(x, -1.f, 1.f)); }
+
+float surface_area(const Bounds3& b) {
+  const vec3 d = glm::max(b.hi - b.lo, vec3(0.f));
+  return 2.f * (d.x * d.y + d.y * d.z + d.z * d.x);
+}
+
+// The solid-angle measure of the directions a node's lights emit into (pbrt-v4's M_omega: the
+// normals' cone widened by the emission spread theta_e), times its power, its box's area and
+// the box's elongation across the split axis: the cost of a child in the surface area
+// orientation heuristic (Conty Estevez and Kulla 2018, section 4.4).
+float split_cost(const LightBounds& b, const Bounds3& parent, int axis) {
+  const float theta_o = safe_acos(b.normals.cos_theta), theta_e = safe_acos(b.cos_theta_e);
+  const float theta_w = std::min(theta_o + theta_e, kPi);
+  const float sin_o = std::sin(theta_o);
+  const float m_omega = 2.f * kPi * (1.f - std::cos(theta_o)) +
+                        0.5f * kPi * (2.f * theta_w * sin_o - std::cos(theta_o - 2.f * theta_w) -
+                                      2.f * theta_o * sin_o + std::cos(theta_o));
+  const vec3 d = parent.hi - parent.lo;
+  const float longest = std::max(d.x, std::max(d.y, d.z));
+  const float kr = d[axis] > 0.f ? longest / d[axis] : 1.f;
+  return b.phi * m_omega * kr * surface_area(b.bounds);
+}
+
+constexpr int kBuckets = 12;
+constexpr int kMaxCostDepth = 40;  // deeper, the binary tree splits by count
+
+int bucket_of(const LightBounds& b, int axis, float lo, float hi) {
+  const float c = 0.5f * (b.bounds.lo[axis] + b.bounds.hi[axis]);
+  return std::clamp(int(float(kBuckets) * (c - lo) / (hi - lo)), 0, kBuckets - 1);
+}
+
+}  // namespace
+
+LightTreeNode::LightTreeNode() {
+  for (int k = 0; k < kWide; ++k) {
+    cx[k] = cy[k] = cz[k] = 0.f;
+    radius[k] = radius2[k] = d2_floor[k] = 0.f;
+    ax[k] = ay[k] = 0.f;
+    az[k] = 1.f;
+    cos_o[k] = -1.f;
+    sin_o[k] = cos_e[k] = phi[k] = 0.f;
+    two_sided[k] = 0.f;
+    all_directions[k] = 1.f;
+    child[k] = -1;
+  }
+}
+
+void LightTreeNode::set(int k, const LightBounds& b, int32_t child_or_light) {
+  const vec3 centre = 0.5f * (b.bounds.lo + b.bounds.hi), diagonal = b.bounds.hi - b.bounds.lo;
+  cx[k] = centre.x, cy[k] = centre.y, cz[k] = centre.z;
+  radius2[k] = 0.25f * glm::dot(diagonal, diagonal);
+  radius[k] = std::sqrt(radius2[k]);
+  d2_floor[k] = 0.5f * glm::length(diagonal);
+  ax[k] = b.normals.axis.x, ay[k] = b.normals.axis.y, az[k] = b.normals.axis.z;
+  cos_o[k] = b.normals.cos_theta;
+  sin_o[k] = safe_sqrt(1.f - cos_o[k] * cos_o[k]);
+  cos_e[k] = b.cos_theta_e;
+  phi[k] = b.phi > 0.f && std::isfinite(b.phi) ? b.phi : 0.f;
+  two_sided[k] = b.two_sided ? 1.f : 0.f;
+  all_directions[k] = b.normals.cos_theta <= -1.f ? 1.f : 0.f;
+  child[k] = child_or_light;
+}
+
+PENUMBRA_SIMD_CLONES
+void light_tree_importance(const LightTreeNode& n, const vec3& p, float* __restrict out) {
+  const float px = p.x, py = p.y, pz = p.z;
+  for (int k = 0; k < LightTreeNode::kWide; ++k) {
+    const float vx = px - n.cx[k], vy = py - n.cy[k], vz = pz - n.cz[k];
+    const float dist2 = vx * vx + vy * vy + vz * vz;
+    const float d2 = std::max(dist2, n.d2_floor[k]);
+    // The angle between the normals' axis and the direction to p, less the cone's own angle,
+    // less the angle the box's bounding sphere subtends from p (sin^2 = r^2 / d^2): cos(a - b)
+    // clamped at a < b to 1, as pbrt-v4's cosSubClamped and sinSubClamped.
+    const float inv_d = 1.f / std::sqrt(dist2);
+    const float dot = (n.ax[k] * vx + n.ay[k] * vy + n.az[k] * vz) * inv_d;
+    const float cos_w = n.two_sided[k] != 0.f ? std::fabs(dot) : dot;
+    const float sin_w = std::sqrt(std::max(0.f, 1.f - cos_w * cos_w));
+    const float sin_b = std::min(n.radius[k] * inv_d, 1.f);
+    const float cos_b = std::sqrt(std::max(0.f, 1.f - sin_b * sin_b));
+    const bool within_o = cos_w > n.cos_o[k];
+    const float cos_x = within_o ? 1.f : cos_w * n.cos_o[k] + sin_w * n.sin_o[k];
+    const float sin_x = within_o ? 0.f : sin_w * n.cos_o[k] - cos_w * n.sin_o[k];
+    float cos_p = cos_x > cos_b ? 1.f : cos_x * cos_b + sin_x * sin_b;
+    // Inside the bounding sphere, or with normals every way, every direction reaches p.
+    cos_p = (n.all_directions[k] != 0.f || dist2 <= n.radius2[k]) ? 1.f : cos_p;
+    const float importance = n.phi[k] * cos_p / d2;
+    out[k] = (cos_p > n.cos_e[k] && importance > 0.f && importance < kInfinity) ? importance : 0.f;
+  }
+}
+
+float light_importance(const LightBounds& b, const vec3& p) {
+  LightTreeNode node;
+  node.set(0, b, -1);
+  float out[LightTreeNode::kWide];
+  light_tree_importance(node, p, out);
+  return out[0];
+}
+
+LightTree::LightTree(const std::vector<LightBounds>& lights, const std::vector<int>& ids) {
+  std::vector<std::pair<LightBounds, int>> kept;
+  int max_id = -1;
+  for (size_t k = 0; k < lights.size() && k < ids.size(); ++k)
+    if (ids[k] >= 0 && lights[k].phi > 0.f && std::isfinite(lights[k].phi) && !lights[k].bounds.empty()) {
+      kept.emplace_back(lights[k], ids[k]);
+      max_id = std::max(max_id, ids[k]);
+    }
+  if (kept.empty()) return;
+  light_count_ = kept.size();
+  slot_of_.assign(size_t(max_id) + 1, {-1, -1});
+  std::vector<Binary> binary;
+  binary.reserve(2 * kept.size() - 1);
+  build_binary(binary, kept, 0, kept.size(), 0);
+  collapse(binary, 0, -1, -1);
+}
+
+int LightTree::build_binary(std::vector<Binary>& out, std::vector<std::pair<LightBounds, int>>& lights,
+                            size_t begin, size_t end, int depth) {
+  const int index = int(out.size());
+  out.emplace_back();
+  if (end - begin == 1) {
+    out[size_t(index)].bounds = lights[begin].first;
+    out[size_t(index)].light = lights[begin].second;
+    return index;
+  }
+  LightBounds all;
+  Bounds3 centres;
+  for (size_t k = begin; k < end; ++k) {
+    all = LightBounds::merge(all, lights[k].first);
+    centres.extend(0.5f * (lights[k].first.bounds.lo + lights[k].first.bounds.hi));
+  }
+  // The cheapest of kBuckets - 1 planes on each axis by the orientation heuristic; half by
+  // count where no plane separates the centres or the tree grows deep.
+  float best = kInfinity;
+  int best_axis = -1, best_plane = 0;
+  for (int axis = 0; axis < 3 && depth < kMaxCostDepth; ++axis) {
+    const float lo = centres.lo[axis], hi = centres.hi[axis];
+    if (!(hi > lo)) continue;
+    LightBounds bucket[kBuckets];
+    for (size_t k = begin; k < end; ++k) {
+      LightBounds& b = bucket[bucket_of(lights[k].first, axis, lo, hi)];
+      b = LightBounds::merge(b, lights[k].first);
+    }
+    for (int plane = 0; plane + 1 < kBuckets; ++plane) {
+      LightBounds below, above;
+      for (int i = 0; i <= plane; ++i) below = LightBounds::merge(below, bucket[i]);
+      for (int i = plane + 1; i < kBuckets; ++i) above = LightBounds::merge(above, bucket[i]);
+      if (!(below.phi > 0.f) || !(above.phi > 0.f)) continue;
+      const float cost = split_cost(below, all.bounds, axis) + split_cost(above, all.bounds, axis);
+      if (cost < best) best = cost, best_axis = axis, best_plane = plane;
+    }
+  }
+  size_t mid = begin + (end - begin) / 2;
+  bool split = false;
+  if (best_axis >= 0) {
+    const int axis = best_axis;
+    const float lo = centres.lo[axis], hi = centres.hi[axis];
+    const auto it = std::partition(lights.begin() + std::ptrdiff_t(begin), lights.begin() + std::ptrdiff_t(end),
+                                   [&](const std::pair<LightBounds, int>& l) {
+                                     return bucket_of(l.first, axis, lo, hi) <= best_plane;
+                                   });
+    const size_t at = size_t(it - lights.begin());
+    if (at > begin && at < end) mid = at, split = true;
+  }
+  if (!split) {
+    // By count along the centres' longest axis, so the halves are at least ordered in space.
+    const vec3 d = centres.hi - centres.lo;
+    const int axis = d.x >= d.y && d.x >= d.z ? 0 : (d.y >= d.z ? 1 : 2);
+    std::nth_element(lights.begin() + std::ptrdiff_t(begin), lights.begin() + std::ptrdiff_t(mid),
+                     lights.begin() + std::ptrdiff_t(end), [axis](const auto& a, const auto& b) {
+                       return a.first.bounds.lo[axis] + a.first.bounds.hi[axis] <
+                              b.first.bounds.lo[axis] + b.first.bounds.hi[axis];
+                     });
+  }
+  build_binary(out, lights, begin, mid, depth + 1);
+  const int second = build_binary(out, lights, mid, end, depth + 1);
+  out[size_t(index)].bounds = all;
+  out[size_t(index)].second = second;
+  return index;
+}
+
+int LightTree::collapse(const std::vector<Binary>& binary, int root, int parent, int parent_slot) {
+  // The node's children: the binary subtree's top, opened up (the brightest interior entry
+  // first) until there are kWide entries or only leaves.
+  std::vector<int> entries = {root};
+  if (binary[size_t(root)].light < 0) {
+    entries.clear();
+    entries.push_back(root + 1);
+    entries.push_back(binary[size_t(root)].second);
+  }
+  while (entries.size() < size_t(LightTreeNode::kWide)) {
+    int open = -1;
+    for (size_t e = 0; e < entries.size(); ++e) {
+      const Binary& b = binary[size_t(entries[e])];
+      if (b.light < 0 && (open < 0 || b.bounds.phi > binary[size_t(entries[size_t(open)])].bounds.phi))
+        open = int(e);
+    }
+    if (open < 0) break;
+    const int at = entries[size_t(open)];
+    entries[size_t(open)] = at + 1;
+    entries.insert(entries.begin() + open + 1, binary[size_t(at)].second);
+  }
+  const int index = int(nodes_.size());
+  nodes_.emplace_back();
+  nodes_[size_t(index)].parent = parent;
+  nodes_[size_t(index)].parent_slot = parent_slot;
+  for (size_t e = 0; e < entries.size(); ++e) {
+    const Binary& b = binary[size_t(entries[e])];
+    int32_t child;
+    if (b.light >= 0) {
+      child = -1 - b.light;
+      slot_of_[size_t(b.light)] = {index, int32_t(e)};
+    } else {
+      child = collapse(binary, entries[e], index, int(e));
+    }
+    nodes_[size_t(index)].set(int(e), b.bounds, child);  // (nodes_ may have grown: index again)
+  }
+  return index;
+}
+
+bool LightTree::step(int node, const vec3& p, float* u, float* prob, int32_t* child) const {
+  const LightTreeNode& n = nodes_[size_t(node)];
+  float imp[LightTreeNode::kWide], cum[LightTreeNode::kWide];
+  light_tree_importance(n, p, imp);
+  float total = 0.f;
+  for (int k = 0; k < LightTreeNode::kWide; ++k) cum[k] = total += imp[k];
+  if (!(total > 0.f)) return false;
+  // The slot whose interval [cum[k - 1], cum[k]) holds u x total: the number of intervals that
+  // end at or below it (counted, not searched: which one it is is random, and a branch on it
+  // would be mispredicted half the time). A slot of importance 0 has an empty interval and is
+  // never the one; rounding past the last interval falls to the last nonempty one.
+  const float target = *u * total;
+  int slot = 0;
+  for (int k = 0; k < LightTreeNode::kWide; ++k) slot += int(cum[k] <= target);
+  if (slot >= LightTreeNode::kWide) {
+    slot = LightTreeNode::kWide - 1;
+    while (!(imp[slot] > 0.f)) --slot;
+  }
+  const float below = slot > 0 ? cum[slot - 1] : 0.f;
+  *u = std::clamp((target - below) / imp[slot], 0.f, kOneMinusEpsilon);
+  *prob *= imp[slot] / total;
+  *child = n.child[slot];
+  return true;
+}
+
+int LightTree::choose(const vec3& p, float u, float* pmf) const {
+  int light;
+  choose_many(1, &p, &u, &light, pmf);
+  return light;
+}
+
+void LightTree::choose_many(size_t n, const vec3* p, const float* u, int* light, float* pmf) const {
+  if (nodes_.empty()) {
+    for (size_t k = 0; k < n; ++k) light[k] = -1, pmf[k] = 0.f;
+    return;
+  }
+  // Per point: its node (light[k] while walking), its u (in a buffer) and its probability.
+  constexpr size_t kChunk = 256;
+  float walk_u[kChunk];
+  int32_t at[kChunk];
+  for (size_t base = 0; base < n; base += kChunk) {
+    const size_t m = std::min(kChunk, n - base);
+    size_t walking = m;
+    for (size_t k = 0; k < m; ++k) {
+      walk_u[k] = u[base + k];
+      pmf[base + k] = 1.f;
+      at[k] = 0;
+    }
+    while (walking > 0) {
+      walking = 0;
+      for (size_t k = 0; k < m; ++k) {
+        if (at[k] < 0) continue;
+        int32_t child;
+        if (!step(at[k], p[base + k], &walk_u[k], &pmf[base + k], &child)) {
+          light[base + k] = -1;
+          pmf[base + k] = 0.f;
+          at[k] = -1;
+        } else if (child < 0) {
+          light[base + k] = -1 - child;
+          at[k] = -1;
+        } else {
+          at[k] = child;
+          ++walking;
+        }
+      }
+    }
+  }
+}
+
+float LightTree::pmf(const vec3& p, int id) const {
+  if (id < 0 || size_t(id) >= slot_of_.size() || slot_of_[size_t(id)].first < 0) return 0.f;
+  // The path from the root to the light's slot, then its probabilities in choose()'s order.
+  std::pair<int32_t, int32_t> path[64];
+  int depth = 0;
+  for (std::pair<int32_t, int32_t> at = slot_of_[size_t(id)]; at.first >= 0 && depth < 64;) {
+    path[depth++] = at;
+    const LightTreeNode& n = nodes_[size_t(at.first)];
+    at = {n.parent, n.parent_slot};
+  }
+  float prob = 1.f;
+  for (int level = depth - 1; level >= 0; --level) {
+    float imp[LightTreeNode::kWide];
+    light_tree_importance(nodes_[size_t(path[level].first)], p, imp);
+    float total = 0.f;
+    for (int k = 0; k < LightTreeNode::kWide; ++k) total += imp[k];  // choose()'s order
+    if (!(total > 0.f)) return 0.f;
+    prob *= imp[path[level].second] / total;
+  }
+  return prob;
+}
+
+}  // namespace penumbra

@@ -1,0 +1,215 @@
+// The light tree chooses among many lights by where the shading point is: a distribution over
+// the lights at every point (its pmf sums to one, choose() draws by it), which favours near and
+// bright lights and never chooses a light that cannot reach the point.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "renderer/lights/light_sampler.h"
+#include "renderer/lights/light_tree.h"
+
+namespace penumbra::test {
+namespace {
+
+// A one-sided square panel of side s at c facing n (one of the axes), or a point when s = 0.
+LightBounds panel(const vec3& c, float s, const vec3& n, float phi) {
+  LightBounds b;
+  const vec3 half = 0.5f * s * (vec3(1.f) - glm::abs(n));
+  b.bounds.extend(c - half);
+  b.bounds.extend(c + half);
+  b.normals.axis = n;
+  b.normals.cos_theta = 1.f;
+  b.phi = phi;
+  return b;
+}
+LightBounds point(const vec3& c, float phi) {
+  LightBounds b;
+  b.bounds.extend(c);
+  b.phi = phi;
+  return b;
+}
+
+// 40 ceiling panels facing down and 10 points, of powers 0.5..5.
+struct ManyLights {
+  std::vector<LightBounds> lights;
+  std::vector<int> ids;
+  ManyLights() {
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> u(0.f, 1.f);
+    for (int i = 0; i < 40; ++i) {
+      lights.push_back(panel(vec3(-4.f + 8.f * u(rng), 3.f, -10.f + 10.f * u(rng)), 0.3f, vec3(0, -1, 0),
+                             0.5f + 4.5f * u(rng)));
+      ids.push_back(3 * i + 1);  // ids need not be dense
+    }
+    for (int i = 0; i < 10; ++i) {
+      lights.push_back(point(vec3(-4.f + 8.f * u(rng), 0.5f + 2.f * u(rng), -10.f + 10.f * u(rng)),
+                             0.5f + 4.5f * u(rng)));
+      ids.push_back(200 + i);
+    }
+  }
+};
+
+TEST(LightTree, PmfSumsToOneAndChooseDrawsByIt) {
+  const ManyLights scene;
+  const LightTree tree(scene.lights, scene.ids);
+  ASSERT_EQ(tree.size(), scene.lights.size());
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(0.f, 1.f);
+  for (int trial = 0; trial < 20; ++trial) {
+    const vec3 p(-4.f + 8.f * u(rng), 2.9f * u(rng), -10.f + 10.f * u(rng));
+    double sum = 0.0;
+    for (int id : scene.ids) sum += tree.pmf(p, id);
+    EXPECT_NEAR(sum, 1.0, 1e-5) << trial;
+    // Stratified u: each light's share of draws within 0.5% of its pmf, and the pmf choose()
+    // reports is pmf() to the bit.
+    std::vector<int> count(256, 0);
+    const int n = 20000;
+    for (int k = 0; k < n; ++k) {
+      float pmf = 0.f;
+      const int id = tree.choose(p, (float(k) + 0.5f) / float(n), &pmf);
+      ASSERT_GE(id, 0);
+      ASSERT_EQ(pmf, tree.pmf(p, id));
+      ++count[size_t(id)];
+    }
+    for (int id : scene.ids) EXPECT_NEAR(double(count[size_t(id)]) / n, tree.pmf(p, id), 5e-3) << id;
+  }
+  EXPECT_EQ(tree.pmf(vec3(0.f), 0), 0.f);  // not in the tree
+}
+
+TEST(LightTree, ManyLevels) {
+  std::vector<LightBounds> lights;
+  std::vector<int> ids;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(0.f, 1.f);
+  for (int i = 0; i < 700; ++i) {
+    lights.push_back(point(vec3(40.f * u(rng), 3.f * u(rng), 40.f * u(rng)), 0.1f + u(rng)));
+    ids.push_back(i);
+  }
+  lights.push_back(point(vec3(1.f), 1.f));  // two lights at one place
+  ids.push_back(700);
+  lights.push_back(point(vec3(1.f), 1.f));
+  ids.push_back(701);
+  const LightTree tree(lights, ids);
+  for (int trial = 0; trial < 5; ++trial) {
+    const vec3 p(40.f * u(rng), 1.f, 40.f * u(rng));
+    double sum = 0.0;
+    for (int id : ids) sum += tree.pmf(p, id);
+    EXPECT_NEAR(sum, 1.0, 1e-4);
+    for (int k = 0; k < 2000; ++k) {
+      float pmf;
+      const int id = tree.choose(p, u(rng), &pmf);
+      ASSERT_GE(id, 0);
+      ASSERT_EQ(pmf, tree.pmf(p, id));
+    }
+  }
+}
+
+TEST(LightTree, FavoursNearLightsAndNeverChoosesOnesThatCannotReach) {
+  // Two equal panels facing down at x = -5 and x = 5, one point light far off.
+  const std::vector<LightBounds> lights = {panel(vec3(-5, 3, 0), 0.5f, vec3(0, -1, 0), 1.f),
+                                           panel(vec3(5, 3, 0), 0.5f, vec3(0, -1, 0), 1.f),
+                                           point(vec3(0, 1, -40), 1.f)};
+  const LightTree tree(lights, {0, 1, 2});
+  const vec3 below_first(-5, 0, 0);
+  EXPECT_GT(tree.pmf(below_first, 0), 0.8f);
+  EXPECT_GT(tree.pmf(below_first, 1), 0.f);  // far, but it still reaches: never zero
+  // Above the panels (behind their emitting sides) only the point light can reach. (The panels'
+  // node itself may still look reachable: inside its bounding sphere every direction counts,
+  // so a choice that goes there ends without a light, -1, as pbrt-v4's does.)
+  const vec3 above(0, 4, 0);
+  EXPECT_EQ(tree.pmf(above, 0), 0.f);
+  EXPECT_EQ(tree.pmf(above, 1), 0.f);
+  EXPECT_GT(tree.pmf(above, 2), 0.f);
+  int chosen = 0;
+  for (int k = 0; k < 100; ++k) {
+    float pmf;
+    const int light = tree.choose(above, (float(k) + 0.5f) / 100.f, &pmf);
+    EXPECT_TRUE(light == 2 || light == -1) << light;
+    chosen += light == 2;
+  }
+  EXPECT_NEAR(chosen / 100.0, tree.pmf(above, 2), 0.011);
+}
+
+TEST(LightTree, NoLightThatCanReachGivesNone) {
+  const LightTree tree({panel(vec3(-1, 3, 0), 0.5f, vec3(0, -1, 0), 1.f), panel(vec3(1, 3, 0), 0.5f, vec3(0, -1, 0), 1.f)},
+                       {0, 1});
+  float pmf = 1.f;
+  EXPECT_EQ(tree.choose(vec3(0, 5, 0), 0.3f, &pmf), -1);
+  EXPECT_EQ(pmf, 0.f);
+}
+
+TEST(LightImportance, ZeroOnlyWhereNoEmissionDirectionReaches) {
+  // A panel facing +z: points just in front of its plane, even far to the side, get light.
+  const LightBounds b = panel(vec3(0.f), 1.f, vec3(0, 0, 1), 1.f);
+  EXPECT_GT(light_importance(b, vec3(0, 0, 1)), 0.f);
+  EXPECT_GT(light_importance(b, vec3(30, 0, 1e-3f)), 0.f);
+  EXPECT_EQ(light_importance(b, vec3(0, 0, -1)), 0.f);
+  EXPECT_EQ(light_importance(b, vec3(30, 0, -1)), 0.f);
+  // Nearer is more important, and importance is finite at the light itself.
+  EXPECT_GT(light_importance(b, vec3(0, 0, 1)), light_importance(b, vec3(0, 0, 4)));
+  EXPECT_TRUE(std::isfinite(light_importance(b, vec3(0.f))));
+  // A point light at the point itself: no finite estimate, importance 0 (not a NaN).
+  EXPECT_EQ(light_importance(point(vec3(1, 2, 3), 1.f), vec3(1, 2, 3)), 0.f);
+  EXPECT_GT(light_importance(point(vec3(1, 2, 3), 1.f), vec3(1, 2, 4)), 0.f);
+}
+
+TEST(DirectionCone, MergeHoldsBoth) {
+  std::mt19937 rng(11);
+  std::normal_distribution<float> g;
+  for (int trial = 0; trial < 200; ++trial) {
+    DirectionCone a, b;
+    a.axis = glm::normalize(vec3(g(rng), g(rng), g(rng)));
+    b.axis = glm::normalize(vec3(g(rng), g(rng), g(rng)));
+    a.cos_theta = std::cos(0.5f * std::fabs(g(rng)));
+    b.cos_theta = std::cos(0.5f * std::fabs(g(rng)));
+    const DirectionCone m = DirectionCone::merge(a, b);
+    // Each input's axis and edge lie within the merged cone.
+    for (const DirectionCone& c : {a, b}) {
+      EXPECT_GE(glm::dot(m.axis, c.axis), m.cos_theta - 1e-5f);
+      const vec3 side = glm::normalize(glm::cross(c.axis, std::fabs(c.axis.x) < 0.9f ? vec3(1, 0, 0) : vec3(0, 1, 0)));
+      const float s = std::sqrt(std::max(0.f, 1.f - c.cos_theta * c.cos_theta));
+      for (int k = 0; k < 8; ++k) {
+        const float phi = float(k) * 0.785398f;
+        const vec3 other = glm::cross(c.axis, side);
+        const vec3 edge = c.cos_theta * c.axis + s * (std::cos(phi) * side + std::sin(phi) * other);
+        EXPECT_GE(glm::dot(m.axis, edge), m.cos_theta - 1e-4f) << trial;
+      }
+    }
+  }
+}
+
+TEST(LightSampler, TreeGroupKeepsItsShareAndSumsToOne) {
+  // An environment (no place) and three placed lights: the group has the share its lights have
+  // by power and count, split by the tree at the point.
+  const std::vector<float> powers = {1.f, 2.f, 3.f, 4.f};
+  const std::vector<bool> sampled(4, true);
+  std::vector<std::optional<LightBounds>> places = {point(vec3(0, 1, 0), 0.f), point(vec3(5, 1, 0), 0.f),
+                                                    point(vec3(-5, 1, 0), 0.f), std::nullopt};
+  const LightSampler flat(powers, sampled);
+  const LightSampler spatial(powers, sampled, places);
+  ASSERT_TRUE(spatial.spatial());
+  ASSERT_FALSE(flat.spatial());
+  const vec3 p(4, 0, 0);
+  EXPECT_FLOAT_EQ(spatial.pmf(3, p), flat.pmf(3));
+  EXPECT_NEAR(spatial.pmf(0, p) + spatial.pmf(1, p) + spatial.pmf(2, p), flat.pmf(0) + flat.pmf(1) + flat.pmf(2), 1e-6);
+  EXPECT_GT(spatial.pmf(1, p), spatial.pmf(2, p));  // the near one
+  std::vector<int> count(4, 0);
+  const int n = 40000;
+  for (int k = 0; k < n; ++k) {
+    float pmf;
+    const int light = spatial.choose((float(k) + 0.5f) / float(n), p, &pmf);
+    ASSERT_GE(light, 0);
+    EXPECT_EQ(pmf, spatial.pmf(light, p));
+    ++count[size_t(light)];
+  }
+  for (int l = 0; l < 4; ++l) EXPECT_NEAR(double(count[size_t(l)]) / n, spatial.pmf(l, p), 2e-3) << l;
+  // One placed light alone: no tree, the same choice as without places.
+  const LightSampler one(powers, sampled, {point(vec3(0.f), 0.f), std::nullopt, std::nullopt, std::nullopt});
+  EXPECT_FALSE(one.spatial());
+  for (int l = 0; l < 4; ++l) EXPECT_EQ(one.pmf(l), flat.pmf(l));
+  EXPECT_EQ(one.cdf(), flat.cdf());
+}
+
+}  // namespace
+}  // namespace penumbra::test
