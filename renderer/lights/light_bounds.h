@@ -10,7 +10,8 @@ namespace penumbra {
 
 // What a light (or a node's lights together) emits where: its points lie in `bounds`, its
 // surface normals within `normals`, light leaves each point within `cos_theta_e` of the normal
-// (cos(pi/2) = 0 for a Lambertian emitter), power `phi` (the light sampler's power: luminance).
+// (cos(pi/2) = 0 for a Lambertian emitter), `phi` a bound of its radiant intensity (luminance
+// per steradian, as the light sampler sets it from the power) or, for a node, its lights' sum.
 // A point light has a point box, the whole sphere of normals and cos_theta_e = 0.
 struct LightBounds {
   Bounds3 bounds;

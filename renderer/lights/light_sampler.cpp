@@ -38,7 +38,7 @@ LightSampler::LightSampler(const std::vector<float>& powers, const std::vector<b
       pmf_[i] = float(0.5 * by_power + 0.5 / double(count));
     }
 
-  const bool use_tree = placed_count >= 2;
+  const bool use_tree = placed_count >= kTreeFrom;
   std::vector<LightBounds> bounds;
   std::vector<int> ids;
   double group = 0.0;
@@ -49,7 +49,11 @@ LightSampler::LightSampler(const std::vector<float>& powers, const std::vector<b
       in_tree_[i] = true;
       group += pmf_[i];
       LightBounds b = *places[i];
-      b.phi = float(power[i]);
+      // The importance's numerator is the light's largest radiant intensity, which its power
+      // bounds as P / (4 pi) for light leaving every way (a point, a sphere) and P / pi for a
+      // flat Lambertian emitter (L A of P = pi L A). Power itself would favour points and
+      // spheres four times over panels of the same intensity.
+      b.phi = float(power[i] / (b.normals.cos_theta <= -1.f ? 4.0 * M_PI : M_PI));
       bounds.push_back(b);
       ids.push_back(int(i));
     }
@@ -100,7 +104,7 @@ float LightSampler::group_u(int e, float u) const {
   return hi > lo ? std::clamp((u - lo) / (hi - lo), 0.f, kOneMinusEpsilon) : 0.f;
 }
 
-int LightSampler::choose(float u, const vec3& p, float* pmf) const {
+int LightSampler::choose(float u, const vec3& p, const vec3& n, float* pmf) const {
   const int e = choose_entry(u);
   const int light = entry_light_[size_t(e)];
   if (light >= 0) {
@@ -108,15 +112,16 @@ int LightSampler::choose(float u, const vec3& p, float* pmf) const {
     return light;
   }
   float tree_pmf;
-  const int chosen = tree_.choose(p, group_u(e, u), &tree_pmf);
+  const int chosen = tree_.choose(p, n, group_u(e, u), &tree_pmf);
   *pmf = tree_pmf_ * tree_pmf;
   return chosen;
 }
 
-void LightSampler::choose_many(size_t n, const vec3* p, const float* u, int* light, float* pmf) const {
+void LightSampler::choose_many(size_t n, const vec3* p, const vec3* normal, const float* u, int* light,
+                               float* pmf) const {
   // Lights outside the tree at once; the tree's group gathered and walked together.
-  std::vector<vec3> group_p;
-  std::vector<float> group_v, group_pmf;
+  std::vector<vec3> group_p, group_n;
+  std::vector<float> group_v, walk_pmf;
   std::vector<int> group_light;
   std::vector<size_t> group_of;
   for (size_t k = 0; k < n; ++k) {
@@ -128,15 +133,17 @@ void LightSampler::choose_many(size_t n, const vec3* p, const float* u, int* lig
     }
     group_of.push_back(k);
     group_p.push_back(p[k]);
+    group_n.push_back(normal[k]);
     group_v.push_back(group_u(e, u[k]));
   }
   if (group_of.empty()) return;
   group_light.resize(group_of.size());
-  group_pmf.resize(group_of.size());
-  tree_.choose_many(group_of.size(), group_p.data(), group_v.data(), group_light.data(), group_pmf.data());
+  walk_pmf.resize(group_of.size());
+  tree_.choose_many(group_of.size(), group_p.data(), group_n.data(), group_v.data(), group_light.data(),
+                    walk_pmf.data());
   for (size_t j = 0; j < group_of.size(); ++j) {
     light[group_of[j]] = group_light[j];
-    pmf[group_of[j]] = tree_pmf_ * group_pmf[j];
+    pmf[group_of[j]] = tree_pmf_ * walk_pmf[j];
   }
 }
 

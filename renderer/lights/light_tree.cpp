@@ -52,6 +52,7 @@ LightTreeNode::LightTreeNode() {
     sin_o[k] = cos_e[k] = phi[k] = 0.f;
     two_sided[k] = 0.f;
     all_directions[k] = 1.f;
+    one_way[k] = behind_at[k] = 0.f;
     child[k] = -1;
   }
 }
@@ -69,12 +70,21 @@ void LightTreeNode::set(int k, const LightBounds& b, int32_t child_or_light) {
   phi[k] = b.phi > 0.f && std::isfinite(b.phi) ? b.phi : 0.f;
   two_sided[k] = b.two_sided ? 1.f : 0.f;
   all_directions[k] = b.normals.cos_theta <= -1.f ? 1.f : 0.f;
+  one_way[k] = b.normals.cos_theta >= 1.f ? 1.f : 0.f;
+  const float reach =
+      0.5f * (std::fabs(ax[k]) * diagonal.x + std::fabs(ay[k]) * diagonal.y + std::fabs(az[k]) * diagonal.z);
+  const float size = 1.f + std::max(std::fabs(centre.x), std::max(std::fabs(centre.y), std::fabs(centre.z))) +
+                     std::max(diagonal.x, std::max(diagonal.y, diagonal.z));
+  behind_at[k] = 1e-5f * size - reach;
   child[k] = child_or_light;
 }
 
 PENUMBRA_SIMD_CLONES
-void light_tree_importance(const LightTreeNode& n, const vec3& p, float* __restrict out) {
+void light_tree_importance(const LightTreeNode& n, const vec3& p, const vec3& normal,
+                           float* __restrict out) {
   const float px = p.x, py = p.y, pz = p.z;
+  const float nx = normal.x, ny = normal.y, nz = normal.z;
+  const bool has_normal = nx != 0.f || ny != 0.f || nz != 0.f;
   for (int k = 0; k < LightTreeNode::kWide; ++k) {
     const float vx = px - n.cx[k], vy = py - n.cy[k], vz = pz - n.cz[k];
     const float dist2 = vx * vx + vy * vy + vz * vz;
@@ -93,17 +103,27 @@ void light_tree_importance(const LightTreeNode& n, const vec3& p, float* __restr
     const float sin_x = within_o ? 0.f : sin_w * n.cos_o[k] - cos_w * n.sin_o[k];
     float cos_p = cos_x > cos_b ? 1.f : cos_x * cos_b + sin_x * sin_b;
     // Inside the bounding sphere, or with normals every way, every direction reaches p.
-    cos_p = (n.all_directions[k] != 0.f || dist2 <= n.radius2[k]) ? 1.f : cos_p;
-    const float importance = n.phi[k] * cos_p / d2;
-    out[k] = (cos_p > n.cos_e[k] && importance > 0.f && importance < kInfinity) ? importance : 0.f;
+    const bool inside = dist2 <= n.radius2[k];
+    cos_p = (n.all_directions[k] != 0.f || inside) ? 1.f : cos_p;
+    // The receiver: |cos| between its normal and the direction to the centre, less the sphere's
+    // angle (1 inside it or without a normal).
+    const float cos_i = std::fabs(nx * vx + ny * vy + nz * vz) * inv_d;
+    const float sin_i = std::sqrt(std::max(0.f, 1.f - cos_i * cos_i));
+    float cos_ip = cos_i > cos_b ? 1.f : cos_i * cos_b + sin_i * sin_b;
+    cos_ip = (inside || !has_normal) ? 1.f : cos_ip;
+    const float importance = n.phi[k] * cos_p * cos_ip / d2;
+    // Behind or in the plane of every emitter of one direction (a Lambertian panel's own
+    // points receive nothing from it either).
+    const bool behind = n.one_way[k] != 0.f && (n.ax[k] * vx + n.ay[k] * vy + n.az[k] * vz) <= n.behind_at[k];
+    out[k] = (!behind && cos_p > n.cos_e[k] && importance > 0.f && importance < kInfinity) ? importance : 0.f;
   }
 }
 
-float light_importance(const LightBounds& b, const vec3& p) {
+float light_importance(const LightBounds& b, const vec3& p, const vec3& n) {
   LightTreeNode node;
   node.set(0, b, -1);
   float out[LightTreeNode::kWide];
-  light_tree_importance(node, p, out);
+  light_tree_importance(node, p, n, out);
   return out[0];
 }
 
@@ -228,10 +248,11 @@ int LightTree::collapse(const std::vector<Binary>& binary, int root, int parent,
   return index;
 }
 
-bool LightTree::step(int node, const vec3& p, float* u, float* prob, int32_t* child) const {
+bool LightTree::step(int node, const vec3& p, const vec3& normal, float* u, float* prob,
+                     int32_t* child) const {
   const LightTreeNode& n = nodes_[size_t(node)];
   float imp[LightTreeNode::kWide], cum[LightTreeNode::kWide];
-  light_tree_importance(n, p, imp);
+  light_tree_importance(n, p, normal, imp);
   float total = 0.f;
   for (int k = 0; k < LightTreeNode::kWide; ++k) cum[k] = total += imp[k];
   if (!(total > 0.f)) return false;
@@ -253,13 +274,14 @@ bool LightTree::step(int node, const vec3& p, float* u, float* prob, int32_t* ch
   return true;
 }
 
-int LightTree::choose(const vec3& p, float u, float* pmf) const {
+int LightTree::choose(const vec3& p, const vec3& normal, float u, float* pmf) const {
   int light;
-  choose_many(1, &p, &u, &light, pmf);
+  choose_many(1, &p, &normal, &u, &light, pmf);
   return light;
 }
 
-void LightTree::choose_many(size_t n, const vec3* p, const float* u, int* light, float* pmf) const {
+void LightTree::choose_many(size_t n, const vec3* p, const vec3* normal, const float* u, int* light,
+                            float* pmf) const {
   if (nodes_.empty()) {
     for (size_t k = 0; k < n; ++k) light[k] = -1, pmf[k] = 0.f;
     return;
@@ -281,7 +303,7 @@ void LightTree::choose_many(size_t n, const vec3* p, const float* u, int* light,
       for (size_t k = 0; k < m; ++k) {
         if (at[k] < 0) continue;
         int32_t child;
-        if (!step(at[k], p[base + k], &walk_u[k], &pmf[base + k], &child)) {
+        if (!step(at[k], p[base + k], normal[base + k], &walk_u[k], &pmf[base + k], &child)) {
           light[base + k] = -1;
           pmf[base + k] = 0.f;
           at[k] = -1;
@@ -297,7 +319,7 @@ void LightTree::choose_many(size_t n, const vec3* p, const float* u, int* light,
   }
 }
 
-float LightTree::pmf(const vec3& p, int id) const {
+float LightTree::pmf(const vec3& p, const vec3& normal, int id) const {
   if (id < 0 || size_t(id) >= slot_of_.size() || slot_of_[size_t(id)].first < 0) return 0.f;
   // The path from the root to the light's slot, then its probabilities in choose()'s order.
   std::pair<int32_t, int32_t> path[64];
@@ -310,7 +332,7 @@ float LightTree::pmf(const vec3& p, int id) const {
   float prob = 1.f;
   for (int level = depth - 1; level >= 0; --level) {
     float imp[LightTreeNode::kWide];
-    light_tree_importance(nodes_[size_t(path[level].first)], p, imp);
+    light_tree_importance(nodes_[size_t(path[level].first)], p, normal, imp);
     float total = 0.f;
     for (int k = 0; k < LightTreeNode::kWide; ++k) total += imp[k];  // choose()'s order
     if (!(total > 0.f)) return 0.f;

@@ -14,8 +14,9 @@
 // whose importances are computed together in SIMD lanes: a choice among 64 lights evaluates two
 // nodes instead of twelve children one by one.
 //
-// Only the point enters the importance (no surface normal): the path state then needs nothing
-// more than the previous vertex to weigh a BSDF-sampled hit on a light by MIS.
+// The receiving surface's normal enters as pbrt-v4's does, |cos| of the angle to the node less
+// the angle the node subtends (either side: light may arrive through a transmitting surface); a
+// zero normal (a point in free space) leaves that factor out.
 #include <cstdint>
 #include <utility>
 #include <vector>
@@ -35,6 +36,12 @@ struct alignas(32) LightTreeNode {
   float cos_o[kWide], sin_o[kWide], cos_e[kWide];
   float phi[kWide];
   float two_sided[kWide], all_directions[kWide];  // 1 or 0
+  // Normals all one way (cos_o = 1: panels): 1, and where along the axis from the centre a point
+  // is behind or in every emitter's plane: at or below -(sum |axis_i| x half extent_i), plus a
+  // slack of 1e-5 of the box's size and distance from the origin (hit points on a panel itself
+  // lie in its plane only to their rounding). Such points are out of reach even inside the
+  // bounding sphere. (Gaps that thin are below any renderer's ray offset, Mitsuba's is 1e-4.)
+  float one_way[kWide], behind_at[kWide];
   int32_t child[kWide];  // >= 0: a node; < 0: the light -1 - child
   int32_t parent = -1, parent_slot = -1;
 
@@ -42,15 +49,18 @@ struct alignas(32) LightTreeNode {
   void set(int slot, const LightBounds& b, int32_t child_or_light);
 };
 
-// Each slot's importance at p: phi x cos(theta') / d^2, where theta' is the smallest angle any
-// of the slot's emission directions can make with the direction to p (importance 0 when no
-// emission direction reaches p) and d^2 the squared distance to the box centre, kept from below
-// at half the box's diagonal (pbrt-v4's LightBounds::Importance, without its surface-normal
-// factor). Finite, >= 0. Every SIMD clone gives the same bits (no contraction).
-void light_tree_importance(const LightTreeNode& node, const vec3& p, float* out);
+// Each slot's importance at p, on a surface of normal n: phi x cos(theta') x cos(theta_i') /
+// d^2, where theta' is the smallest angle any of the slot's emission directions can make with
+// the direction to p (importance 0 when no emission direction reaches p), theta_i' the smallest
+// angle between n (either side) and a direction into the slot's bounding sphere (0 also where
+// all of a slot's normals point one way and p lies behind or in every one of its planes), and d^2 the
+// squared distance to the box centre, kept from below at half the box's diagonal (pbrt-v4's
+// LightBounds::Importance). n = 0: no theta_i' factor. Finite, >= 0. Every SIMD clone gives the
+// same bits (no contraction).
+void light_tree_importance(const LightTreeNode& node, const vec3& p, const vec3& n, float* out);
 
-// One light's importance at p (light_tree_importance with it alone in a node): for tests.
-float light_importance(const LightBounds& b, const vec3& p);
+// One light's importance at p, n (light_tree_importance with it alone in a node): for tests.
+float light_importance(const LightBounds& b, const vec3& p, const vec3& n = vec3(0.f));
 
 class LightTree {
  public:
@@ -63,16 +73,16 @@ class LightTree {
   // Number of lights in the tree.
   size_t size() const { return light_count_; }
 
-  // The light chosen for point p by u in [0, 1): its id, its probability in *pmf; -1 (and *pmf
-  // 0) when no light in the tree can reach p.
-  int choose(const vec3& p, float u, float* pmf) const;
-  // choose() for n points at once (light[k], pmf[k] for p[k], u[k]): the same choices and bits.
-  // The tree is walked a level at a time over all of them, so the walks, each a chain of
-  // dependent arithmetic, overlap.
-  void choose_many(size_t n, const vec3* p, const float* u, int* light, float* pmf) const;
-  // Probability that choose(p, u) returns light `id` for u uniform in [0, 1) (0 for a light
+  // The light chosen for point p with surface normal n (0 for none) by u in [0, 1): its id, its
+  // probability in *pmf; -1 (and *pmf 0) when no light in the tree can reach p.
+  int choose(const vec3& p, const vec3& n, float u, float* pmf) const;
+  // choose() for count points at once (light[k], pmf[k] for p[k], n[k], u[k]): the same choices
+  // and bits. The tree is walked a level at a time over all of them, so the walks, each a
+  // chain of dependent arithmetic, overlap.
+  void choose_many(size_t count, const vec3* p, const vec3* n, const float* u, int* light, float* pmf) const;
+  // Probability that choose(p, n, u) returns light `id` for u uniform in [0, 1) (0 for a light
   // that is not in the tree or cannot reach p); the same bits choose() reports.
-  float pmf(const vec3& p, int id) const;
+  float pmf(const vec3& p, const vec3& n, int id) const;
 
  private:
   struct Binary {
@@ -84,7 +94,7 @@ class LightTree {
                           size_t begin, size_t end, int depth);
   // One level of a walk: at `node`, the slot u selects; u becomes its place within the slot's
   // interval and *prob is multiplied by the slot's probability. False if nothing reaches p.
-  bool step(int node, const vec3& p, float* u, float* prob, int32_t* child) const;
+  bool step(int node, const vec3& p, const vec3& n, float* u, float* prob, int32_t* child) const;
   int collapse(const std::vector<Binary>& binary, int root, int parent, int parent_slot);
 
   std::vector<LightTreeNode> nodes_;

@@ -74,6 +74,9 @@ struct PathState {
   vec3 prev_p{0.f};
   float eta = 1.f;  // product of relative iors crossed (Russian roulette)
   int depth = 1;    // segment number of `ray`, from 1 for the camera ray
+  // The geometric normal at prev_p (0 at the camera), where a light tree weighed the lights
+  // for the MIS weight of the emitter `ray` may hit.
+  vec3 prev_n{0.f};
 
   explicit PathState(const Ray& camera_ray) : ray(camera_ray), prev_p(camera_ray.origin) {}
   PathState() = default;
@@ -228,7 +231,7 @@ template <bool kDistributed, uint32_t kFeatures>
   if (obj.area_light && front) {
     float w = 1.f;
     if (!s.prev_delta)
-      w = power_heuristic(s.prev_pdf, lights.pmf(obj.light, s.prev_p) *
+      w = power_heuristic(s.prev_pdf, lights.pmf(obj.light, s.prev_p, s.prev_n) *
                                           obj.area_light->pdf(s.prev_p, hit.p, hit.ng, ray.time));
     s.radiance += s.beta * obj.area_light->radiance(TextureQuery{hit.p, hit.uv, ray.time}) * w;
   }
@@ -268,7 +271,7 @@ inline bool path_scatter(const Scene& scene, const IntegratorSettings& settings,
     sampler.get_1d_2d(&u_light, &u_point);  // one 3D point (Sampler::get_1d_2d)
     LightSample ls;
     float light_pmf;
-    const int light = lights.choose(u_light, hit.p, &light_pmf);
+    const int light = lights.choose(u_light, hit.p, hit.ng, &light_pmf);
     if (light >= 0 && next_event_light<kDistributed>(scene, light).sample(hit.p, ray.time, u_point, &ls)) {
       ls.pdf *= light_pmf;
       const vec3 wo = frame.to_local(ls.wi);
@@ -331,6 +334,7 @@ inline bool path_scatter(const Scene& scene, const IntegratorSettings& settings,
   s.prev_pdf = bs->pdf;
   s.prev_delta = (bs->lobe & kLobeDelta) != 0;
   s.prev_p = hit.p;
+  s.prev_n = hit.ng;
   if constexpr ((kFeatures & kFeatureTransmission) != 0) s.eta *= bs->eta;
   s.ray = Ray{offset_ray_origin(hit.p, hit.p_error, hit.ng, wo_world), wo_world, ray.time};
 

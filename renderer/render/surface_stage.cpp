@@ -632,7 +632,7 @@ void SurfaceStage::add_many(size_t n, const uint32_t* slots, const uint32_t* liv
   static_assert(offsetof(PathState, ray) == 0 && offsetof(Ray, direction) == 12 &&
                     offsetof(Ray, time) == 24 && offsetof(PathState, beta) == 44 &&
                     offsetof(PathState, eta) == 76 && offsetof(PathState, depth) == 80 &&
-                    sizeof(PathState) == 84,
+                    sizeof(PathState) == 96,
                 "PathState's layout, as the transposes read it");
   for (; i + 4 <= n; i += 4) {
     __m128 h[3][4], d[4], b[4], e[4];
@@ -645,7 +645,7 @@ void SurfaceStage::add_many(size_t n, const uint32_t* slots, const uint32_t* liv
       const float* g = reinterpret_cast<const float*>(&states[live[k]]);
       d[j] = _mm_loadu_ps(g + 3);   // direction, time
       b[j] = _mm_loadu_ps(g + 10);  // radiance.z, beta
-      e[j] = _mm_loadu_ps(g + 17);  // prev_p.y, prev_p.z, eta, depth (the struct's last four)
+      e[j] = _mm_loadu_ps(g + 17);  // prev_p.y, prev_p.z, eta, depth
     }
     for (int r = 0; r < 3; ++r) {
       _MM_TRANSPOSE4_PS(h[r][0], h[r][1], h[r][2], h[r][3]);
@@ -811,8 +811,13 @@ void SurfaceStage::compute(const IntegratorSettings& settings, bool scene_next_e
       // Chosen by the light tree at each lane's point (LightSampler::choose, lane by lane); a
       // lane none of whose lights can reach its point has no light (-1, no light sample).
       choose_p_.resize(n);
-      for (size_t i = 0; i < n; ++i) choose_p_[i] = vec3(p_[0][i], p_[1][i], p_[2][i]);
-      sampler.choose_many(n, choose_p_.data(), u_light_.data(), light_.data(), l_pmf_.data());
+      choose_n_.resize(n);
+      for (size_t i = 0; i < n; ++i) {
+        choose_p_[i] = vec3(p_[0][i], p_[1][i], p_[2][i]);
+        choose_n_[i] = vec3(ng_[0][i], ng_[1][i], ng_[2][i]);
+      }
+      sampler.choose_many(n, choose_p_.data(), choose_n_.data(), u_light_.data(), light_.data(),
+                          l_pmf_.data());
     } else {
       choose_lights(sampler.cdf().data(), int32_t(sampler.cdf().size()), n, u_light_.data(),
                     light_.data());
@@ -1065,6 +1070,7 @@ uint64_t SurfaceStage::deliver(const uint32_t* live, PathState* states, Sampler:
     s.prev_pdf = prev_pdf_[i];
     s.prev_delta = prev_delta_[i] != 0;
     s.prev_p = vec3(p_[0][i], p_[1][i], p_[2][i]);
+    s.prev_n = vec3(ng_[0][i], ng_[1][i], ng_[2][i]);
     s.ray = Ray{vec3(origin_[0][i], origin_[1][i], origin_[2][i]),
                 vec3(wo_[0][i], wo_[1][i], wo_[2][i]), time_[i]};
     s.eta = eta_out_[i];

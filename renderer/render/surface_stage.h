@@ -139,7 +139,7 @@ class SurfaceStage {
   std::vector<float> metallic_, roughness_, e_avg_, dielectric_avg_, f_ms_[3];
   std::vector<int32_t> table_, nodes_;
   std::vector<float> time_, eta_, u_light_, u_point_[2], u_lobe_, u_dir_[2], u_rr_;
-  std::vector<vec3> choose_p_;  // the lanes' points, for a light tree's choice
+  std::vector<vec3> choose_p_, choose_n_;  // the lanes' points and normals, for a light tree
   std::vector<int32_t> depth_;
   // The light sample per lane.
   std::vector<int32_t> light_, light_ok_, l_delta_;

@@ -152,8 +152,9 @@ DirectionCone TriangleMesh::normal_cone() const {
     const float l = glm::length(f);
     if (l > 0.f && std::isfinite(l)) cos_theta = std::min(cos_theta, glm::dot(cone.axis, f) / l);
   }
-  // A little wider than the farthest normal, for the rounding of the normals at the hits.
-  cone.cos_theta = std::max(-1.f, cos_theta - 1e-4f);
+  // A flat mesh (a quad, a panel) points one way: exactly, so that the light tree sees points
+  // behind its plane as out of reach; otherwise a little wider than the farthest normal.
+  cone.cos_theta = cos_theta >= 1.f - 1e-6f ? 1.f : std::max(-1.f, cos_theta - 1e-4f);
   return cone;
 }
 

@@ -12,6 +12,8 @@
 namespace penumbra::test {
 namespace {
 
+const vec3 kNoNormal(0.f);
+
 // A one-sided square panel of side s at c facing n (one of the axes), or a point when s = 0.
 LightBounds panel(const vec3& c, float s, const vec3& n, float phi) {
   LightBounds b;
@@ -58,8 +60,10 @@ TEST(LightTree, PmfSumsToOneAndChooseDrawsByIt) {
   std::uniform_real_distribution<float> u(0.f, 1.f);
   for (int trial = 0; trial < 20; ++trial) {
     const vec3 p(-4.f + 8.f * u(rng), 2.9f * u(rng), -10.f + 10.f * u(rng));
+    // A receiving surface of random orientation, or none.
+    const vec3 nrm = trial % 2 ? glm::normalize(vec3(u(rng) - 0.5f, u(rng) - 0.5f, u(rng) - 0.5f)) : kNoNormal;
     double sum = 0.0;
-    for (int id : scene.ids) sum += tree.pmf(p, id);
+    for (int id : scene.ids) sum += tree.pmf(p, nrm, id);
     EXPECT_NEAR(sum, 1.0, 1e-5) << trial;
     // Stratified u: each light's share of draws within 0.5% of its pmf, and the pmf choose()
     // reports is pmf() to the bit.
@@ -67,14 +71,14 @@ TEST(LightTree, PmfSumsToOneAndChooseDrawsByIt) {
     const int n = 20000;
     for (int k = 0; k < n; ++k) {
       float pmf = 0.f;
-      const int id = tree.choose(p, (float(k) + 0.5f) / float(n), &pmf);
+      const int id = tree.choose(p, nrm, (float(k) + 0.5f) / float(n), &pmf);
       ASSERT_GE(id, 0);
-      ASSERT_EQ(pmf, tree.pmf(p, id));
+      ASSERT_EQ(pmf, tree.pmf(p, nrm, id));
       ++count[size_t(id)];
     }
-    for (int id : scene.ids) EXPECT_NEAR(double(count[size_t(id)]) / n, tree.pmf(p, id), 5e-3) << id;
+    for (int id : scene.ids) EXPECT_NEAR(double(count[size_t(id)]) / n, tree.pmf(p, nrm, id), 5e-3) << id;
   }
-  EXPECT_EQ(tree.pmf(vec3(0.f), 0), 0.f);  // not in the tree
+  EXPECT_EQ(tree.pmf(vec3(0.f), vec3(0.f), 0), 0.f);  // not in the tree
 }
 
 TEST(LightTree, ManyLevels) {
@@ -93,14 +97,15 @@ TEST(LightTree, ManyLevels) {
   const LightTree tree(lights, ids);
   for (int trial = 0; trial < 5; ++trial) {
     const vec3 p(40.f * u(rng), 1.f, 40.f * u(rng));
+    const vec3 nrm(0.f, 1.f, 0.f);
     double sum = 0.0;
-    for (int id : ids) sum += tree.pmf(p, id);
+    for (int id : ids) sum += tree.pmf(p, nrm, id);
     EXPECT_NEAR(sum, 1.0, 1e-4);
     for (int k = 0; k < 2000; ++k) {
       float pmf;
-      const int id = tree.choose(p, u(rng), &pmf);
+      const int id = tree.choose(p, nrm, u(rng), &pmf);
       ASSERT_GE(id, 0);
-      ASSERT_EQ(pmf, tree.pmf(p, id));
+      ASSERT_EQ(pmf, tree.pmf(p, nrm, id));
     }
   }
 }
@@ -112,30 +117,30 @@ TEST(LightTree, FavoursNearLightsAndNeverChoosesOnesThatCannotReach) {
                                            point(vec3(0, 1, -40), 1.f)};
   const LightTree tree(lights, {0, 1, 2});
   const vec3 below_first(-5, 0, 0);
-  EXPECT_GT(tree.pmf(below_first, 0), 0.8f);
-  EXPECT_GT(tree.pmf(below_first, 1), 0.f);  // far, but it still reaches: never zero
+  EXPECT_GT(tree.pmf(below_first, kNoNormal, 0), 0.8f);
+  EXPECT_GT(tree.pmf(below_first, kNoNormal, 1), 0.f);  // far, but it still reaches: never zero
   // Above the panels (behind their emitting sides) only the point light can reach. (The panels'
   // node itself may still look reachable: inside its bounding sphere every direction counts,
   // so a choice that goes there ends without a light, -1, as pbrt-v4's does.)
   const vec3 above(0, 4, 0);
-  EXPECT_EQ(tree.pmf(above, 0), 0.f);
-  EXPECT_EQ(tree.pmf(above, 1), 0.f);
-  EXPECT_GT(tree.pmf(above, 2), 0.f);
+  EXPECT_EQ(tree.pmf(above, kNoNormal, 0), 0.f);
+  EXPECT_EQ(tree.pmf(above, kNoNormal, 1), 0.f);
+  EXPECT_GT(tree.pmf(above, kNoNormal, 2), 0.f);
   int chosen = 0;
   for (int k = 0; k < 100; ++k) {
     float pmf;
-    const int light = tree.choose(above, (float(k) + 0.5f) / 100.f, &pmf);
+    const int light = tree.choose(above, kNoNormal, (float(k) + 0.5f) / 100.f, &pmf);
     EXPECT_TRUE(light == 2 || light == -1) << light;
     chosen += light == 2;
   }
-  EXPECT_NEAR(chosen / 100.0, tree.pmf(above, 2), 0.011);
+  EXPECT_NEAR(chosen / 100.0, tree.pmf(above, kNoNormal, 2), 0.011);
 }
 
 TEST(LightTree, NoLightThatCanReachGivesNone) {
   const LightTree tree({panel(vec3(-1, 3, 0), 0.5f, vec3(0, -1, 0), 1.f), panel(vec3(1, 3, 0), 0.5f, vec3(0, -1, 0), 1.f)},
                        {0, 1});
   float pmf = 1.f;
-  EXPECT_EQ(tree.choose(vec3(0, 5, 0), 0.3f, &pmf), -1);
+  EXPECT_EQ(tree.choose(vec3(0, 5, 0), kNoNormal, 0.3f, &pmf), -1);
   EXPECT_EQ(pmf, 0.f);
 }
 
@@ -149,6 +154,13 @@ TEST(LightImportance, ZeroOnlyWhereNoEmissionDirectionReaches) {
   // Nearer is more important, and importance is finite at the light itself.
   EXPECT_GT(light_importance(b, vec3(0, 0, 1)), light_importance(b, vec3(0, 0, 4)));
   EXPECT_TRUE(std::isfinite(light_importance(b, vec3(0.f))));
+  // The receiver's normal: a light straight above counts fully, one at its horizon only by the
+  // angle its bounding sphere subtends, from either side.
+  const LightBounds lamp = point(vec3(0, 2, 0), 1.f);
+  EXPECT_FLOAT_EQ(light_importance(lamp, vec3(0.f), vec3(0, 1, 0)), light_importance(lamp, vec3(0.f)));
+  EXPECT_FLOAT_EQ(light_importance(lamp, vec3(0.f), vec3(0, -1, 0)), light_importance(lamp, vec3(0.f)));
+  EXPECT_LT(light_importance(lamp, vec3(0.f), vec3(1, 0, 0)), 1e-6f * light_importance(lamp, vec3(0.f)));
+  EXPECT_GT(light_importance(panel(vec3(0, 2, 0), 1.f, vec3(0, -1, 0), 1.f), vec3(0.f), vec3(1, 0, 0)), 0.f);
   // A point light at the point itself: no finite estimate, importance 0 (not a NaN).
   EXPECT_EQ(light_importance(point(vec3(1, 2, 3), 1.f), vec3(1, 2, 3)), 0.f);
   EXPECT_GT(light_importance(point(vec3(1, 2, 3), 1.f), vec3(1, 2, 4)), 0.f);
@@ -180,34 +192,45 @@ TEST(DirectionCone, MergeHoldsBoth) {
 }
 
 TEST(LightSampler, TreeGroupKeepsItsShareAndSumsToOne) {
-  // An environment (no place) and three placed lights: the group has the share its lights have
-  // by power and count, split by the tree at the point.
-  const std::vector<float> powers = {1.f, 2.f, 3.f, 4.f};
-  const std::vector<bool> sampled(4, true);
-  std::vector<std::optional<LightBounds>> places = {point(vec3(0, 1, 0), 0.f), point(vec3(5, 1, 0), 0.f),
-                                                    point(vec3(-5, 1, 0), 0.f), std::nullopt};
+  // An environment (no place) and kTreeFrom placed lights: the group has the share its lights
+  // have by power and count, split by the tree at the point.
+  const size_t placed = LightSampler::kTreeFrom;
+  std::vector<float> powers;
+  std::vector<std::optional<LightBounds>> places;
+  for (size_t i = 0; i < placed; ++i) {
+    powers.push_back(1.f + float(i));
+    places.push_back(point(vec3(i == 1 ? 5.f : -5.f - float(i), 1.f, 0.f), 0.f));
+  }
+  powers.push_back(4.f);
+  places.push_back(std::nullopt);
+  const size_t count = powers.size(), env = placed;
+  const std::vector<bool> sampled(count, true);
   const LightSampler flat(powers, sampled);
   const LightSampler spatial(powers, sampled, places);
   ASSERT_TRUE(spatial.spatial());
   ASSERT_FALSE(flat.spatial());
-  const vec3 p(4, 0, 0);
-  EXPECT_FLOAT_EQ(spatial.pmf(3, p), flat.pmf(3));
-  EXPECT_NEAR(spatial.pmf(0, p) + spatial.pmf(1, p) + spatial.pmf(2, p), flat.pmf(0) + flat.pmf(1) + flat.pmf(2), 1e-6);
-  EXPECT_GT(spatial.pmf(1, p), spatial.pmf(2, p));  // the near one
-  std::vector<int> count(4, 0);
+  const vec3 p(4, 0, 0), up(0, 1, 0);
+  EXPECT_FLOAT_EQ(spatial.pmf(int(env), p, up), flat.pmf(int(env)));
+  double group = 0.0, flat_group = 0.0;
+  for (size_t l = 0; l < placed; ++l) group += spatial.pmf(int(l), p, up), flat_group += flat.pmf(int(l));
+  EXPECT_NEAR(group, flat_group, 1e-6);
+  EXPECT_GT(spatial.pmf(1, p, up), spatial.pmf(2, p, up));  // the near one
+  std::vector<int> chosen(count, 0);
   const int n = 40000;
   for (int k = 0; k < n; ++k) {
     float pmf;
-    const int light = spatial.choose((float(k) + 0.5f) / float(n), p, &pmf);
+    const int light = spatial.choose((float(k) + 0.5f) / float(n), p, up, &pmf);
     ASSERT_GE(light, 0);
-    EXPECT_EQ(pmf, spatial.pmf(light, p));
-    ++count[size_t(light)];
+    EXPECT_EQ(pmf, spatial.pmf(light, p, up));
+    ++chosen[size_t(light)];
   }
-  for (int l = 0; l < 4; ++l) EXPECT_NEAR(double(count[size_t(l)]) / n, spatial.pmf(l, p), 2e-3) << l;
-  // One placed light alone: no tree, the same choice as without places.
-  const LightSampler one(powers, sampled, {point(vec3(0.f), 0.f), std::nullopt, std::nullopt, std::nullopt});
+  for (size_t l = 0; l < count; ++l) EXPECT_NEAR(double(chosen[l]) / n, spatial.pmf(int(l), p, up), 2e-3) << l;
+  // Fewer placed lights: no tree, the same choice as without places.
+  std::vector<std::optional<LightBounds>> few(count, std::nullopt);
+  for (size_t l = 0; l + 1 < LightSampler::kTreeFrom; ++l) few[l] = places[l];
+  const LightSampler one(powers, sampled, few);
   EXPECT_FALSE(one.spatial());
-  for (int l = 0; l < 4; ++l) EXPECT_EQ(one.pmf(l), flat.pmf(l));
+  for (size_t l = 0; l < count; ++l) EXPECT_EQ(one.pmf(int(l)), flat.pmf(int(l)));
   EXPECT_EQ(one.cdf(), flat.cdf());
 }
 
