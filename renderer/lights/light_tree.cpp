@@ -37,7 +37,10 @@ constexpr int kMaxCostDepth = 40;  // deeper, the binary tree splits by count
 
 int bucket_of(const LightBounds& b, int axis, float lo, float hi) {
   const float c = 0.5f * (b.bounds.lo[axis] + b.bounds.hi[axis]);
-  return std::clamp(int(float(kBuckets) * (c - lo) / (hi - lo)), 0, kBuckets - 1);
+  const float f = float(kBuckets) * (c - lo) / (hi - lo);
+  // (Compared before the conversion: a NaN or overflow, from coordinates near the float range,
+  // must not reach int().)
+  return f > 0.f ? (f < float(kBuckets) ? int(f) : kBuckets - 1) : 0;
 }
 
 }  // namespace
@@ -131,7 +134,9 @@ LightTree::LightTree(const std::vector<LightBounds>& lights, const std::vector<i
   std::vector<std::pair<LightBounds, int>> kept;
   int max_id = -1;
   for (size_t k = 0; k < lights.size() && k < ids.size(); ++k)
-    if (ids[k] >= 0 && lights[k].phi > 0.f && std::isfinite(lights[k].phi) && !lights[k].bounds.empty()) {
+    if (ids[k] >= 0 && lights[k].phi > 0.f && std::isfinite(lights[k].phi) && !lights[k].bounds.empty() &&
+        std::isfinite(glm::length(lights[k].bounds.hi - lights[k].bounds.lo)) &&
+        std::isfinite(glm::length(lights[k].bounds.hi + lights[k].bounds.lo))) {
       kept.emplace_back(lights[k], ids[k]);
       max_id = std::max(max_id, ids[k]);
     }
@@ -165,7 +170,7 @@ int LightTree::build_binary(std::vector<Binary>& out, std::vector<std::pair<Ligh
   int best_axis = -1, best_plane = 0;
   for (int axis = 0; axis < 3 && depth < kMaxCostDepth; ++axis) {
     const float lo = centres.lo[axis], hi = centres.hi[axis];
-    if (!(hi > lo)) continue;
+    if (!(hi > lo) || !std::isfinite(hi - lo)) continue;
     LightBounds bucket[kBuckets];
     for (size_t k = begin; k < end; ++k) {
       LightBounds& b = bucket[bucket_of(lights[k].first, axis, lo, hi)];

@@ -7,8 +7,10 @@
 // (power x a bound of the emission cosine / squared distance). Conty Estevez and Kulla 2018,
 // "Importance Sampling of Many Lights with Adaptive Tree Splitting"; the node importance and the
 // split cost as pbrt-v4's BVHLightSampler (section 12.6.3). The importance is conservative: it is
-// zero only where none of a node's lights can send light to the point, so choosing by it stays
-// unbiased.
+// zero only where none of a node's lights can send light to the point (but for points within a
+// hair, 1e-5 of the scene's scale, of a panel's plane: LightTreeNode::behind_at), so choosing by
+// it stays unbiased; and where an area light gets no choice, the path integrator's BSDF-sampled
+// rays that reach it count with MIS weight 1.
 //
 // The tree is built binary by the split cost, then collapsed to nodes of up to eight children
 // whose importances are computed together in SIMD lanes: a choice among 64 lights evaluates two
@@ -66,7 +68,8 @@ class LightTree {
  public:
   LightTree() = default;
   // Over `lights`: lights[k] bounds light ids[k] (the scene's light index, >= 0). Lights with
-  // phi <= 0 or empty bounds are left out (never chosen, pmf 0).
+  // phi <= 0, empty bounds or bounds near the end of the float range (whose centre or size is
+  // not finite) are left out (never chosen, pmf 0).
   LightTree(const std::vector<LightBounds>& lights, const std::vector<int>& ids);
 
   bool empty() const { return nodes_.empty(); }

@@ -144,6 +144,27 @@ TEST(LightTree, NoLightThatCanReachGivesNone) {
   EXPECT_EQ(pmf, 0.f);
 }
 
+TEST(LightTree, LightsNearTheEndOfTheFloatRangeAreLeftOut) {
+  // Hostile coordinates: the tree is built without a NaN reaching its splits, the far lights are
+  // never chosen, and choices among the rest stay finite.
+  std::vector<LightBounds> lights = {point(vec3(3e38f, 0, 0), 1.f), point(vec3(-3e38f, 0, 0), 1.f),
+                                     panel(vec3(0, 3e38f, 0), 2e38f, vec3(0, -1, 0), 1.f)};
+  std::vector<int> ids = {0, 1, 2};
+  for (int i = 0; i < 10; ++i) {
+    lights.push_back(point(vec3(float(i), 1, 0), 1.f));
+    ids.push_back(3 + i);
+  }
+  const LightTree tree(lights, ids);
+  EXPECT_EQ(tree.size(), 10u);  // the three far lights left out
+  for (int id = 0; id < 3; ++id) EXPECT_EQ(tree.pmf(vec3(0.5f, 0, 0), kNoNormal, id), 0.f);
+  for (int k = 0; k < 100; ++k) {
+    float pmf;
+    const int id = tree.choose(vec3(0.5f, 0, 0), kNoNormal, (float(k) + 0.5f) / 100.f, &pmf);
+    EXPECT_TRUE(std::isfinite(pmf));
+    if (id >= 0) EXPECT_EQ(pmf, tree.pmf(vec3(0.5f, 0, 0), kNoNormal, id));
+  }
+}
+
 TEST(LightImportance, ZeroOnlyWhereNoEmissionDirectionReaches) {
   // A panel facing +z: points just in front of its plane, even far to the side, get light.
   const LightBounds b = panel(vec3(0.f), 1.f, vec3(0, 0, 1), 1.f);
