@@ -59,6 +59,7 @@ LightSampler::LightSampler(const std::vector<float>& powers, const std::vector<b
     }
     tree_ = LightTree(bounds, ids);
     tree_pmf_ = float(group);
+    spatial_ = true;
   }
   // The entries: each sampled light (in index order) and, with a tree, its group after them.
   double acc = 0.0;

@@ -36,7 +36,9 @@ class LightSampler {
   bool empty() const { return cdf_.empty(); }
   // Whether the choice depends on the shading point (a light tree is in use); if not, choose(u)
   // and pmf(light) answer for every point, and cdf() lists the lights themselves.
-  bool spatial() const { return !tree_.empty(); }
+  // (Also when the tree turned out empty, every light in it having no power: its group then
+  // gives no light, in every driver alike.)
+  bool spatial() const { return spatial_; }
 
   // The light that u in [0, 1) selects at point p on a surface of geometric normal n (0 for
   // none), its probability in *pmf; -1 (and *pmf 0) if the tree's lights were chosen and none
@@ -69,6 +71,7 @@ class LightSampler {
   std::vector<int> entry_light_;  // per entry: a light, or -1 for the tree's group
   std::vector<bool> in_tree_;    // per light (empty without a tree)
   float tree_pmf_ = 0.f;         // the group's probability
+  bool spatial_ = false;
   LightTree tree_;
 };
 

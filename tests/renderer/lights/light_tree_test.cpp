@@ -246,6 +246,15 @@ TEST(LightSampler, TreeGroupKeepsItsShareAndSumsToOne) {
     ++chosen[size_t(light)];
   }
   for (size_t l = 0; l < count; ++l) EXPECT_NEAR(double(chosen[l]) / n, spatial.pmf(int(l), p, up), 2e-3) << l;
+  // Placed lights that all have no power: still the group, which gives no light, at any point.
+  const LightSampler dark(std::vector<float>(placed, 0.f), std::vector<bool>(placed, true),
+                          std::vector<std::optional<LightBounds>>(places.begin(), places.begin() + std::ptrdiff_t(placed)));
+  ASSERT_TRUE(dark.spatial());
+  for (int k = 0; k < 10; ++k) {
+    float pmf = 1.f;
+    EXPECT_EQ(dark.choose((float(k) + 0.5f) / 10.f, p, up, &pmf), -1);
+    EXPECT_EQ(pmf, 0.f);
+  }
   // Fewer placed lights: no tree, the same choice as without places.
   std::vector<std::optional<LightBounds>> few(count, std::nullopt);
   for (size_t l = 0; l + 1 < LightSampler::kTreeFrom; ++l) few[l] = places[l];
