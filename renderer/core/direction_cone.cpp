@@ -6,8 +6,6 @@
 namespace penumbra {
 namespace {
 
-float safe_acos(float x) { return std::acos(std::clamp(x, -1.f, 1.f)); }
-
 // v rotated by `angle` about the unit axis k (Rodrigues).
 vec3 rotate(const vec3& v, const vec3& k, float angle) {
   const float c = std::cos(angle), s = std::sin(angle);

@@ -34,6 +34,7 @@ inline bool is_finite(const Spectrum& s) {
 // fabs on -0 and NaN), nine branches in a hit point's error bound (docs/performance.md).
 inline vec3 abs_components(const vec3& v) { return vec3(std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)); }
 inline float safe_sqrt(float x) { return std::sqrt(std::max(0.f, x)); }
+inline float safe_acos(float x) { return std::acos(std::clamp(x, -1.f, 1.f)); }
 inline float sqr(float x) { return x * x; }
 
 }  // namespace penumbra

@@ -1,6 +1,6 @@
 #pragma once
 // Where a light (or a group of lights) is and which way it shines: a box around its points, the
-// cone of its surface normals and its power, for choosing among many lights by where the
+// cone of its surface normals and a bound of its radiant intensity, for choosing among many lights by where the
 // shading point is (lights/light_tree.h). Conty Estevez and Kulla 2018; pbrt-v4 section 12.6.3.
 #include "renderer/core/bounds.h"
 #include "renderer/core/direction_cone.h"

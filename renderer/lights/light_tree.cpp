@@ -8,8 +8,6 @@
 namespace penumbra {
 namespace {
 
-float safe_acos(float x) { return std::acos(std::clamp(x, -1.f, 1.f)); }
-
 float surface_area(const Bounds3& b) {
   const vec3 d = glm::max(b.hi - b.lo, vec3(0.f));
   return 2.f * (d.x * d.y + d.y * d.z + d.z * d.x);

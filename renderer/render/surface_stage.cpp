@@ -808,8 +808,9 @@ void SurfaceStage::compute(const IntegratorSettings& settings, bool scene_next_e
   const LightSampler& sampler = scene_.mis_light_sampler();  // stages: path integrator
   if (next_event) {
     if (sampler.spatial()) {
-      // Chosen by the light tree at each lane's point (LightSampler::choose, lane by lane); a
-      // lane none of whose lights can reach its point has no light (-1, no light sample).
+      // Chosen by the light tree at each lane's point and normal, the lanes' walks together
+      // (LightSampler::choose_many); a lane none of whose lights can reach its point has no
+      // light (-1, no light sample).
       choose_p_.resize(n);
       choose_n_.resize(n);
       for (size_t i = 0; i < n; ++i) {
