@@ -13,7 +13,7 @@ binary=$1
 min_share=${MIN_SHARE:-0.15}
 command -v objdump >/dev/null || { echo "objdump (binutils) is missing" >&2; exit 1; }
 # Kernels beside the step kernels that must be vectorised (share in the last measured build).
-others="scrambled_sobol_kernel scrambled_sobol_z_kernel quad_light_samples packet_intersect16 packet_occluded16 lens_rays"  # 0.26, 0.37, 0.26, 0.85, 0.89, 0.28
+others="scrambled_sobol_kernel scrambled_sobol_z_kernel quad_light_samples sphere_light_samples packet_intersect16 packet_occluded16 lens_rays"  # 0.26, 0.37, 0.22, 0.33, 0.88, 0.90, 0.28
 # (packet_*: the parallelogram's packets, shapes/parallelogram.cpp)
 table=$(objdump -d --no-show-raw-insn "$binary" | awk '
   /^[0-9a-f]+ <.*>:$/ { name = substr($2, 2, length($2) - 3); on = (name ~ /\.arch_x86_64_v3$/); next }

@@ -10,32 +10,48 @@
 #include "renderer/lights/point_light.h"
 #include "renderer/sampling/sampling.h"
 #include "renderer/shapes/quad.h"
+#include "renderer/shapes/sphere.h"
+#include "renderer/shapes/sphere_sample.h"
 
 namespace penumbra {
 
-// Quad::sample followed by AreaLight::sample for the entries whose light is `id`, over arrays;
-// other entries keep what they hold. Operation for operation as the scalar code: glm's dot sums
-// x, y, z in that order, length is sqrt(dot), a vector divided by a scalar divides each
-// component, and every comparison that rejects a sample is the scalar one (NaNs included).
-PENUMBRA_SIMD_CLONES
-void quad_light_samples(const float* __restrict q_origin, const float* __restrict q_u,
-                        const float* __restrict q_v, const float* __restrict q_n, float q_area,
-                        int32_t id, size_t n, const int32_t* __restrict light,
-                        const float* __restrict ref_x, const float* __restrict ref_y,
-                        const float* __restrict ref_z, const float* __restrict u_x,
-                        const float* __restrict u_y, int32_t* __restrict ok,
-                        float* __restrict wi_x, float* __restrict wi_y, float* __restrict wi_z,
-                        float* __restrict distance, float* __restrict pdf, float* __restrict p_x,
-                        float* __restrict p_y, float* __restrict p_z, float* __restrict e_x,
-                        float* __restrict e_y, float* __restrict e_z) {
-  constexpr float g6 = gamma_bound(6);
-  const float ox = q_origin[0], oy = q_origin[1], oz = q_origin[2];
-  const float ux = q_u[0], uy = q_u[1], uz = q_u[2], vx = q_v[0], vy = q_v[1], vz = q_v[2];
-  const float nx = q_n[0], ny = q_n[1], nz = q_n[2];
+void fetch_light_rows(const float* table, int32_t width, int32_t of_kind, size_t n,
+                      const int32_t* kind, const int32_t* slot, float* const* fields) {
   for (size_t i = 0; i < n; ++i) {
+    if (kind[i] != of_kind) continue;
+    const float* row = table + size_t(slot[i]) * size_t(width);
+    for (int32_t f = 0; f < width; ++f) fields[f][i] = row[f];
+  }
+}
+
+// Quad::sample followed by AreaLight::sample for the entries of kind kQuad, over arrays; other
+// entries keep what they hold. Operation for operation as the scalar code: glm's dot sums x, y, z
+// in that order, length is sqrt(dot), a vector divided by a scalar divides each component, and
+// every comparison that rejects a sample is the scalar one (NaNs included).
+PENUMBRA_SIMD_CLONES
+void quad_light_samples(size_t n, const int32_t* __restrict kind, const float* __restrict o_x,
+                        const float* __restrict o_y, const float* __restrict o_z,
+                        const float* __restrict u_x, const float* __restrict u_y,
+                        const float* __restrict u_z, const float* __restrict v_x,
+                        const float* __restrict v_y, const float* __restrict v_z,
+                        const float* __restrict nrm_x, const float* __restrict nrm_y,
+                        const float* __restrict nrm_z, const float* __restrict area,
+                        const float* __restrict ref_x, const float* __restrict ref_y,
+                        const float* __restrict ref_z, const float* __restrict s_x,
+                        const float* __restrict s_y, int32_t* __restrict ok,
+                        float* __restrict wi_x, float* __restrict wi_y, float* __restrict wi_z,
+                        float* __restrict distance, float* __restrict pdf,
+                        float* __restrict p_x, float* __restrict p_y, float* __restrict p_z,
+                        float* __restrict e_x, float* __restrict e_y, float* __restrict e_z) {
+  constexpr float g6 = gamma_bound(6);
+  for (size_t i = 0; i < n; ++i) {
+    const Mask mine = mask(kind[i] == StagedLights::kQuad);
+    const float ox = o_x[i], oy = o_y[i], oz = o_z[i], ux = u_x[i], uy = u_y[i], uz = u_z[i];
+    const float vx = v_x[i], vy = v_y[i], vz = v_z[i];
+    const float nx = nrm_x[i], ny = nrm_y[i], nz = nrm_z[i], q_area = area[i];
     // Quad::sample: p = o + s u + t v and its error bound (pbrt-v4 section 6.8.1).
-    const float sux = u_x[i] * ux, suy = u_x[i] * uy, suz = u_x[i] * uz;
-    const float svx = u_y[i] * vx, svy = u_y[i] * vy, svz = u_y[i] * vz;
+    const float sux = s_x[i] * ux, suy = s_x[i] * uy, suz = s_x[i] * uz;
+    const float svx = s_y[i] * vx, svy = s_y[i] * vy, svz = s_y[i] * vz;
     const float px = (ox + sux) + svx, py = (oy + suy) + svy, pz = (oz + suz) + svz;
     const float ex = g6 * ((std::fabs(ox) + std::fabs(sux)) + std::fabs(svx));
     const float ey = g6 * ((std::fabs(oy) + std::fabs(suy)) + std::fabs(svy));
@@ -53,7 +69,6 @@ void quad_light_samples(const float* __restrict q_origin, const float* __restric
     const float dx = wx / dist, dy = wy / dist, dz = wz / dist;
     const bool good = (density > 0.f) & (density < kInfinity) & (dist > 0.f) &
                       !(((nx * dx + ny * dy) + nz * dz) >= 0.f);
-    const Mask mine = mask(light[i] == id);
     ok[i] = when(mine, int32_t(good), ok[i]);
     wi_x[i] = when(mine, dx, wi_x[i]);
     wi_y[i] = when(mine, dy, wi_y[i]);
@@ -69,11 +84,55 @@ void quad_light_samples(const float* __restrict q_origin, const float* __restric
   }
 }
 
-// PointLight::sample for the entries whose light is `id`, over arrays (glm's dot and the
+// sample_sphere (through the arithmetic it shares, shapes/sphere_sample.h) followed by
+// AreaLight::sample for the entries of kind kSphere, over arrays; other entries keep what they
+// hold.
+PENUMBRA_SIMD_CLONES
+void sphere_light_samples(size_t n, const int32_t* __restrict kind, const float* __restrict c_x,
+                          const float* __restrict c_y, const float* __restrict c_z,
+                          const float* __restrict radius, const float* __restrict ref_x,
+                          const float* __restrict ref_y, const float* __restrict ref_z,
+                          const float* __restrict s_x, const float* __restrict s_y,
+                          int32_t* __restrict ok, float* __restrict wi_x, float* __restrict wi_y,
+                          float* __restrict wi_z, float* __restrict distance,
+                          float* __restrict pdf, float* __restrict p_x, float* __restrict p_y,
+                          float* __restrict p_z, float* __restrict e_x, float* __restrict e_y,
+                          float* __restrict e_z, float* __restrict n_x, float* __restrict n_y,
+                          float* __restrict n_z) {
+  for (size_t i = 0; i < n; ++i) {
+    const Mask mine = mask(kind[i] == StagedLights::kSphere);
+    float sp[3], sn[3], se[3], spdf;
+    sphere_solid_angle_sample(c_x[i], c_y[i], c_z[i], radius[i], ref_x[i], ref_y[i], ref_z[i],
+                              s_x[i], s_y[i], sp, sn, se, &spdf);
+    // AreaLight::sample: a finite positive density, a positive distance, the front side.
+    const float wx = sp[0] - ref_x[i], wy = sp[1] - ref_y[i], wz = sp[2] - ref_z[i];
+    const float dist = std::sqrt((wx * wx + wy * wy) + wz * wz);
+    const float dx = wx / dist, dy = wy / dist, dz = wz / dist;
+    const bool good = (spdf > 0.f) & (spdf < kInfinity) & (dist > 0.f) &
+                      !(((sn[0] * dx + sn[1] * dy) + sn[2] * dz) >= 0.f);
+    ok[i] = when(mine, int32_t(good), ok[i]);
+    wi_x[i] = when(mine, dx, wi_x[i]);
+    wi_y[i] = when(mine, dy, wi_y[i]);
+    wi_z[i] = when(mine, dz, wi_z[i]);
+    distance[i] = when(mine, dist, distance[i]);
+    pdf[i] = when(mine, spdf, pdf[i]);
+    p_x[i] = when(mine, sp[0], p_x[i]);
+    p_y[i] = when(mine, sp[1], p_y[i]);
+    p_z[i] = when(mine, sp[2], p_z[i]);
+    e_x[i] = when(mine, se[0], e_x[i]);
+    e_y[i] = when(mine, se[1], e_y[i]);
+    e_z[i] = when(mine, se[2], e_z[i]);
+    n_x[i] = when(mine, sn[0], n_x[i]);
+    n_y[i] = when(mine, sn[1], n_y[i]);
+    n_z[i] = when(mine, sn[2], n_z[i]);
+  }
+}
+
+// PointLight::sample for the entries of kind kPoint, over arrays (glm's dot and the
 // component-wise divisions as the scalar code does them).
 PENUMBRA_SIMD_CLONES
-void point_light_samples(const float* __restrict position, const float* __restrict intensity,
-                         int32_t id, size_t n, const int32_t* __restrict light,
+void point_light_samples(size_t n, const int32_t* __restrict kind, const float* __restrict pos_x,
+                         const float* __restrict pos_y, const float* __restrict pos_z,
                          const float* __restrict ref_x, const float* __restrict ref_y,
                          const float* __restrict ref_z, int32_t* __restrict ok,
                          float* __restrict wi_x, float* __restrict wi_y, float* __restrict wi_z,
@@ -81,13 +140,12 @@ void point_light_samples(const float* __restrict position, const float* __restri
                          float* __restrict p_x, float* __restrict p_y, float* __restrict p_z,
                          float* __restrict value_x, float* __restrict value_y,
                          float* __restrict value_z) {
-  const float sx = position[0], sy = position[1], sz = position[2];
-  const float ix = intensity[0], iy = intensity[1], iz = intensity[2];
   for (size_t i = 0; i < n; ++i) {
+    const Mask mine = mask(kind[i] == StagedLights::kPoint);
+    const float sx = pos_x[i], sy = pos_y[i], sz = pos_z[i];
     const float dx = sx - ref_x[i], dy = sy - ref_y[i], dz = sz - ref_z[i];
     const float dist2 = (dx * dx + dy * dy) + dz * dz;
     const float dist = std::sqrt(dist2);
-    const Mask mine = mask(light[i] == id);
     ok[i] = when(mine, int32_t(dist2 > 0.f), ok[i]);
     wi_x[i] = when(mine, dx / dist, wi_x[i]);
     wi_y[i] = when(mine, dy / dist, wi_y[i]);
@@ -97,9 +155,9 @@ void point_light_samples(const float* __restrict position, const float* __restri
     p_x[i] = when(mine, sx, p_x[i]);
     p_y[i] = when(mine, sy, p_y[i]);
     p_z[i] = when(mine, sz, p_z[i]);
-    value_x[i] = when(mine, ix / dist2, value_x[i]);
-    value_y[i] = when(mine, iy / dist2, value_y[i]);
-    value_z[i] = when(mine, iz / dist2, value_z[i]);
+    value_x[i] = when(mine, value_x[i] / dist2, value_x[i]);
+    value_y[i] = when(mine, value_y[i] / dist2, value_y[i]);
+    value_z[i] = when(mine, value_z[i] / dist2, value_z[i]);
   }
 }
 
@@ -149,6 +207,22 @@ StagedLights::StagedLights(const Scene& scene) {
     }
     const auto* area = dynamic_cast<const AreaLight*>(&light);
     if (!area) continue;
+    if (const auto* sphere = dynamic_cast<const Sphere*>(&area->shape())) {
+      if (area->textured() || !sphere->motion().is_static()) continue;
+      SphereLight b;
+      b.light = int32_t(l);
+      const vec3 c = sphere->center_at(0.f);  // (the centre plus zero, as Sphere::sample takes it)
+      const Spectrum r = area->radiance_factor();
+      for (int k = 0; k < 3; ++k) {
+        b.center[k] = c[k];
+        b.radiance[k] = r[k];
+      }
+      b.radius = sphere->radius();
+      kind[l] = kSphere;
+      index[l] = int32_t(spheres.size());
+      spheres.push_back(b);
+      continue;
+    }
     const auto* quad = dynamic_cast<const Quad*>(&area->shape());
     if (!quad || quad->moving()) continue;
     StagedLights::QuadLight q;
@@ -172,13 +246,22 @@ StagedLights::StagedLights(const Scene& scene) {
     index[l] = int32_t(quads.size());
     quads.push_back(q);
   }
-  // Each staged quad or point light is a pass over all of a stage's lanes: past a few of them
-  // (a scene of many lights, chosen by the light tree) the lanes sample their lights one by one.
-  if (quads.size() + points.size() > kMaxStaged) {
-    for (size_t l = 0; l < lights; ++l)
-      if (kind[l] == kQuad || kind[l] == kPoint) kind[l] = kOwnCode, index[l] = -1;
-    quads.clear();
-    points.clear();
+  for (const QuadLight& q : quads) {
+    const float row[kQuadRow] = {q.origin[0], q.origin[1], q.origin[2], q.u[0], q.u[1], q.u[2],
+                                 q.v[0], q.v[1], q.v[2], q.n[0], q.n[1], q.n[2], q.area,
+                                 q.radiance[0], q.radiance[1], q.radiance[2]};
+    quad_table.insert(quad_table.end(), row, row + kQuadRow);
+  }
+  for (const SphereLight& b : spheres) {
+    const float row[kSphereRow] = {b.center[0], b.center[1], b.center[2], b.radius,
+                                   b.radiance[0], b.radiance[1], b.radiance[2]};
+    sphere_table.insert(sphere_table.end(), row, row + kSphereRow);
+  }
+  for (const PointSource& p : points) {
+    const float row[kPointRow] = {p.position[0], p.position[1], p.position[2],
+                                  p.intensity[0], p.intensity[1], p.intensity[2],
+                                  0.f, 0.f, 0.f, 0.f, 0.f, 0.f};
+    point_table.insert(point_table.end(), row, row + kPointRow);
   }
 }
 

@@ -1,16 +1,19 @@
 #pragma once
-// Next-event light choices and light samples over arrays, for the wavefront driver's SIMD
-// stages: one path at a time a quad light's sample is a dependent chain of multiplies, a square
-// root and two divisions; over arrays eight or sixteen paths go at once. Static quad lights (the
-// emitters of most scenes; an image-textured one's radiance is then looked up for all the lanes
-// on the light at once), point and directional lights have kernels (the stages'
-// path integrator never chooses a constant environment: Light::left_to_bsdf_sampling). The
-// values are the scalar code's to the bit: the kernels are LightSampler::choose, Quad::sample
-// with AreaLight::sample, and PointLight::sample operation for operation, compiled without
-// contraction into fused multiply-adds (renderer/CMakeLists.txt). Every other light (spheres,
-// emitting meshes, moving quads, spot lights, environment maps) is `kOwnCode`: the
-// stage calls its Light::sample lane by lane, with the lane's point, time and sampler values,
-// and the rest of the step stays in the lanes.
+// Next-event light samples over arrays, for the wavefront driver's SIMD stages: one path at a
+// time a quad or sphere light's sample is a dependent chain of multiplies, square roots and
+// divisions; over arrays eight or sixteen paths go at once. Static quad lights (the emitters of
+// most scenes; an image-textured one's radiance is then looked up for all the lanes on the light
+// at once), static untextured sphere lights (lamps), point and directional lights have kernels
+// (the stages' path integrator never chooses a constant environment:
+// Light::left_to_bsdf_sampling). One pass of a kernel serves all the lanes of its kind, each
+// lane reading its own light's constants (gathers): a scene of many lights, chosen by the
+// light tree, costs one pass, not one per light. The values are the scalar code's to the bit: the
+// kernels are Quad::sample with AreaLight::sample, sample_sphere (its arithmetic shared,
+// shapes/sphere_sample.h) with AreaLight::sample, and PointLight::sample operation for
+// operation, compiled without contraction into fused multiply-adds (renderer/CMakeLists.txt).
+// Every other light (emitting meshes, moving or textured spheres, moving quads, spot lights,
+// environment maps) is `kOwnCode`: the stage calls its Light::sample lane by lane, with the
+// lane's point, time and sampler values, and the rest of the step stays in the lanes.
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -27,7 +30,7 @@ struct StagedLights {
   explicit StagedLights(const Scene& scene);
 
   // kOwnCode: no kernel; sampled lane by lane through Light::sample.
-  enum Kind : int32_t { kOwnCode, kQuad, kPoint, kDirectional };
+  enum Kind : int32_t { kOwnCode, kQuad, kPoint, kDirectional, kSphere };
   // A static quad light: what Quad::sample and AreaLight::sample read. A textured one's radiance
   // is `radiance` times its image's texel at the sample's uv, which is the sample's (u_x, u_y)
   // (Quad::sample); texture is null for an untextured one.
@@ -45,35 +48,71 @@ struct StagedLights {
   struct DistantSource {
     float wi[3], irradiance[3];
   };
-  // Lights with kernels at most: more quad and point lights than this are all sampled lane by
-  // lane (their kernels run over every lane once per light).
-  static constexpr size_t kMaxStaged = 8;
+  // A static, untextured sphere light: its centre as Sphere::center_at gives it, its radius and
+  // radiance.
+  struct SphereLight {
+    int32_t light;
+    float center[3], radius, radiance[3];
+  };
   std::vector<QuadLight> quads;
   std::vector<PointSource> points;
   std::vector<DistantSource> distant;
-  // Per light: its kind and its index in quads, points or distant.
+  std::vector<SphereLight> spheres;
+  // The lights' constants as rows of floats, one row per light of quads, spheres and points
+  // (quad: origin, u, v, n, area, radiance; sphere: centre, radius, radiance; point: position,
+  // intensity, then six zeros: its sample's error bound and normal), kQuadRow, kSphereRow or
+  // kPointRow floats each, which fetch_light_rows copies into each lane's arrays.
+  static constexpr int32_t kQuadRow = 16, kSphereRow = 7, kPointRow = 12;
+  std::vector<float> quad_table, sphere_table, point_table;
+  // Per light: its kind and its index in quads, points, distant or spheres.
   std::vector<int32_t> kind, index;
 };
 
 // LightSampler::choose of u[i] into light[i], i < n (`cdf`: its table of `lights` entries).
 void choose_lights(const float* cdf, int32_t lights, size_t n, const float* u, int32_t* light);
 
-// Quad::sample then AreaLight::sample from ref at (u_x, u_y), for the entries whose light is
-// `id`; other entries keep what they hold. ok = whether the light gave a sample.
-void quad_light_samples(const float* q_origin, const float* q_u, const float* q_v,
-                        const float* q_n, float q_area, int32_t id, size_t n, const int32_t* light,
-                        const float* ref_x, const float* ref_y, const float* ref_z,
-                        const float* u_x, const float* u_y, int32_t* ok, float* wi_x, float* wi_y,
-                        float* wi_z, float* distance, float* pdf, float* p_x, float* p_y,
-                        float* p_z, float* e_x, float* e_y, float* e_z);
+// The kernels below take, per entry i < n, the kind of its light (kind[i], -1 for no light) and
+// its light's constants in arrays (fetch_light_rows); the entries of their kind get the sample
+// from ref at (u_x, u_y), the others keep what they hold (their constants' arrays hold whatever
+// the arrays held: the kernels compute on them in every lane and discard the results). ok =
+// whether the light gave a sample; e = the sample point's error bound.
+//
+// (The constants come in arrays rather than as a table and an index per lane: GCC's generic
+// tuning does not vectorise loads by a per-lane index, gathers being slow on many x86 cores; and
+// every array is a parameter of its own, since GCC trusts __restrict only on parameters and
+// without it the kernels, with their dozen outputs, stay scalar.)
 
-// PointLight::sample from ref for the entries whose light is `id` (pdf 1, a delta light);
-// other entries keep what they hold.
-void point_light_samples(const float* position, const float* intensity, int32_t id, size_t n,
-                         const int32_t* light, const float* ref_x, const float* ref_y,
+// For the entries of kind `of_kind`: row slot[i] of `table` (rows of `width` floats), float f
+// into fields[f][i]. Other entries are left as they are.
+void fetch_light_rows(const float* table, int32_t width, int32_t of_kind, size_t n,
+                      const int32_t* kind, const int32_t* slot, float* const* fields);
+
+// Quad::sample then AreaLight::sample, from each lane's quad (origin o, edges u and v, unit
+// normal nrm, area).
+void quad_light_samples(size_t n, const int32_t* kind, const float* o_x, const float* o_y,
+                        const float* o_z, const float* u_x, const float* u_y, const float* u_z,
+                        const float* v_x, const float* v_y, const float* v_z,
+                        const float* nrm_x, const float* nrm_y, const float* nrm_z,
+                        const float* area, const float* ref_x, const float* ref_y,
+                        const float* ref_z, const float* s_x, const float* s_y, int32_t* ok,
+                        float* wi_x, float* wi_y, float* wi_z, float* distance, float* pdf,
+                        float* p_x, float* p_y, float* p_z, float* e_x, float* e_y, float* e_z);
+
+// Sphere::sample (sample_sphere) then AreaLight::sample, from each lane's sphere (centre c,
+// radius); n = the sampled point's normal.
+void sphere_light_samples(size_t n, const int32_t* kind, const float* c_x, const float* c_y,
+                          const float* c_z, const float* radius, const float* ref_x,
+                          const float* ref_y, const float* ref_z, const float* s_x,
+                          const float* s_y, int32_t* ok, float* wi_x, float* wi_y, float* wi_z,
+                          float* distance, float* pdf, float* p_x, float* p_y, float* p_z,
+                          float* e_x, float* e_y, float* e_z, float* n_x, float* n_y, float* n_z);
+
+// PointLight::sample (pdf 1, a delta light) from each lane's light position; value holds the
+// light's intensity on entry and the sample's irradiance-like value I / d^2 on return.
+void point_light_samples(size_t n, const int32_t* kind, const float* pos_x, const float* pos_y,
+                         const float* pos_z, const float* ref_x, const float* ref_y,
                          const float* ref_z, int32_t* ok, float* wi_x, float* wi_y, float* wi_z,
                          float* distance, float* pdf, float* p_x, float* p_y, float* p_z,
                          float* value_x, float* value_y, float* value_z);
-
 
 }  // namespace penumbra

@@ -823,24 +823,68 @@ void SurfaceStage::compute(const IntegratorSettings& settings, bool scene_next_e
       choose_lights(sampler.cdf().data(), int32_t(sampler.cdf().size()), n, u_light_.data(),
                     light_.data());
     }
-    for (const StagedLights::QuadLight& q : lights_.quads)
-      quad_light_samples(q.origin, q.u, q.v, q.n, q.area, q.light, n, light_.data(), p_[0].data(),
-                         p_[1].data(), p_[2].data(), u_point_[0].data(), u_point_[1].data(),
-                         light_ok_.data(), l_wi_[0].data(), l_wi_[1].data(), l_wi_[2].data(),
-                         l_distance_.data(), l_pdf_.data(), l_p_[0].data(), l_p_[1].data(),
-                         l_p_[2].data(), l_error_[0].data(), l_error_[1].data(),
-                         l_error_[2].data());
-    for (const StagedLights::PointSource& q : lights_.points)
-      point_light_samples(q.position, q.intensity, q.light, n, light_.data(), p_[0].data(),
-                          p_[1].data(), p_[2].data(), light_ok_.data(), l_wi_[0].data(),
-                          l_wi_[1].data(), l_wi_[2].data(), l_distance_.data(), l_pdf_.data(),
-                          l_p_[0].data(), l_p_[1].data(), l_p_[2].data(), l_value_[0].data(),
-                          l_value_[1].data(), l_value_[2].data());
-    // Each lane's light constants: a quad's normal and radiance; a point light's zero normal
-    // and error; a directional light's whole sample. Point and directional lights are deltas:
-    // no MIS weight. (No constant environment: the path integrator, the stages' only user,
-    // leaves it to BSDF sampling and never chooses it.)
+    // Each lane's light kind and its index among the lights of that kind; one pass of each kind's
+    // kernel then serves all of its lanes.
     const bool spatial = sampler.spatial();
+    lane_kind_.resize(n);
+    lane_slot_.resize(n);
+    for (size_t i = 0; i < n; ++i) {
+      const int32_t light = light_[i];
+      lane_kind_[i] = light < 0 ? -1 : lights_.kind[size_t(light)];
+      lane_slot_[i] = light < 0 ? 0 : lights_.index[size_t(light)];
+    }
+    float* const ref[3] = {p_[0].data(), p_[1].data(), p_[2].data()};
+    // Each kind's constants into the lanes' arrays (fetch_light_rows): what only the kernel
+    // reads into scratch arrays, what the step reads (a quad's normal and radiance, a sphere's
+    // radiance, a point light's intensity and zero error and normal) straight into its arrays.
+    float* q[13];
+    for (size_t f = 0; f < std::size(q); ++f) {
+      light_rows_[f].resize(n);
+      q[f] = light_rows_[f].data();
+    }
+    const int32_t* kinds = lane_kind_.data();
+    const int32_t* slots = lane_slot_.data();
+    if (!lights_.quads.empty()) {
+      float* const fields[StagedLights::kQuadRow] = {
+          q[0], q[1], q[2], q[3], q[4], q[5], q[6], q[7], q[8], l_n_[0].data(), l_n_[1].data(),
+          l_n_[2].data(), q[9], l_value_[0].data(), l_value_[1].data(), l_value_[2].data()};
+      fetch_light_rows(lights_.quad_table.data(), StagedLights::kQuadRow, StagedLights::kQuad, n,
+                       kinds, slots, fields);
+      quad_light_samples(n, kinds, q[0], q[1], q[2], q[3], q[4], q[5], q[6], q[7], q[8],
+                         l_n_[0].data(), l_n_[1].data(), l_n_[2].data(), q[9], ref[0], ref[1],
+                         ref[2], u_point_[0].data(), u_point_[1].data(), light_ok_.data(),
+                         l_wi_[0].data(), l_wi_[1].data(), l_wi_[2].data(), l_distance_.data(),
+                         l_pdf_.data(), l_p_[0].data(), l_p_[1].data(), l_p_[2].data(),
+                         l_error_[0].data(), l_error_[1].data(), l_error_[2].data());
+    }
+    if (!lights_.spheres.empty()) {
+      float* const fields[StagedLights::kSphereRow] = {
+          q[0], q[1], q[2], q[3], l_value_[0].data(), l_value_[1].data(), l_value_[2].data()};
+      fetch_light_rows(lights_.sphere_table.data(), StagedLights::kSphereRow, StagedLights::kSphere,
+                       n, kinds, slots, fields);
+      sphere_light_samples(n, kinds, q[0], q[1], q[2], q[3], ref[0], ref[1], ref[2],
+                           u_point_[0].data(), u_point_[1].data(), light_ok_.data(),
+                           l_wi_[0].data(), l_wi_[1].data(), l_wi_[2].data(), l_distance_.data(),
+                           l_pdf_.data(), l_p_[0].data(), l_p_[1].data(), l_p_[2].data(),
+                           l_error_[0].data(), l_error_[1].data(), l_error_[2].data(),
+                           l_n_[0].data(), l_n_[1].data(), l_n_[2].data());
+    }
+    if (!lights_.points.empty()) {
+      float* const fields[StagedLights::kPointRow] = {
+          q[0], q[1], q[2], l_value_[0].data(), l_value_[1].data(), l_value_[2].data(),
+          l_error_[0].data(), l_error_[1].data(), l_error_[2].data(), l_n_[0].data(),
+          l_n_[1].data(), l_n_[2].data()};
+      fetch_light_rows(lights_.point_table.data(), StagedLights::kPointRow, StagedLights::kPoint, n,
+                       kinds, slots, fields);
+      point_light_samples(n, kinds, q[0], q[1], q[2], ref[0], ref[1], ref[2], light_ok_.data(),
+                          l_wi_[0].data(), l_wi_[1].data(), l_wi_[2].data(), l_distance_.data(),
+                          l_pdf_.data(), l_p_[0].data(), l_p_[1].data(), l_p_[2].data(),
+                          l_value_[0].data(), l_value_[1].data(), l_value_[2].data());
+    }
+    // What the kernels leave: the choice's probability, the delta flags, a directional light's
+    // whole sample (the same everywhere). Point and directional lights are deltas: no MIS
+    // weight. (No constant environment: the path integrator, the stages' only user, leaves it
+    // to BSDF sampling and never chooses it.)
     for (size_t i = 0; i < n; ++i) {
       const int32_t light = light_[i];
       l_delta_[i] = 0;
@@ -848,24 +892,16 @@ void SurfaceStage::compute(const IntegratorSettings& settings, bool scene_next_e
         light_ok_[i] = 0;
         continue;
       }
-      const size_t index = size_t(lights_.index[size_t(light)]);
+      const size_t index = size_t(lane_slot_[i]);
       if (!spatial) l_pmf_[i] = sampler.pmf(light);
-      switch (lights_.kind[size_t(light)]) {
-        case StagedLights::kQuad: {
-          const StagedLights::QuadLight& q = lights_.quads[index];
-          for (int c = 0; c < 3; ++c) {
-            l_n_[c][i] = q.n[c];
-            l_value_[c][i] = q.radiance[c];
-          }
-          if (q.texture) emission_lanes_.push_back(uint32_t(i));
+      switch (lane_kind_[i]) {
+        case StagedLights::kQuad:
+          if (lights_.quads[index].texture) emission_lanes_.push_back(uint32_t(i));
           break;
-        }
+        case StagedLights::kSphere:
+          break;
         case StagedLights::kPoint:
           l_delta_[i] = 1;
-          for (int c = 0; c < 3; ++c) {
-            l_n_[c][i] = 0.f;
-            l_error_[c][i] = 0.f;
-          }
           break;
         case StagedLights::kDirectional: {
           const StagedLights::DistantSource& d = lights_.distant[index];

@@ -145,6 +145,11 @@ class SurfaceStage {
   std::vector<int32_t> light_, light_ok_, l_delta_;
   std::vector<float> l_wi_[3], l_distance_, l_pdf_, l_p_[3], l_error_[3], l_n_[3], l_value_[3], l_pmf_;
   std::vector<uint32_t> own_code_lanes_;  // lanes whose light is StagedLights::kOwnCode
+  // Per lane: its light's StagedLights kind (-1: no light) and index among that kind's lights.
+  std::vector<int32_t> lane_kind_, lane_slot_;
+  // Per lane: the constants of its light that only the light kernels read (a quad's origin,
+  // edges and area; a sphere's centre and radius; a point light's position; fetch_light_rows).
+  std::vector<float> light_rows_[13];
   // Lanes whose light is a textured quad, and one light's lanes and uvs: their radiance is
   // looked up for all of them at once (look_up_emission, into looked_up_).
   std::vector<uint32_t> emission_lanes_, emission_of_;

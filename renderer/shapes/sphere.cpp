@@ -7,6 +7,7 @@
 #include "renderer/core/simd_clones.h"
 #include "renderer/embree/ray_access.h"
 #include "renderer/sampling/sampling.h"
+#include "renderer/shapes/sphere_sample.h"
 
 namespace penumbra {
 namespace {
@@ -352,43 +353,12 @@ void sphere_hit_geometry(const vec3& center, float radius, const vec3& p_approx,
 
 ShapeSample sample_sphere(const vec3& center, float radius, const vec3& ref, const vec2& u) {
   ShapeSample s;
-  const vec3 to_center = center - ref;
-  const float dc2 = glm::dot(to_center, to_center);
-  const float r2 = radius * radius;
-  if (dc2 <= r2 * 1.0001f) {
-    // Inside (or on) the sphere: uniform area sampling.
-    const vec3 n = square_to_uniform_sphere(u);
-    s.p = center + radius * n;
-    s.n = n;
-    s.p_error = gamma_bound(6) * (abs_components(center) + abs_components(n * radius));
-    s.pdf = area_to_solid_angle(ref, s.p, n, 4.f * kPi * r2);
-    return s;
-  }
-  const float dc = std::sqrt(dc2);
-  const vec3 wc = to_center / dc;
-  const Frame frame(wc);
-  const float sin2_max = r2 / dc2;
-  const float cos_max = safe_sqrt(1.f - sin2_max);
-  // For tiny or distant spheres 1 - cos_max cancels catastrophically; its series is exact enough.
-  const float one_minus_cos_max = sin2_max < 1e-3f ? sin2_max * 0.5f + sin2_max * sin2_max / 8.f
-                                                   : 1.f - cos_max;
-  const float cos_t = 1.f - u.x * one_minus_cos_max;
-  const float sin2_t = std::max(0.f, 1.f - cos_t * cos_t);
-  const float sin2_t_exact = u.x * one_minus_cos_max * (2.f - u.x * one_minus_cos_max);
-  const float sin2 = sin2_max < 1e-3f ? sin2_t_exact : sin2_t;
-  // Angle alpha at the centre between -wc and the sampled point, by the law of cosines in the
-  // triangle (ref, centre, point) (pbrt-v3 section 14.2.2).
-  const float ds = dc * cos_t - safe_sqrt(r2 - dc2 * sin2);
-  const float ca = std::clamp((dc2 + r2 - ds * ds) / (2.f * dc * radius), -1.f, 1.f);
-  const float sa = safe_sqrt(1.f - ca * ca);
-  float sin_phi, cos_phi;
-  sincos_two_pi(u.y, &sin_phi, &cos_phi);
-  const vec3 n_local(sa * cos_phi, sa * sin_phi, ca);
-  const vec3 n = -frame.to_world(n_local);
-  s.n = glm::normalize(n);
-  s.p = center + radius * s.n;
-  s.p_error = gamma_bound(6) * (abs_components(center) + abs_components(s.n * radius));
-  s.pdf = 1.f / (2.f * kPi * one_minus_cos_max);
+  float p[3], n[3], e[3];
+  sphere_solid_angle_sample(center.x, center.y, center.z, radius, ref.x, ref.y, ref.z, u.x, u.y, p, n,
+                            e, &s.pdf);
+  s.p = vec3(p[0], p[1], p[2]);
+  s.n = vec3(n[0], n[1], n[2]);
+  s.p_error = vec3(e[0], e[1], e[2]);
   return s;
 }
 

@@ -197,6 +197,7 @@ struct Coverage {
   int staged = 0, fallback = 0, alive = 0, dead = 0, shadows = 0, back = 0, ball = 0, delta = 0;
   int delta_lights = 0;  // staged lanes whose chosen light is a point or directional light
   int own_code_lights = 0;  // staged lanes whose chosen light has no kernel
+  int kernel_lights[5] = {};  // staged lanes by their chosen light's StagedLights::Kind
   int textured_lights = 0;  // staged lanes whose chosen light is a textured quad
 };
 
@@ -285,6 +286,7 @@ Coverage expect_stage_matches_scene(const SceneInput& in, bool lights, uint32_t 
         const Light& light = scene->mis_light(chosen);
         cover.delta_lights += light.sample(hit.p, 0.f, vec2(0.5f), &ls) && ls.is_delta;
         cover.own_code_lights += staged_lights.kind[size_t(chosen)] == StagedLights::kOwnCode;
+        ++cover.kernel_lights[staged_lights.kind[size_t(chosen)]];
         cover.textured_lights += staged_lights.kind[size_t(chosen)] == StagedLights::kQuad &&
                                  staged_lights.quads[size_t(staged_lights.index[size_t(chosen)])].texture;
       }
@@ -416,24 +418,29 @@ TEST(SurfaceStage, LambertStepIsPathScatterToTheBitWithTexturedQuadLights) {
 }
 
 TEST(SurfaceStage, LambertStepIsPathScatterToTheBitWithManyLights) {
-  // More quad and point lights than have kernels (StagedLights::kMaxStaged): every lane samples
-  // its light by the light's own code, chosen by the light tree at its point.
+  // Many quad, sphere and point lights, chosen by the light tree at each lane's point: each
+  // kind's kernel runs once over the lanes, every lane reading its own light's constants.
   SceneInput in = floor_scene(true, DiffuseParams{Spectrum(0.7f, 0.5f, 0.3f)});
   for (int i = 0; i < 12; ++i) {
     const float x = -3.f + 0.5f * float(i);
     in.objects.push_back(quad_object({x, 1.5f + 0.1f * float(i % 3), -1.f + 0.2f * float(i % 4)}, {0.3f, 0, 0},
                                      {0, 0, 0.3f}, 1, Spectrum(1.f + 0.5f * float(i % 5))));
+    in.objects.push_back(sphere_object({x, 0.6f + 0.1f * float(i % 4), -1.8f}, 0.05f + 0.02f * float(i % 3), 1,
+                                       Spectrum(4.f + float(i % 3), 3.f, 2.f + float(i % 2))));
     in.lights.push_back(PointLightDesc{{x, 0.8f, 1.5f}, Spectrum(0.2f + 0.1f * float(i % 3))});
   }
   const auto scene = Scene::build(in);
   ASSERT_TRUE(scene->mis_light_sampler().spatial());
   const StagedLights staged(*scene);
-  EXPECT_TRUE(staged.quads.empty());
-  EXPECT_TRUE(staged.points.empty());
+  EXPECT_EQ(staged.quads.size(), 12u + 2u);  // (and the scene's own lights)
+  EXPECT_EQ(staged.spheres.size(), 12u + 1u);
+  EXPECT_EQ(staged.points.size(), 12u + 1u);
   const Coverage c = expect_stage_matches_scene(in, true, 61, StageModel::kLambert);
   EXPECT_GT(c.staged, 1000);
   EXPECT_EQ(c.fallback, 0);
-  EXPECT_GT(c.own_code_lights, 1000);
+  EXPECT_GT(c.kernel_lights[StagedLights::kQuad], 200);
+  EXPECT_GT(c.kernel_lights[StagedLights::kSphere], 100);
+  EXPECT_GT(c.kernel_lights[StagedLights::kPoint], 100);
   EXPECT_GT(c.shadows, 500);
 }
 
@@ -456,7 +463,8 @@ void expect_model_cases(StageModel model, std::initializer_list<float> roughness
       const Coverage c = expect_stage_matches_scatter(true, seed, model, roughness, ior);
       EXPECT_GT(c.staged, 1000);
       EXPECT_EQ(c.fallback, 0);
-      EXPECT_GT(c.own_code_lights, 100);  // the sphere and mesh lights
+      EXPECT_GT(c.own_code_lights, 100);  // the mesh light
+      EXPECT_GT(c.kernel_lights[StagedLights::kSphere], 100);
       EXPECT_GT(c.delta_lights, 200);
       EXPECT_GT(c.alive, 300);
       EXPECT_GT(c.dead, 50);
