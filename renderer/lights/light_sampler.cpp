@@ -120,11 +120,20 @@ int LightSampler::choose(float u, const vec3& p, const vec3& n, float* pmf) cons
 
 void LightSampler::choose_many(size_t n, const vec3* p, const vec3* normal, const float* u, int* light,
                                float* pmf) const {
-  // Lights outside the tree at once; the tree's group gathered and walked together.
-  std::vector<vec3> group_p, group_n;
-  std::vector<float> group_v, walk_pmf;
-  std::vector<int> group_light;
-  std::vector<size_t> group_of;
+  // Lights outside the tree at once; the tree's group gathered and walked together. (The
+  // gather buffers are the thread's, kept between calls: a stage calls this every bounce.)
+  struct Buffers {
+    std::vector<vec3> group_p, group_n;
+    std::vector<float> group_v, walk_pmf;
+    std::vector<int> group_light;
+    std::vector<size_t> group_of;
+  };
+  thread_local Buffers buffers;
+  auto& [group_p, group_n, group_v, walk_pmf, group_light, group_of] = buffers;
+  group_p.clear();
+  group_n.clear();
+  group_v.clear();
+  group_of.clear();
   for (size_t k = 0; k < n; ++k) {
     const int e = choose_entry(u[k]);
     light[k] = entry_light_[size_t(e)];

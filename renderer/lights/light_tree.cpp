@@ -80,9 +80,12 @@ void LightTreeNode::set(int k, const LightBounds& b, int32_t child_or_light) {
   child[k] = child_or_light;
 }
 
-PENUMBRA_SIMD_CLONES
-void light_tree_importance(const LightTreeNode& n, const vec3& p, const vec3& normal,
-                           float* __restrict out) {
+namespace {
+
+// light_tree_importance's arithmetic, inlined into it and into the walk's level kernel (the same
+// operations in the same order: the same bits).
+[[gnu::always_inline]] inline void node_importance(const LightTreeNode& n, const vec3& p,
+                                                   const vec3& normal, float* __restrict out) {
   const float px = p.x, py = p.y, pz = p.z;
   const float nx = normal.x, ny = normal.y, nz = normal.z;
   const bool has_normal = nx != 0.f || ny != 0.f || nz != 0.f;
@@ -118,6 +121,14 @@ void light_tree_importance(const LightTreeNode& n, const vec3& p, const vec3& no
     const bool behind = n.one_way[k] != 0.f && (n.ax[k] * vx + n.ay[k] * vy + n.az[k] * vz) <= n.behind_at[k];
     out[k] = (!behind && cos_p > n.cos_e[k] && importance > 0.f && importance < kInfinity) ? importance : 0.f;
   }
+}
+
+}  // namespace
+
+PENUMBRA_SIMD_CLONES
+void light_tree_importance(const LightTreeNode& n, const vec3& p, const vec3& normal,
+                           float* __restrict out) {
+  node_importance(n, p, normal, out);
 }
 
 float light_importance(const LightBounds& b, const vec3& p, const vec3& n) {
@@ -251,14 +262,16 @@ int LightTree::collapse(const std::vector<Binary>& binary, int root, int parent,
   return index;
 }
 
-bool LightTree::step(int node, const vec3& p, const vec3& normal, float* u, float* prob,
-                     int32_t* child) const {
-  const LightTreeNode& n = nodes_[size_t(node)];
-  float imp[LightTreeNode::kWide], cum[LightTreeNode::kWide];
-  light_tree_importance(n, p, normal, imp);
+namespace {
+
+// One level of a walk, given the node's importances at the point: the slot u selects; u becomes
+// its place within the slot's interval, *prob is multiplied by the slot's probability, and the
+// slot is returned (-1 if nothing reaches the point).
+[[gnu::always_inline]] inline int walk_step(const float* imp, float* u, float* prob) {
+  float cum[LightTreeNode::kWide];
   float total = 0.f;
   for (int k = 0; k < LightTreeNode::kWide; ++k) cum[k] = total += imp[k];
-  if (!(total > 0.f)) return false;
+  if (!(total > 0.f)) return -1;
   // The slot whose interval [cum[k - 1], cum[k]) holds u x total: the number of intervals that
   // end at or below it (counted, not searched: which one it is is random, and a branch on it
   // would be mispredicted half the time). A slot of importance 0 has an empty interval and is
@@ -273,8 +286,43 @@ bool LightTree::step(int node, const vec3& p, const vec3& normal, float* u, floa
   const float below = slot > 0 ? cum[slot - 1] : 0.f;
   *u = std::clamp((target - below) / imp[slot], 0.f, kOneMinusEpsilon);
   *prob *= imp[slot] / total;
-  *child = n.child[slot];
-  return true;
+  return slot;
+}
+
+}  // namespace
+
+// A level of the walks of m points (LightTree::choose_many): each point at a node (at[k] >= 0)
+// takes its step; a point that reaches a light or finds nothing stops (at[k] = -1). Returns how
+// many go on. In two passes, the importances of every point's node (in this function's SIMD
+// width, without a call) into `scratch` (m x kWide floats), then the choices: each pass's work
+// per point is a short chain independent of the other points', which the core overlaps (one
+// pass per point was a chain of both, mostly waiting).
+PENUMBRA_SIMD_CLONES
+size_t light_tree_walk_level(const LightTreeNode* nodes, size_t m, int32_t* __restrict at,
+                             const vec3* p, const vec3* normal, float* __restrict u,
+                             float* __restrict pmf, int* __restrict light,
+                             float* __restrict scratch) {
+  for (size_t k = 0; k < m; ++k)
+    if (at[k] >= 0)
+      node_importance(nodes[size_t(at[k])], p[k], normal[k], scratch + k * LightTreeNode::kWide);
+  size_t walking = 0;
+  for (size_t k = 0; k < m; ++k) {
+    if (at[k] < 0) continue;
+    const int slot = walk_step(scratch + k * LightTreeNode::kWide, &u[k], &pmf[k]);
+    const int32_t child = slot >= 0 ? nodes[size_t(at[k])].child[slot] : 0;
+    if (slot < 0) {
+      light[k] = -1;
+      pmf[k] = 0.f;
+      at[k] = -1;
+    } else if (child < 0) {
+      light[k] = -1 - child;
+      at[k] = -1;
+    } else {
+      at[k] = child;
+      ++walking;
+    }
+  }
+  return walking;
 }
 
 int LightTree::choose(const vec3& p, const vec3& normal, float u, float* pmf) const {
@@ -293,6 +341,7 @@ void LightTree::choose_many(size_t n, const vec3* p, const vec3* normal, const f
   constexpr size_t kChunk = 256;
   float walk_u[kChunk];
   int32_t at[kChunk];
+  alignas(32) float scratch[kChunk * LightTreeNode::kWide];
   for (size_t base = 0; base < n; base += kChunk) {
     const size_t m = std::min(kChunk, n - base);
     size_t walking = m;
@@ -301,24 +350,9 @@ void LightTree::choose_many(size_t n, const vec3* p, const vec3* normal, const f
       pmf[base + k] = 1.f;
       at[k] = 0;
     }
-    while (walking > 0) {
-      walking = 0;
-      for (size_t k = 0; k < m; ++k) {
-        if (at[k] < 0) continue;
-        int32_t child;
-        if (!step(at[k], p[base + k], normal[base + k], &walk_u[k], &pmf[base + k], &child)) {
-          light[base + k] = -1;
-          pmf[base + k] = 0.f;
-          at[k] = -1;
-        } else if (child < 0) {
-          light[base + k] = -1 - child;
-          at[k] = -1;
-        } else {
-          at[k] = child;
-          ++walking;
-        }
-      }
-    }
+    while (walking > 0)
+      walking = light_tree_walk_level(nodes_.data(), m, at, p + base, normal + base, walk_u,
+                                      pmf + base, light + base, scratch);
   }
 }
 

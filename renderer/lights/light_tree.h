@@ -95,9 +95,6 @@ class LightTree {
   };
   static int build_binary(std::vector<Binary>& out, std::vector<std::pair<LightBounds, int>>& lights,
                           size_t begin, size_t end, int depth);
-  // One level of a walk: at `node`, the slot u selects; u becomes its place within the slot's
-  // interval and *prob is multiplied by the slot's probability. False if nothing reaches p.
-  bool step(int node, const vec3& p, const vec3& n, float* u, float* prob, int32_t* child) const;
   int collapse(const std::vector<Binary>& binary, int root, int parent, int parent_slot);
 
   std::vector<LightTreeNode> nodes_;
