@@ -15,12 +15,48 @@
 
 namespace penumbra {
 
-void fetch_light_rows(const float* table, int32_t width, int32_t of_kind, size_t n,
-                      const int32_t* kind, const int32_t* slot, float* const* fields) {
+namespace {
+
+// out[i] = v where kind[i] is of_kind: one light's constant for all of its lanes.
+PENUMBRA_SIMD_CLONES
+void fill_where(size_t n, const int32_t* __restrict kind, int32_t of_kind, float v,
+                float* __restrict out) {
+  for (size_t i = 0; i < n; ++i) out[i] = when(mask(kind[i] == of_kind), v, out[i]);
+}
+
+template <int32_t kWidth>
+void gather_rows(const float* table, int32_t of_kind, size_t n, const int32_t* kind,
+                 const int32_t* slot, float* const* fields) {
+  float* out[kWidth];
+  for (int32_t f = 0; f < kWidth; ++f) out[f] = fields[f];
   for (size_t i = 0; i < n; ++i) {
     if (kind[i] != of_kind) continue;
-    const float* row = table + size_t(slot[i]) * size_t(width);
-    for (int32_t f = 0; f < width; ++f) fields[f][i] = row[f];
+    const float* row = table + size_t(slot[i]) * size_t(kWidth);
+    for (int32_t f = 0; f < kWidth; ++f) out[f][i] = row[f];
+  }
+}
+
+}  // namespace
+
+void fetch_light_rows(const float* table, size_t rows, int32_t width, int32_t of_kind, size_t n,
+                      const int32_t* kind, const int32_t* slot, float* const* fields) {
+  if (rows == 1) {  // (most scenes: one light of the kind, its constants in vector stores)
+    for (int32_t f = 0; f < width; ++f) fill_where(n, kind, of_kind, table[f], fields[f]);
+    return;
+  }
+  switch (width) {
+    case StagedLights::kQuadRow:
+      return gather_rows<StagedLights::kQuadRow>(table, of_kind, n, kind, slot, fields);
+    case StagedLights::kSphereRow:
+      return gather_rows<StagedLights::kSphereRow>(table, of_kind, n, kind, slot, fields);
+    case StagedLights::kPointRow:
+      return gather_rows<StagedLights::kPointRow>(table, of_kind, n, kind, slot, fields);
+    default:
+      for (size_t i = 0; i < n; ++i) {
+        if (kind[i] != of_kind) continue;
+        const float* row = table + size_t(slot[i]) * size_t(width);
+        for (int32_t f = 0; f < width; ++f) fields[f][i] = row[f];
+      }
   }
 }
 

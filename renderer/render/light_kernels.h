@@ -82,9 +82,9 @@ void choose_lights(const float* cdf, int32_t lights, size_t n, const float* u, i
 // every array is a parameter of its own, since GCC trusts __restrict only on parameters and
 // without it the kernels, with their dozen outputs, stay scalar.)
 
-// For the entries of kind `of_kind`: row slot[i] of `table` (rows of `width` floats), float f
-// into fields[f][i]. Other entries are left as they are.
-void fetch_light_rows(const float* table, int32_t width, int32_t of_kind, size_t n,
+// For the entries of kind `of_kind`: row slot[i] of `table` (`rows` rows of `width` floats),
+// float f into fields[f][i]. Other entries are left as they are.
+void fetch_light_rows(const float* table, size_t rows, int32_t width, int32_t of_kind, size_t n,
                       const int32_t* kind, const int32_t* slot, float* const* fields);
 
 // Quad::sample then AreaLight::sample, from each lane's quad (origin o, edges u and v, unit

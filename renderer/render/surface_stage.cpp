@@ -848,8 +848,8 @@ void SurfaceStage::compute(const IntegratorSettings& settings, bool scene_next_e
       float* const fields[StagedLights::kQuadRow] = {
           q[0], q[1], q[2], q[3], q[4], q[5], q[6], q[7], q[8], l_n_[0].data(), l_n_[1].data(),
           l_n_[2].data(), q[9], l_value_[0].data(), l_value_[1].data(), l_value_[2].data()};
-      fetch_light_rows(lights_.quad_table.data(), StagedLights::kQuadRow, StagedLights::kQuad, n,
-                       kinds, slots, fields);
+      fetch_light_rows(lights_.quad_table.data(), lights_.quads.size(), StagedLights::kQuadRow,
+                       StagedLights::kQuad, n, kinds, slots, fields);
       quad_light_samples(n, kinds, q[0], q[1], q[2], q[3], q[4], q[5], q[6], q[7], q[8],
                          l_n_[0].data(), l_n_[1].data(), l_n_[2].data(), q[9], ref[0], ref[1],
                          ref[2], u_point_[0].data(), u_point_[1].data(), light_ok_.data(),
@@ -860,8 +860,8 @@ void SurfaceStage::compute(const IntegratorSettings& settings, bool scene_next_e
     if (!lights_.spheres.empty()) {
       float* const fields[StagedLights::kSphereRow] = {
           q[0], q[1], q[2], q[3], l_value_[0].data(), l_value_[1].data(), l_value_[2].data()};
-      fetch_light_rows(lights_.sphere_table.data(), StagedLights::kSphereRow, StagedLights::kSphere,
-                       n, kinds, slots, fields);
+      fetch_light_rows(lights_.sphere_table.data(), lights_.spheres.size(),
+                       StagedLights::kSphereRow, StagedLights::kSphere, n, kinds, slots, fields);
       sphere_light_samples(n, kinds, q[0], q[1], q[2], q[3], ref[0], ref[1], ref[2],
                            u_point_[0].data(), u_point_[1].data(), light_ok_.data(),
                            l_wi_[0].data(), l_wi_[1].data(), l_wi_[2].data(), l_distance_.data(),
@@ -874,8 +874,8 @@ void SurfaceStage::compute(const IntegratorSettings& settings, bool scene_next_e
           q[0], q[1], q[2], l_value_[0].data(), l_value_[1].data(), l_value_[2].data(),
           l_error_[0].data(), l_error_[1].data(), l_error_[2].data(), l_n_[0].data(),
           l_n_[1].data(), l_n_[2].data()};
-      fetch_light_rows(lights_.point_table.data(), StagedLights::kPointRow, StagedLights::kPoint, n,
-                       kinds, slots, fields);
+      fetch_light_rows(lights_.point_table.data(), lights_.points.size(), StagedLights::kPointRow,
+                       StagedLights::kPoint, n, kinds, slots, fields);
       point_light_samples(n, kinds, q[0], q[1], q[2], ref[0], ref[1], ref[2], light_ok_.data(),
                           l_wi_[0].data(), l_wi_[1].data(), l_wi_[2].data(), l_distance_.data(),
                           l_pdf_.data(), l_p_[0].data(), l_p_[1].data(), l_p_[2].data(),
