@@ -17,18 +17,11 @@ namespace penumbra {
 
 namespace {
 
-// out[i] = v where kind[i] is of_kind: one light's constant for all of its lanes.
-PENUMBRA_SIMD_CLONES
-void fill_where(size_t n, const int32_t* __restrict kind, int32_t of_kind, float v,
-                float* __restrict out) {
-  for (size_t i = 0; i < n; ++i) out[i] = when(mask(kind[i] == of_kind), v, out[i]);
-}
-
 template <int32_t kWidth>
 void gather_rows(const float* table, int32_t of_kind, size_t n, const int32_t* kind,
-                 const int32_t* slot, float* const* fields) {
+                 const int32_t* slot, std::vector<std::vector<float>>& fields) {
   float* out[kWidth];
-  for (int32_t f = 0; f < kWidth; ++f) out[f] = fields[f];
+  for (int32_t f = 0; f < kWidth; ++f) out[f] = fields[size_t(f)].data();
   for (size_t i = 0; i < n; ++i) {
     if (kind[i] != of_kind) continue;
     const float* row = table + size_t(slot[i]) * size_t(kWidth);
@@ -38,163 +31,258 @@ void gather_rows(const float* table, int32_t of_kind, size_t n, const int32_t* k
 
 }  // namespace
 
-void fetch_light_rows(const float* table, size_t rows, int32_t width, int32_t of_kind, size_t n,
-                      const int32_t* kind, const int32_t* slot, float* const* fields) {
-  if (rows == 1) {  // (most scenes: one light of the kind, its constants in vector stores)
-    for (int32_t f = 0; f < width; ++f) fill_where(n, kind, of_kind, table[f], fields[f]);
-    return;
-  }
-  switch (width) {
+void LightRows::fetch(size_t n, const int32_t* kind, const int32_t* slot) {
+  const size_t rows = table_.size() / size_t(width_);
+  if (rows == 0) return;
+  if (fields_[0].size() < n)
+    for (std::vector<float>& f : fields_) f.resize(n);
+  switch (width_) {
     case StagedLights::kQuadRow:
-      return gather_rows<StagedLights::kQuadRow>(table, of_kind, n, kind, slot, fields);
+      return gather_rows<StagedLights::kQuadRow>(table_.data(), kind_, n, kind, slot, fields_);
     case StagedLights::kSphereRow:
-      return gather_rows<StagedLights::kSphereRow>(table, of_kind, n, kind, slot, fields);
+      return gather_rows<StagedLights::kSphereRow>(table_.data(), kind_, n, kind, slot, fields_);
     case StagedLights::kPointRow:
-      return gather_rows<StagedLights::kPointRow>(table, of_kind, n, kind, slot, fields);
-    default:
-      for (size_t i = 0; i < n; ++i) {
-        if (kind[i] != of_kind) continue;
-        const float* row = table + size_t(slot[i]) * size_t(width);
-        for (int32_t f = 0; f < width; ++f) fields[f][i] = row[f];
-      }
+      return gather_rows<StagedLights::kPointRow>(table_.data(), kind_, n, kind, slot, fields_);
   }
 }
 
-// Quad::sample followed by AreaLight::sample for the entries of kind kQuad, over arrays; other
-// entries keep what they hold. Operation for operation as the scalar code: glm's dot sums x, y, z
-// in that order, length is sqrt(dot), a vector divided by a scalar divides each component, and
-// every comparison that rejects a sample is the scalar one (NaNs included).
-PENUMBRA_SIMD_CLONES
-void quad_light_samples(size_t n, const int32_t* __restrict kind, const float* __restrict o_x,
-                        const float* __restrict o_y, const float* __restrict o_z,
-                        const float* __restrict u_x, const float* __restrict u_y,
-                        const float* __restrict u_z, const float* __restrict v_x,
-                        const float* __restrict v_y, const float* __restrict v_z,
-                        const float* __restrict nrm_x, const float* __restrict nrm_y,
-                        const float* __restrict nrm_z, const float* __restrict area,
-                        const float* __restrict ref_x, const float* __restrict ref_y,
-                        const float* __restrict ref_z, const float* __restrict s_x,
-                        const float* __restrict s_y, int32_t* __restrict ok,
-                        float* __restrict wi_x, float* __restrict wi_y, float* __restrict wi_z,
-                        float* __restrict distance, float* __restrict pdf,
-                        float* __restrict p_x, float* __restrict p_y, float* __restrict p_z,
-                        float* __restrict e_x, float* __restrict e_y, float* __restrict e_z) {
+namespace {
+
+// Quad::sample followed by AreaLight::sample for lane i, whose light is this quad if `mine`;
+// other lanes keep what they hold. Operation for operation as the scalar code: glm's dot sums x,
+// y, z in that order, length is sqrt(dot), a vector divided by a scalar divides each component,
+// and every comparison that rejects a sample is the scalar one (NaNs included).
+[[gnu::always_inline]] inline void quad_lane(
+    size_t i, Mask mine, float ox, float oy, float oz, float ux, float uy, float uz, float vx,
+    float vy, float vz, float nx, float ny, float nz, float q_area, float rad_x, float rad_y,
+    float rad_z, const float* __restrict ref_x, const float* __restrict ref_y, const float* __restrict ref_z, const float* __restrict s_x, const float* __restrict s_y, int32_t* __restrict ok, float* __restrict wi_x, float* __restrict wi_y, float* __restrict wi_z, float* __restrict distance, float* __restrict pdf, float* __restrict p_x, float* __restrict p_y, float* __restrict p_z, float* __restrict e_x, float* __restrict e_y, float* __restrict e_z, float* __restrict n_x, float* __restrict n_y, float* __restrict n_z, float* __restrict value_x, float* __restrict value_y, float* __restrict value_z) {
   constexpr float g6 = gamma_bound(6);
-  for (size_t i = 0; i < n; ++i) {
-    const Mask mine = mask(kind[i] == StagedLights::kQuad);
-    const float ox = o_x[i], oy = o_y[i], oz = o_z[i], ux = u_x[i], uy = u_y[i], uz = u_z[i];
-    const float vx = v_x[i], vy = v_y[i], vz = v_z[i];
-    const float nx = nrm_x[i], ny = nrm_y[i], nz = nrm_z[i], q_area = area[i];
-    // Quad::sample: p = o + s u + t v and its error bound (pbrt-v4 section 6.8.1).
-    const float sux = s_x[i] * ux, suy = s_x[i] * uy, suz = s_x[i] * uz;
-    const float svx = s_y[i] * vx, svy = s_y[i] * vy, svz = s_y[i] * vz;
-    const float px = (ox + sux) + svx, py = (oy + suy) + svy, pz = (oz + suz) + svz;
-    const float ex = g6 * ((std::fabs(ox) + std::fabs(sux)) + std::fabs(svx));
-    const float ey = g6 * ((std::fabs(oy) + std::fabs(suy)) + std::fabs(svy));
-    const float ez = g6 * ((std::fabs(oz) + std::fabs(suz)) + std::fabs(svz));
-    // area_to_solid_angle (shapes/shape.h). Divided in every lane and then selected: a division
-    // under a condition is not if-converted; the selected value is the scalar one.
-    const float wx = px - ref_x[i], wy = py - ref_y[i], wz = pz - ref_z[i];
-    const float dist2 = (wx * wx + wy * wy) + wz * wz;
-    const float cos_l = std::fabs((nx * wx + ny * wy) + nz * wz) / std::sqrt(dist2);
-    const float ratio = dist2 / (cos_l * q_area);
-    const float density = (cos_l > 0.f) & (q_area > 0.f) ? ratio : 0.f;
-    // AreaLight::sample: a finite positive density, a positive distance, the front side (&
-    // rather than &&: no branches in the loop).
-    const float dist = std::sqrt(dist2);
-    const float dx = wx / dist, dy = wy / dist, dz = wz / dist;
-    const bool good = (density > 0.f) & (density < kInfinity) & (dist > 0.f) &
-                      !(((nx * dx + ny * dy) + nz * dz) >= 0.f);
-    ok[i] = when(mine, int32_t(good), ok[i]);
-    wi_x[i] = when(mine, dx, wi_x[i]);
-    wi_y[i] = when(mine, dy, wi_y[i]);
-    wi_z[i] = when(mine, dz, wi_z[i]);
-    distance[i] = when(mine, dist, distance[i]);
-    pdf[i] = when(mine, density, pdf[i]);
-    p_x[i] = when(mine, px, p_x[i]);
-    p_y[i] = when(mine, py, p_y[i]);
-    p_z[i] = when(mine, pz, p_z[i]);
-    e_x[i] = when(mine, ex, e_x[i]);
-    e_y[i] = when(mine, ey, e_y[i]);
-    e_z[i] = when(mine, ez, e_z[i]);
-  }
+  // Quad::sample: p = o + s u + t v and its error bound (pbrt-v4 section 6.8.1).
+  const float sux = s_x[i] * ux, suy = s_x[i] * uy, suz = s_x[i] * uz;
+  const float svx = s_y[i] * vx, svy = s_y[i] * vy, svz = s_y[i] * vz;
+  const float px = (ox + sux) + svx, py = (oy + suy) + svy, pz = (oz + suz) + svz;
+  const float ex = g6 * ((std::fabs(ox) + std::fabs(sux)) + std::fabs(svx));
+  const float ey = g6 * ((std::fabs(oy) + std::fabs(suy)) + std::fabs(svy));
+  const float ez = g6 * ((std::fabs(oz) + std::fabs(suz)) + std::fabs(svz));
+  // area_to_solid_angle (shapes/shape.h). Divided in every lane and then selected: a division
+  // under a condition is not if-converted; the selected value is the scalar one.
+  const float wx = px - ref_x[i], wy = py - ref_y[i], wz = pz - ref_z[i];
+  const float dist2 = (wx * wx + wy * wy) + wz * wz;
+  const float cos_l = std::fabs((nx * wx + ny * wy) + nz * wz) / std::sqrt(dist2);
+  const float ratio = dist2 / (cos_l * q_area);
+  const float density = (cos_l > 0.f) & (q_area > 0.f) ? ratio : 0.f;
+  // AreaLight::sample: a finite positive density, a positive distance, the front side (&
+  // rather than &&: no branches in the loop).
+  const float dist = std::sqrt(dist2);
+  const float dx = wx / dist, dy = wy / dist, dz = wz / dist;
+  const bool good = (density > 0.f) & (density < kInfinity) & (dist > 0.f) &
+                    !(((nx * dx + ny * dy) + nz * dz) >= 0.f);
+  ok[i] = when(mine, int32_t(good), ok[i]);
+  wi_x[i] = when(mine, dx, wi_x[i]);
+  wi_y[i] = when(mine, dy, wi_y[i]);
+  wi_z[i] = when(mine, dz, wi_z[i]);
+  distance[i] = when(mine, dist, distance[i]);
+  pdf[i] = when(mine, density, pdf[i]);
+  p_x[i] = when(mine, px, p_x[i]);
+  p_y[i] = when(mine, py, p_y[i]);
+  p_z[i] = when(mine, pz, p_z[i]);
+  e_x[i] = when(mine, ex, e_x[i]);
+  e_y[i] = when(mine, ey, e_y[i]);
+  e_z[i] = when(mine, ez, e_z[i]);
+  n_x[i] = when(mine, nx, n_x[i]);
+  n_y[i] = when(mine, ny, n_y[i]);
+  n_z[i] = when(mine, nz, n_z[i]);
+  value_x[i] = when(mine, rad_x, value_x[i]);
+  value_y[i] = when(mine, rad_y, value_y[i]);
+  value_z[i] = when(mine, rad_z, value_z[i]);
+}
+
+// The quad lanes with their quads' constants in arrays (LightRows).
+PENUMBRA_SIMD_CLONES
+void quad_kernel(size_t n, const int32_t* __restrict kind, const float* __restrict o_x, const float* __restrict o_y, const float* __restrict o_z,
+                 const float* __restrict u_x, const float* __restrict u_y, const float* __restrict u_z, const float* __restrict v_x, const float* __restrict v_y, const float* __restrict v_z, const float* __restrict nrm_x, const float* __restrict nrm_y,
+                 const float* __restrict nrm_z, const float* __restrict area, const float* __restrict rad_x, const float* __restrict rad_y, const float* __restrict rad_z, const float* __restrict ref_x, const float* __restrict ref_y,
+                 const float* __restrict ref_z, const float* __restrict s_x, const float* __restrict s_y, int32_t* __restrict ok, float* __restrict wi_x, float* __restrict wi_y, float* __restrict wi_z, float* __restrict distance, float* __restrict pdf, float* __restrict p_x, float* __restrict p_y, float* __restrict p_z, float* __restrict e_x, float* __restrict e_y, float* __restrict e_z, float* __restrict n_x, float* __restrict n_y, float* __restrict n_z, float* __restrict value_x, float* __restrict value_y, float* __restrict value_z) {
+  for (size_t i = 0; i < n; ++i)
+    quad_lane(i, mask(kind[i] == StagedLights::kQuad), o_x[i], o_y[i], o_z[i], u_x[i], u_y[i],
+              u_z[i], v_x[i], v_y[i], v_z[i], nrm_x[i], nrm_y[i], nrm_z[i], area[i], rad_x[i],
+              rad_y[i], rad_z[i], ref_x, ref_y, ref_z, s_x, s_y, ok, wi_x, wi_y, wi_z, distance,
+              pdf, p_x, p_y, p_z, e_x, e_y, e_z, n_x, n_y, n_z, value_x, value_y, value_z);
+}
+
+// The lanes of one quad (its slot `row`), its constants as values.
+PENUMBRA_SIMD_CLONES
+void quad_kernel_one(size_t n, const int32_t* __restrict kind, const int32_t* __restrict slot,
+                     int32_t row, const float* c, const float* __restrict ref_x, const float* __restrict ref_y, const float* __restrict ref_z, const float* __restrict s_x,
+                     const float* __restrict s_y, int32_t* __restrict ok, float* __restrict wi_x, float* __restrict wi_y, float* __restrict wi_z, float* __restrict distance, float* __restrict pdf, float* __restrict p_x, float* __restrict p_y, float* __restrict p_z, float* __restrict e_x, float* __restrict e_y, float* __restrict e_z, float* __restrict n_x, float* __restrict n_y, float* __restrict n_z, float* __restrict value_x, float* __restrict value_y, float* __restrict value_z) {
+  const float ox = c[0], oy = c[1], oz = c[2], ux = c[3], uy = c[4], uz = c[5], vx = c[6];
+  const float vy = c[7], vz = c[8], nx = c[9], ny = c[10], nz = c[11], area = c[12];
+  const float rx = c[13], ry = c[14], rz = c[15];
+  for (size_t i = 0; i < n; ++i)
+    quad_lane(i, mask(kind[i] == StagedLights::kQuad) & mask(slot[i] == row), ox, oy, oz, ux, uy,
+              uz, vx, vy, vz, nx, ny, nz, area, rx, ry, rz, ref_x, ref_y, ref_z, s_x, s_y, ok,
+              wi_x, wi_y, wi_z, distance, pdf, p_x, p_y, p_z, e_x, e_y, e_z, n_x, n_y, n_z,
+              value_x, value_y, value_z);
 }
 
 // sample_sphere (through the arithmetic it shares, shapes/sphere_sample.h) followed by
-// AreaLight::sample for the entries of kind kSphere, over arrays; other entries keep what they
+// AreaLight::sample for lane i, whose light is this sphere if `mine`; other lanes keep what they
 // hold.
-PENUMBRA_SIMD_CLONES
-void sphere_light_samples(size_t n, const int32_t* __restrict kind, const float* __restrict c_x,
-                          const float* __restrict c_y, const float* __restrict c_z,
-                          const float* __restrict radius, const float* __restrict ref_x,
-                          const float* __restrict ref_y, const float* __restrict ref_z,
-                          const float* __restrict s_x, const float* __restrict s_y,
-                          int32_t* __restrict ok, float* __restrict wi_x, float* __restrict wi_y,
-                          float* __restrict wi_z, float* __restrict distance,
-                          float* __restrict pdf, float* __restrict p_x, float* __restrict p_y,
-                          float* __restrict p_z, float* __restrict e_x, float* __restrict e_y,
-                          float* __restrict e_z, float* __restrict n_x, float* __restrict n_y,
-                          float* __restrict n_z) {
-  for (size_t i = 0; i < n; ++i) {
-    const Mask mine = mask(kind[i] == StagedLights::kSphere);
-    float sp[3], sn[3], se[3], spdf;
-    sphere_solid_angle_sample(c_x[i], c_y[i], c_z[i], radius[i], ref_x[i], ref_y[i], ref_z[i],
-                              s_x[i], s_y[i], sp, sn, se, &spdf);
-    // AreaLight::sample: a finite positive density, a positive distance, the front side.
-    const float wx = sp[0] - ref_x[i], wy = sp[1] - ref_y[i], wz = sp[2] - ref_z[i];
-    const float dist = std::sqrt((wx * wx + wy * wy) + wz * wz);
-    const float dx = wx / dist, dy = wy / dist, dz = wz / dist;
-    const bool good = (spdf > 0.f) & (spdf < kInfinity) & (dist > 0.f) &
-                      !(((sn[0] * dx + sn[1] * dy) + sn[2] * dz) >= 0.f);
-    ok[i] = when(mine, int32_t(good), ok[i]);
-    wi_x[i] = when(mine, dx, wi_x[i]);
-    wi_y[i] = when(mine, dy, wi_y[i]);
-    wi_z[i] = when(mine, dz, wi_z[i]);
-    distance[i] = when(mine, dist, distance[i]);
-    pdf[i] = when(mine, spdf, pdf[i]);
-    p_x[i] = when(mine, sp[0], p_x[i]);
-    p_y[i] = when(mine, sp[1], p_y[i]);
-    p_z[i] = when(mine, sp[2], p_z[i]);
-    e_x[i] = when(mine, se[0], e_x[i]);
-    e_y[i] = when(mine, se[1], e_y[i]);
-    e_z[i] = when(mine, se[2], e_z[i]);
-    n_x[i] = when(mine, sn[0], n_x[i]);
-    n_y[i] = when(mine, sn[1], n_y[i]);
-    n_z[i] = when(mine, sn[2], n_z[i]);
-  }
+[[gnu::always_inline]] inline void sphere_lane(
+    size_t i, Mask mine, float cx, float cy, float cz, float radius, float rad_x, float rad_y,
+    float rad_z, const float* __restrict ref_x, const float* __restrict ref_y, const float* __restrict ref_z, const float* __restrict s_x, const float* __restrict s_y, int32_t* __restrict ok, float* __restrict wi_x, float* __restrict wi_y, float* __restrict wi_z, float* __restrict distance, float* __restrict pdf, float* __restrict p_x, float* __restrict p_y, float* __restrict p_z, float* __restrict e_x, float* __restrict e_y, float* __restrict e_z, float* __restrict n_x, float* __restrict n_y, float* __restrict n_z, float* __restrict value_x, float* __restrict value_y, float* __restrict value_z) {
+  float sp[3], sn[3], se[3], spdf;
+  sphere_solid_angle_sample(cx, cy, cz, radius, ref_x[i], ref_y[i], ref_z[i],
+                            s_x[i], s_y[i], sp, sn, se, &spdf);
+  // AreaLight::sample: a finite positive density, a positive distance, the front side.
+  const float wx = sp[0] - ref_x[i], wy = sp[1] - ref_y[i], wz = sp[2] - ref_z[i];
+  const float dist = std::sqrt((wx * wx + wy * wy) + wz * wz);
+  const float dx = wx / dist, dy = wy / dist, dz = wz / dist;
+  const bool good = (spdf > 0.f) & (spdf < kInfinity) & (dist > 0.f) &
+                    !(((sn[0] * dx + sn[1] * dy) + sn[2] * dz) >= 0.f);
+  ok[i] = when(mine, int32_t(good), ok[i]);
+  wi_x[i] = when(mine, dx, wi_x[i]);
+  wi_y[i] = when(mine, dy, wi_y[i]);
+  wi_z[i] = when(mine, dz, wi_z[i]);
+  distance[i] = when(mine, dist, distance[i]);
+  pdf[i] = when(mine, spdf, pdf[i]);
+  p_x[i] = when(mine, sp[0], p_x[i]);
+  p_y[i] = when(mine, sp[1], p_y[i]);
+  p_z[i] = when(mine, sp[2], p_z[i]);
+  e_x[i] = when(mine, se[0], e_x[i]);
+  e_y[i] = when(mine, se[1], e_y[i]);
+  e_z[i] = when(mine, se[2], e_z[i]);
+  n_x[i] = when(mine, sn[0], n_x[i]);
+  n_y[i] = when(mine, sn[1], n_y[i]);
+  n_z[i] = when(mine, sn[2], n_z[i]);
+  value_x[i] = when(mine, rad_x, value_x[i]);
+  value_y[i] = when(mine, rad_y, value_y[i]);
+  value_z[i] = when(mine, rad_z, value_z[i]);
 }
 
-// PointLight::sample for the entries of kind kPoint, over arrays (glm's dot and the
-// component-wise divisions as the scalar code does them).
+// The sphere lanes with their spheres' constants in arrays (LightRows).
 PENUMBRA_SIMD_CLONES
-void point_light_samples(size_t n, const int32_t* __restrict kind, const float* __restrict pos_x,
-                         const float* __restrict pos_y, const float* __restrict pos_z,
-                         const float* __restrict ref_x, const float* __restrict ref_y,
-                         const float* __restrict ref_z, int32_t* __restrict ok,
-                         float* __restrict wi_x, float* __restrict wi_y, float* __restrict wi_z,
-                         float* __restrict distance, float* __restrict pdf,
-                         float* __restrict p_x, float* __restrict p_y, float* __restrict p_z,
-                         float* __restrict value_x, float* __restrict value_y,
-                         float* __restrict value_z) {
-  for (size_t i = 0; i < n; ++i) {
-    const Mask mine = mask(kind[i] == StagedLights::kPoint);
-    const float sx = pos_x[i], sy = pos_y[i], sz = pos_z[i];
-    const float dx = sx - ref_x[i], dy = sy - ref_y[i], dz = sz - ref_z[i];
-    const float dist2 = (dx * dx + dy * dy) + dz * dz;
-    const float dist = std::sqrt(dist2);
-    ok[i] = when(mine, int32_t(dist2 > 0.f), ok[i]);
-    wi_x[i] = when(mine, dx / dist, wi_x[i]);
-    wi_y[i] = when(mine, dy / dist, wi_y[i]);
-    wi_z[i] = when(mine, dz / dist, wi_z[i]);
-    distance[i] = when(mine, dist, distance[i]);
-    pdf[i] = when(mine, 1.f, pdf[i]);
-    p_x[i] = when(mine, sx, p_x[i]);
-    p_y[i] = when(mine, sy, p_y[i]);
-    p_z[i] = when(mine, sz, p_z[i]);
-    value_x[i] = when(mine, value_x[i] / dist2, value_x[i]);
-    value_y[i] = when(mine, value_y[i] / dist2, value_y[i]);
-    value_z[i] = when(mine, value_z[i] / dist2, value_z[i]);
+void sphere_kernel(size_t n, const int32_t* __restrict kind, const float* __restrict c_x, const float* __restrict c_y, const float* __restrict c_z,
+                   const float* __restrict radius, const float* __restrict rad_x, const float* __restrict rad_y, const float* __restrict rad_z, const float* __restrict ref_x, const float* __restrict ref_y, const float* __restrict ref_z,
+                   const float* __restrict s_x, const float* __restrict s_y, int32_t* __restrict ok, float* __restrict wi_x, float* __restrict wi_y, float* __restrict wi_z, float* __restrict distance, float* __restrict pdf, float* __restrict p_x, float* __restrict p_y, float* __restrict p_z, float* __restrict e_x, float* __restrict e_y, float* __restrict e_z, float* __restrict n_x, float* __restrict n_y, float* __restrict n_z, float* __restrict value_x, float* __restrict value_y, float* __restrict value_z) {
+  for (size_t i = 0; i < n; ++i)
+    sphere_lane(i, mask(kind[i] == StagedLights::kSphere), c_x[i], c_y[i], c_z[i], radius[i],
+                rad_x[i], rad_y[i], rad_z[i], ref_x, ref_y, ref_z, s_x, s_y, ok, wi_x, wi_y, wi_z,
+                distance, pdf, p_x, p_y, p_z, e_x, e_y, e_z, n_x, n_y, n_z, value_x, value_y,
+                value_z);
+}
+
+// The lanes of one sphere (its slot `row`), its constants as values.
+PENUMBRA_SIMD_CLONES
+void sphere_kernel_one(size_t n, const int32_t* __restrict kind, const int32_t* __restrict slot,
+                       int32_t row, const float* c, const float* __restrict ref_x, const float* __restrict ref_y, const float* __restrict ref_z, const float* __restrict s_x,
+                       const float* __restrict s_y, int32_t* __restrict ok, float* __restrict wi_x, float* __restrict wi_y, float* __restrict wi_z, float* __restrict distance, float* __restrict pdf, float* __restrict p_x, float* __restrict p_y, float* __restrict p_z, float* __restrict e_x, float* __restrict e_y, float* __restrict e_z, float* __restrict n_x, float* __restrict n_y, float* __restrict n_z, float* __restrict value_x, float* __restrict value_y, float* __restrict value_z) {
+  const float cx = c[0], cy = c[1], cz = c[2], radius = c[3], rx = c[4], ry = c[5], rz = c[6];
+  for (size_t i = 0; i < n; ++i)
+    sphere_lane(i, mask(kind[i] == StagedLights::kSphere) & mask(slot[i] == row), cx, cy, cz,
+                radius, rx, ry, rz, ref_x, ref_y, ref_z, s_x, s_y, ok, wi_x, wi_y, wi_z, distance,
+                pdf, p_x, p_y, p_z, e_x, e_y, e_z, n_x, n_y, n_z, value_x, value_y, value_z);
+}
+
+// PointLight::sample for lane i, whose light is this one if `mine`; other lanes keep what they
+// hold (glm's dot and the component-wise divisions as the scalar code does them).
+[[gnu::always_inline]] inline void point_lane(size_t i, Mask mine, float sx, float sy, float sz,
+                                              float int_x, float int_y, float int_z, const float* __restrict ref_x,
+                                              const float* __restrict ref_y, const float* __restrict ref_z, int32_t* __restrict ok, float* __restrict wi_x, float* __restrict wi_y, float* __restrict wi_z, float* __restrict distance, float* __restrict pdf, float* __restrict p_x, float* __restrict p_y, float* __restrict p_z, float* __restrict e_x, float* __restrict e_y, float* __restrict e_z, float* __restrict n_x, float* __restrict n_y, float* __restrict n_z, float* __restrict value_x, float* __restrict value_y, float* __restrict value_z) {
+  const float dx = sx - ref_x[i], dy = sy - ref_y[i], dz = sz - ref_z[i];
+  const float dist2 = (dx * dx + dy * dy) + dz * dz;
+  const float dist = std::sqrt(dist2);
+  ok[i] = when(mine, int32_t(dist2 > 0.f), ok[i]);
+  wi_x[i] = when(mine, dx / dist, wi_x[i]);
+  wi_y[i] = when(mine, dy / dist, wi_y[i]);
+  wi_z[i] = when(mine, dz / dist, wi_z[i]);
+  distance[i] = when(mine, dist, distance[i]);
+  pdf[i] = when(mine, 1.f, pdf[i]);
+  p_x[i] = when(mine, sx, p_x[i]);
+  p_y[i] = when(mine, sy, p_y[i]);
+  p_z[i] = when(mine, sz, p_z[i]);
+  e_x[i] = when(mine, 0.f, e_x[i]);
+  e_y[i] = when(mine, 0.f, e_y[i]);
+  e_z[i] = when(mine, 0.f, e_z[i]);
+  n_x[i] = when(mine, 0.f, n_x[i]);
+  n_y[i] = when(mine, 0.f, n_y[i]);
+  n_z[i] = when(mine, 0.f, n_z[i]);
+  value_x[i] = when(mine, int_x / dist2, value_x[i]);
+  value_y[i] = when(mine, int_y / dist2, value_y[i]);
+  value_z[i] = when(mine, int_z / dist2, value_z[i]);
+}
+
+// The point-light lanes with their lights' constants in arrays (LightRows).
+PENUMBRA_SIMD_CLONES
+void point_kernel(size_t n, const int32_t* __restrict kind, const float* __restrict pos_x, const float* __restrict pos_y, const float* __restrict pos_z,
+                  const float* __restrict int_x, const float* __restrict int_y, const float* __restrict int_z, const float* __restrict ref_x, const float* __restrict ref_y, const float* __restrict ref_z, int32_t* __restrict ok, float* __restrict wi_x, float* __restrict wi_y, float* __restrict wi_z, float* __restrict distance, float* __restrict pdf, float* __restrict p_x, float* __restrict p_y, float* __restrict p_z, float* __restrict e_x, float* __restrict e_y, float* __restrict e_z, float* __restrict n_x, float* __restrict n_y, float* __restrict n_z, float* __restrict value_x, float* __restrict value_y, float* __restrict value_z) {
+  for (size_t i = 0; i < n; ++i)
+    point_lane(i, mask(kind[i] == StagedLights::kPoint), pos_x[i], pos_y[i], pos_z[i], int_x[i],
+               int_y[i], int_z[i], ref_x, ref_y, ref_z, ok, wi_x, wi_y, wi_z, distance, pdf, p_x,
+               p_y, p_z, e_x, e_y, e_z, n_x, n_y, n_z, value_x, value_y, value_z);
+}
+
+// The lanes of one point light (its slot `row`), its constants as values.
+PENUMBRA_SIMD_CLONES
+void point_kernel_one(size_t n, const int32_t* __restrict kind, const int32_t* __restrict slot,
+                      int32_t row, const float* c, const float* __restrict ref_x, const float* __restrict ref_y, const float* __restrict ref_z, int32_t* __restrict ok, float* __restrict wi_x, float* __restrict wi_y, float* __restrict wi_z, float* __restrict distance, float* __restrict pdf, float* __restrict p_x, float* __restrict p_y, float* __restrict p_z, float* __restrict e_x, float* __restrict e_y, float* __restrict e_z, float* __restrict n_x, float* __restrict n_y, float* __restrict n_z, float* __restrict value_x, float* __restrict value_y, float* __restrict value_z) {
+  const float sx = c[0], sy = c[1], sz = c[2], ix = c[3], iy = c[4], iz = c[5];
+  for (size_t i = 0; i < n; ++i)
+    point_lane(i, mask(kind[i] == StagedLights::kPoint) & mask(slot[i] == row), sx, sy, sz, ix,
+               iy, iz, ref_x, ref_y, ref_z, ok, wi_x, wi_y, wi_z, distance, pdf, p_x, p_y, p_z,
+               e_x, e_y, e_z, n_x, n_y, n_z, value_x, value_y, value_z);
+}
+
+}  // namespace
+
+void quad_light_samples(size_t n, const int32_t* kind, const int32_t* slot, LightRows& q,
+                        const float* ref_x, const float* ref_y, const float* ref_z,
+                        const float* s_x, const float* s_y, int32_t* ok, float* wi_x,
+                        float* wi_y, float* wi_z, float* distance, float* pdf, float* p_x,
+                        float* p_y, float* p_z, float* e_x, float* e_y, float* e_z, float* n_x,
+                        float* n_y, float* n_z, float* value_x, float* value_y, float* value_z) {
+  if (q.rows() <= LightRows::kFewRows) {
+    for (size_t r = 0; r < q.rows(); ++r)
+      quad_kernel_one(n, kind, slot, int32_t(r), q.row(r), ref_x, ref_y, ref_z, s_x, s_y,
+                      ok, wi_x, wi_y, wi_z, distance, pdf, p_x, p_y, p_z, e_x, e_y, e_z, n_x, n_y, n_z, value_x, value_y, value_z);
+    return;
   }
+  q.fetch(n, kind, slot);
+  quad_kernel(n, kind, q[0], q[1], q[2], q[3], q[4], q[5], q[6], q[7], q[8], q[9], q[10], q[11],
+              q[12], q[13], q[14], q[15], ref_x, ref_y, ref_z, s_x, s_y, ok, wi_x, wi_y, wi_z, distance, pdf, p_x, p_y, p_z, e_x, e_y, e_z, n_x, n_y, n_z, value_x, value_y, value_z);
+}
+
+void sphere_light_samples(size_t n, const int32_t* kind, const int32_t* slot, LightRows& b,
+                          const float* ref_x, const float* ref_y, const float* ref_z,
+                          const float* s_x, const float* s_y, int32_t* ok, float* wi_x,
+                          float* wi_y, float* wi_z, float* distance, float* pdf, float* p_x,
+                          float* p_y, float* p_z, float* e_x, float* e_y, float* e_z, float* n_x,
+                          float* n_y, float* n_z, float* value_x, float* value_y,
+                          float* value_z) {
+  if (b.rows() <= LightRows::kFewRows) {
+    for (size_t r = 0; r < b.rows(); ++r)
+      sphere_kernel_one(n, kind, slot, int32_t(r), b.row(r), ref_x, ref_y, ref_z, s_x, s_y,
+                        ok, wi_x, wi_y, wi_z, distance, pdf, p_x, p_y, p_z, e_x, e_y, e_z, n_x, n_y, n_z, value_x, value_y, value_z);
+    return;
+  }
+  b.fetch(n, kind, slot);
+  sphere_kernel(n, kind, b[0], b[1], b[2], b[3], b[4], b[5], b[6], ref_x, ref_y, ref_z, s_x, s_y,
+                ok, wi_x, wi_y, wi_z, distance, pdf, p_x, p_y, p_z, e_x, e_y, e_z, n_x, n_y, n_z, value_x, value_y, value_z);
+}
+
+void point_light_samples(size_t n, const int32_t* kind, const int32_t* slot, LightRows& l,
+                         const float* ref_x, const float* ref_y, const float* ref_z, int32_t* ok,
+                         float* wi_x, float* wi_y, float* wi_z, float* distance, float* pdf,
+                         float* p_x, float* p_y, float* p_z, float* e_x, float* e_y, float* e_z,
+                         float* n_x, float* n_y, float* n_z, float* value_x, float* value_y,
+                         float* value_z) {
+  if (l.rows() <= LightRows::kFewRows) {
+    for (size_t r = 0; r < l.rows(); ++r)
+      point_kernel_one(n, kind, slot, int32_t(r), l.row(r), ref_x, ref_y, ref_z, ok, wi_x, wi_y, wi_z, distance, pdf, p_x, p_y, p_z, e_x, e_y, e_z, n_x, n_y, n_z, value_x, value_y, value_z);
+    return;
+  }
+  l.fetch(n, kind, slot);
+  point_kernel(n, kind, l[0], l[1], l[2], l[3], l[4], l[5], ref_x, ref_y, ref_z, ok, wi_x, wi_y, wi_z, distance, pdf, p_x, p_y, p_z, e_x, e_y, e_z, n_x, n_y, n_z, value_x, value_y, value_z);
 }
 
 // LightSampler::choose for every entry: the first light whose cumulative probability exceeds
@@ -295,8 +383,7 @@ StagedLights::StagedLights(const Scene& scene) {
   }
   for (const PointSource& p : points) {
     const float row[kPointRow] = {p.position[0], p.position[1], p.position[2],
-                                  p.intensity[0], p.intensity[1], p.intensity[2],
-                                  0.f, 0.f, 0.f, 0.f, 0.f, 0.f};
+                                  p.intensity[0], p.intensity[1], p.intensity[2]};
     point_table.insert(point_table.end(), row, row + kPointRow);
   }
 }

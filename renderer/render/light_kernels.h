@@ -60,9 +60,9 @@ struct StagedLights {
   std::vector<SphereLight> spheres;
   // The lights' constants as rows of floats, one row per light of quads, spheres and points
   // (quad: origin, u, v, n, area, radiance; sphere: centre, radius, radiance; point: position,
-  // intensity, then six zeros: its sample's error bound and normal), kQuadRow, kSphereRow or
-  // kPointRow floats each, which fetch_light_rows copies into each lane's arrays.
-  static constexpr int32_t kQuadRow = 16, kSphereRow = 7, kPointRow = 12;
+  // intensity), kQuadRow, kSphereRow or kPointRow floats each, which LightRows copies into the
+  // arrays of the lanes that chose them.
+  static constexpr int32_t kQuadRow = 16, kSphereRow = 7, kPointRow = 6;
   std::vector<float> quad_table, sphere_table, point_table;
   // Per light: its kind and its index in quads, points, distant or spheres.
   std::vector<int32_t> kind, index;
@@ -72,47 +72,65 @@ struct StagedLights {
 void choose_lights(const float* cdf, int32_t lights, size_t n, const float* u, int32_t* light);
 
 // The kernels below take, per entry i < n, the kind of its light (kind[i], -1 for no light) and
-// its light's constants in arrays (fetch_light_rows); the entries of their kind get the sample
-// from ref at (u_x, u_y), the others keep what they hold (their constants' arrays hold whatever
-// the arrays held: the kernels compute on them in every lane and discard the results). ok =
-// whether the light gave a sample; e = the sample point's error bound.
+// its index among that kind's lights (slot[i]); the entries of their kind get the sample from
+// ref at (s_x, s_y), the others keep what they hold (every lane computes a sample and discards
+// what is not its own). ok = whether the light gave a sample;
+// e = the sample point's error bound, n = its normal (0 for a point light), value = the
+// radiance arriving (a textured quad's texel is multiplied in afterwards).
 //
-// (The constants come in arrays rather than as a table and an index per lane: GCC's generic
-// tuning does not vectorise loads by a per-lane index, gathers being slow on many x86 cores; and
-// every array is a parameter of its own, since GCC trusts __restrict only on parameters and
-// without it the kernels, with their dozen outputs, stay scalar.)
+// (With many lights the constants come in arrays rather than as a table and an index per lane:
+// GCC's generic tuning does not vectorise loads by a per-lane index, gathers being slow on many
+// x86 cores; and every array is a parameter of its own, since GCC trusts __restrict only on
+// parameters and without it the kernels, with their dozen outputs, stay scalar.)
 
-// For the entries of kind `of_kind`: row slot[i] of `table` (`rows` rows of `width` floats),
-// float f into fields[f][i]. Other entries are left as they are.
-void fetch_light_rows(const float* table, size_t rows, int32_t width, int32_t of_kind, size_t n,
-                      const int32_t* kind, const int32_t* slot, float* const* fields);
+// A kind's lights' constants for the kernels. With a few lights (kFewRows or fewer; most scenes
+// have one of a kind) the kernel runs once per light, its constants as values, over the lanes
+// that chose it; with more, fetch() copies each lane's light's row into one array per float and
+// the kernel runs once over all of the kind's lanes.
+class LightRows {
+ public:
+  static constexpr size_t kFewRows = 4;
+  LightRows(const std::vector<float>& table, int32_t width, int32_t kind)
+      : table_(table), width_(width), kind_(kind), fields_(size_t(width)) {}
+  size_t rows() const { return table_.size() / size_t(width_); }
+  const float* row(size_t r) const { return table_.data() + r * size_t(width_); }
+  // Row slot[i] into fields[f][i] for the first n lanes whose kind is this one's (kind and
+  // slot per lane, as StagedLights::kind and index of the lane's light); other lanes keep what
+  // they hold.
+  void fetch(size_t n, const int32_t* kind, const int32_t* slot);
+  const float* operator[](size_t f) const { return fields_[f].data(); }
 
-// Quad::sample then AreaLight::sample, from each lane's quad (origin o, edges u and v, unit
-// normal nrm, area).
-void quad_light_samples(size_t n, const int32_t* kind, const float* o_x, const float* o_y,
-                        const float* o_z, const float* u_x, const float* u_y, const float* u_z,
-                        const float* v_x, const float* v_y, const float* v_z,
-                        const float* nrm_x, const float* nrm_y, const float* nrm_z,
-                        const float* area, const float* ref_x, const float* ref_y,
-                        const float* ref_z, const float* s_x, const float* s_y, int32_t* ok,
-                        float* wi_x, float* wi_y, float* wi_z, float* distance, float* pdf,
-                        float* p_x, float* p_y, float* p_z, float* e_x, float* e_y, float* e_z);
+ private:
+  const std::vector<float>& table_;
+  int32_t width_, kind_;
+  std::vector<std::vector<float>> fields_;
+};
 
-// Sphere::sample (sample_sphere) then AreaLight::sample, from each lane's sphere (centre c,
-// radius); n = the sampled point's normal.
-void sphere_light_samples(size_t n, const int32_t* kind, const float* c_x, const float* c_y,
-                          const float* c_z, const float* radius, const float* ref_x,
-                          const float* ref_y, const float* ref_z, const float* s_x,
-                          const float* s_y, int32_t* ok, float* wi_x, float* wi_y, float* wi_z,
-                          float* distance, float* pdf, float* p_x, float* p_y, float* p_z,
-                          float* e_x, float* e_y, float* e_z, float* n_x, float* n_y, float* n_z);
+// Quad::sample then AreaLight::sample: the quads' rows are origin, u, v, normal, area,
+// radiance.
+void quad_light_samples(size_t n, const int32_t* kind, const int32_t* slot, LightRows& quads,
+                        const float* ref_x, const float* ref_y, const float* ref_z,
+                        const float* s_x, const float* s_y, int32_t* ok, float* wi_x,
+                        float* wi_y, float* wi_z, float* distance, float* pdf, float* p_x,
+                        float* p_y, float* p_z, float* e_x, float* e_y, float* e_z, float* n_x,
+                        float* n_y, float* n_z, float* value_x, float* value_y, float* value_z);
 
-// PointLight::sample (pdf 1, a delta light) from each lane's light position; value holds the
-// light's intensity on entry and the sample's irradiance-like value I / d^2 on return.
-void point_light_samples(size_t n, const int32_t* kind, const float* pos_x, const float* pos_y,
-                         const float* pos_z, const float* ref_x, const float* ref_y,
-                         const float* ref_z, int32_t* ok, float* wi_x, float* wi_y, float* wi_z,
-                         float* distance, float* pdf, float* p_x, float* p_y, float* p_z,
-                         float* value_x, float* value_y, float* value_z);
+// Sphere::sample (sample_sphere) then AreaLight::sample: the spheres' rows are centre, radius,
+// radiance.
+void sphere_light_samples(size_t n, const int32_t* kind, const int32_t* slot, LightRows& spheres,
+                          const float* ref_x, const float* ref_y, const float* ref_z,
+                          const float* s_x, const float* s_y, int32_t* ok, float* wi_x,
+                          float* wi_y, float* wi_z, float* distance, float* pdf, float* p_x,
+                          float* p_y, float* p_z, float* e_x, float* e_y, float* e_z, float* n_x,
+                          float* n_y, float* n_z, float* value_x, float* value_y,
+                          float* value_z);
+
+// PointLight::sample (pdf 1, a delta light): the lights' rows are position, intensity.
+void point_light_samples(size_t n, const int32_t* kind, const int32_t* slot, LightRows& points,
+                         const float* ref_x, const float* ref_y, const float* ref_z, int32_t* ok,
+                         float* wi_x, float* wi_y, float* wi_z, float* distance, float* pdf,
+                         float* p_x, float* p_y, float* p_z, float* e_x, float* e_y, float* e_z,
+                         float* n_x, float* n_y, float* n_z, float* value_x, float* value_y,
+                         float* value_z);
 
 }  // namespace penumbra

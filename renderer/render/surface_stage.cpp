@@ -457,7 +457,12 @@ bool SurfaceStage::fill_params(const SurfaceBsdf& b, SurfaceParams* q) const {
 }
 
 SurfaceStage::SurfaceStage(const Scene& scene, StageModel model)
-    : scene_(scene), model_(model), lights_(scene) {
+    : scene_(scene),
+      model_(model),
+      lights_(scene),
+      quad_rows_(lights_.quad_table, StagedLights::kQuadRow, StagedLights::kQuad),
+      sphere_rows_(lights_.sphere_table, StagedLights::kSphereRow, StagedLights::kSphere),
+      point_rows_(lights_.point_table, StagedLights::kPointRow, StagedLights::kPoint) {
   params_of_.assign(scene.object_count(), -1);
   textured_of_.assign(scene.object_count(), 0);
   texture_lookups_of_.assign(scene.object_count(), -1);
@@ -834,52 +839,33 @@ void SurfaceStage::compute(const IntegratorSettings& settings, bool scene_next_e
       lane_slot_[i] = light < 0 ? 0 : lights_.index[size_t(light)];
     }
     float* const ref[3] = {p_[0].data(), p_[1].data(), p_[2].data()};
-    // Each kind's constants into the lanes' arrays (fetch_light_rows): what only the kernel
-    // reads into scratch arrays, what the step reads (a quad's normal and radiance, a sphere's
-    // radiance, a point light's intensity and zero error and normal) straight into its arrays.
-    float* q[13];
-    for (size_t f = 0; f < std::size(q); ++f) {
-      light_rows_[f].resize(n);
-      q[f] = light_rows_[f].data();
-    }
+    // Each kind's kernel: a pass per light, or with many lights one pass over the lanes with
+    // each lane's light's constants fetched into arrays (LightRows).
     const int32_t* kinds = lane_kind_.data();
     const int32_t* slots = lane_slot_.data();
-    if (!lights_.quads.empty()) {
-      float* const fields[StagedLights::kQuadRow] = {
-          q[0], q[1], q[2], q[3], q[4], q[5], q[6], q[7], q[8], l_n_[0].data(), l_n_[1].data(),
-          l_n_[2].data(), q[9], l_value_[0].data(), l_value_[1].data(), l_value_[2].data()};
-      fetch_light_rows(lights_.quad_table.data(), lights_.quads.size(), StagedLights::kQuadRow,
-                       StagedLights::kQuad, n, kinds, slots, fields);
-      quad_light_samples(n, kinds, q[0], q[1], q[2], q[3], q[4], q[5], q[6], q[7], q[8],
-                         l_n_[0].data(), l_n_[1].data(), l_n_[2].data(), q[9], ref[0], ref[1],
-                         ref[2], u_point_[0].data(), u_point_[1].data(), light_ok_.data(),
-                         l_wi_[0].data(), l_wi_[1].data(), l_wi_[2].data(), l_distance_.data(),
-                         l_pdf_.data(), l_p_[0].data(), l_p_[1].data(), l_p_[2].data(),
-                         l_error_[0].data(), l_error_[1].data(), l_error_[2].data());
+    if (quad_rows_.rows() > 0) {
+      quad_light_samples(n, kinds, slots, quad_rows_, ref[0], ref[1], ref[2], u_point_[0].data(),
+                         u_point_[1].data(), light_ok_.data(), l_wi_[0].data(), l_wi_[1].data(),
+                         l_wi_[2].data(), l_distance_.data(), l_pdf_.data(), l_p_[0].data(),
+                         l_p_[1].data(), l_p_[2].data(), l_error_[0].data(), l_error_[1].data(),
+                         l_error_[2].data(), l_n_[0].data(), l_n_[1].data(), l_n_[2].data(),
+                         l_value_[0].data(), l_value_[1].data(), l_value_[2].data());
     }
-    if (!lights_.spheres.empty()) {
-      float* const fields[StagedLights::kSphereRow] = {
-          q[0], q[1], q[2], q[3], l_value_[0].data(), l_value_[1].data(), l_value_[2].data()};
-      fetch_light_rows(lights_.sphere_table.data(), lights_.spheres.size(),
-                       StagedLights::kSphereRow, StagedLights::kSphere, n, kinds, slots, fields);
-      sphere_light_samples(n, kinds, q[0], q[1], q[2], q[3], ref[0], ref[1], ref[2],
-                           u_point_[0].data(), u_point_[1].data(), light_ok_.data(),
-                           l_wi_[0].data(), l_wi_[1].data(), l_wi_[2].data(), l_distance_.data(),
-                           l_pdf_.data(), l_p_[0].data(), l_p_[1].data(), l_p_[2].data(),
-                           l_error_[0].data(), l_error_[1].data(), l_error_[2].data(),
-                           l_n_[0].data(), l_n_[1].data(), l_n_[2].data());
+    if (sphere_rows_.rows() > 0) {
+      sphere_light_samples(n, kinds, slots, sphere_rows_, ref[0], ref[1], ref[2], u_point_[0].data(),
+                           u_point_[1].data(), light_ok_.data(), l_wi_[0].data(), l_wi_[1].data(),
+                           l_wi_[2].data(), l_distance_.data(), l_pdf_.data(), l_p_[0].data(),
+                           l_p_[1].data(), l_p_[2].data(), l_error_[0].data(), l_error_[1].data(),
+                           l_error_[2].data(), l_n_[0].data(), l_n_[1].data(), l_n_[2].data(),
+                           l_value_[0].data(), l_value_[1].data(), l_value_[2].data());
     }
-    if (!lights_.points.empty()) {
-      float* const fields[StagedLights::kPointRow] = {
-          q[0], q[1], q[2], l_value_[0].data(), l_value_[1].data(), l_value_[2].data(),
-          l_error_[0].data(), l_error_[1].data(), l_error_[2].data(), l_n_[0].data(),
-          l_n_[1].data(), l_n_[2].data()};
-      fetch_light_rows(lights_.point_table.data(), lights_.points.size(), StagedLights::kPointRow,
-                       StagedLights::kPoint, n, kinds, slots, fields);
-      point_light_samples(n, kinds, q[0], q[1], q[2], ref[0], ref[1], ref[2], light_ok_.data(),
+    if (point_rows_.rows() > 0) {
+      point_light_samples(n, kinds, slots, point_rows_, ref[0], ref[1], ref[2], light_ok_.data(),
                           l_wi_[0].data(), l_wi_[1].data(), l_wi_[2].data(), l_distance_.data(),
                           l_pdf_.data(), l_p_[0].data(), l_p_[1].data(), l_p_[2].data(),
-                          l_value_[0].data(), l_value_[1].data(), l_value_[2].data());
+                          l_error_[0].data(), l_error_[1].data(), l_error_[2].data(),
+                          l_n_[0].data(), l_n_[1].data(), l_n_[2].data(), l_value_[0].data(),
+                          l_value_[1].data(), l_value_[2].data());
     }
     // What the kernels leave: the choice's probability, the delta flags, a directional light's
     // whole sample (the same everywhere). Point and directional lights are deltas: no MIS

@@ -46,6 +46,9 @@ inline constexpr StageModel kStageModels[] = {
 class SurfaceStage {
  public:
   SurfaceStage(const Scene& scene, StageModel model);
+  // (Not copied: its LightRows refer to its own lights_.)
+  SurfaceStage(const SurfaceStage&) = delete;
+  SurfaceStage& operator=(const SurfaceStage&) = delete;
   const Scene& scene() const { return scene_; }
   StageModel model() const { return model_; }
 
@@ -123,6 +126,8 @@ class SurfaceStage {
   const Scene& scene_;
   StageModel model_;
   StagedLights lights_;
+  // Each kernel's per-lane constants (the lanes' lights' rows of lights_' tables).
+  LightRows quad_rows_, sphere_rows_, point_rows_;
   std::vector<int32_t> params_of_;  // per object: index into params_, or -1
   // Per object: whether its material is textured (parameters looked up at each hit).
   std::vector<uint8_t> textured_of_;
@@ -147,9 +152,6 @@ class SurfaceStage {
   std::vector<uint32_t> own_code_lanes_;  // lanes whose light is StagedLights::kOwnCode
   // Per lane: its light's StagedLights kind (-1: no light) and index among that kind's lights.
   std::vector<int32_t> lane_kind_, lane_slot_;
-  // Per lane: the constants of its light that only the light kernels read (a quad's origin,
-  // edges and area; a sphere's centre and radius; a point light's position; fetch_light_rows).
-  std::vector<float> light_rows_[13];
   // Lanes whose light is a textured quad, and one light's lanes and uvs: their radiance is
   // looked up for all of them at once (look_up_emission, into looked_up_).
   std::vector<uint32_t> emission_lanes_, emission_of_;
