@@ -254,6 +254,10 @@ def time_to_reach(rows: list[dict], target: float, key: str = "relmse") -> tuple
             return float(math.exp(math.log(s0) + f * math.log(s1 / s0))), True
     x = np.log([p[0] for p in pts])
     y = np.log([p[1] for p in pts])
+    if x.max() - x.min() < math.log(1.5):
+        # Points at nearly one time (adaptive renders that all stopped at the spp cap): no line
+        # through them says where the curve goes, and a fitted one extrapolates to nonsense.
+        return math.nan, False
     slope, intercept = np.polyfit(x, y, 1)
     if slope >= 0:
         return math.nan, False
