@@ -14,6 +14,14 @@
 #include "renderer/shapes/sphere_sample.h"
 
 namespace penumbra {
+namespace {
+
+// A kernel's array parameters (GCC trusts __restrict on parameters only: without it the
+// kernels' many outputs would each need a run-time overlap check, and the loops stay scalar).
+using In = const float* __restrict;
+using Out = float* __restrict;
+
+}  // namespace
 
 namespace {
 
@@ -55,7 +63,9 @@ namespace {
 [[gnu::always_inline]] inline void quad_lane(
     size_t i, Mask mine, float ox, float oy, float oz, float ux, float uy, float uz, float vx,
     float vy, float vz, float nx, float ny, float nz, float q_area, float rad_x, float rad_y,
-    float rad_z, const float* __restrict ref_x, const float* __restrict ref_y, const float* __restrict ref_z, const float* __restrict s_x, const float* __restrict s_y, int32_t* __restrict ok, float* __restrict wi_x, float* __restrict wi_y, float* __restrict wi_z, float* __restrict distance, float* __restrict pdf, float* __restrict p_x, float* __restrict p_y, float* __restrict p_z, float* __restrict e_x, float* __restrict e_y, float* __restrict e_z, float* __restrict n_x, float* __restrict n_y, float* __restrict n_z, float* __restrict value_x, float* __restrict value_y, float* __restrict value_z) {
+    float rad_z, In ref_x, In ref_y, In ref_z, In s_x, In s_y, int32_t* __restrict ok, Out wi_x,
+    Out wi_y, Out wi_z, Out distance, Out pdf, Out p_x, Out p_y, Out p_z, Out e_x, Out e_y, Out e_z,
+    Out n_x, Out n_y, Out n_z, Out value_x, Out value_y, Out value_z) {
   constexpr float g6 = gamma_bound(6);
   // Quad::sample: p = o + s u + t v and its error bound (pbrt-v4 section 6.8.1).
   const float sux = s_x[i] * ux, suy = s_x[i] * uy, suz = s_x[i] * uz;
@@ -99,10 +109,12 @@ namespace {
 
 // The quad lanes with their quads' constants in arrays (LightRows).
 PENUMBRA_SIMD_CLONES
-void quad_kernel(size_t n, const int32_t* __restrict kind, const float* __restrict o_x, const float* __restrict o_y, const float* __restrict o_z,
-                 const float* __restrict u_x, const float* __restrict u_y, const float* __restrict u_z, const float* __restrict v_x, const float* __restrict v_y, const float* __restrict v_z, const float* __restrict nrm_x, const float* __restrict nrm_y,
-                 const float* __restrict nrm_z, const float* __restrict area, const float* __restrict rad_x, const float* __restrict rad_y, const float* __restrict rad_z, const float* __restrict ref_x, const float* __restrict ref_y,
-                 const float* __restrict ref_z, const float* __restrict s_x, const float* __restrict s_y, int32_t* __restrict ok, float* __restrict wi_x, float* __restrict wi_y, float* __restrict wi_z, float* __restrict distance, float* __restrict pdf, float* __restrict p_x, float* __restrict p_y, float* __restrict p_z, float* __restrict e_x, float* __restrict e_y, float* __restrict e_z, float* __restrict n_x, float* __restrict n_y, float* __restrict n_z, float* __restrict value_x, float* __restrict value_y, float* __restrict value_z) {
+void quad_kernel(size_t n, const int32_t* __restrict kind, In o_x, In o_y, In o_z, In u_x, In u_y,
+                 In u_z, In v_x, In v_y, In v_z, In nrm_x, In nrm_y, In nrm_z, In area, In rad_x,
+                 In rad_y, In rad_z, In ref_x, In ref_y, In ref_z, In s_x, In s_y,
+                 int32_t* __restrict ok, Out wi_x, Out wi_y, Out wi_z, Out distance, Out pdf,
+                 Out p_x, Out p_y, Out p_z, Out e_x, Out e_y, Out e_z, Out n_x, Out n_y, Out n_z,
+                 Out value_x, Out value_y, Out value_z) {
   for (size_t i = 0; i < n; ++i)
     quad_lane(i, mask(kind[i] == StagedLights::kQuad), o_x[i], o_y[i], o_z[i], u_x[i], u_y[i],
               u_z[i], v_x[i], v_y[i], v_z[i], nrm_x[i], nrm_y[i], nrm_z[i], area[i], rad_x[i],
@@ -113,27 +125,33 @@ void quad_kernel(size_t n, const int32_t* __restrict kind, const float* __restri
 // The lanes of one quad (its slot `row`), its constants as values.
 PENUMBRA_SIMD_CLONES
 void quad_kernel_one(size_t n, const int32_t* __restrict kind, const int32_t* __restrict slot,
-                     int32_t row, const float* c, const float* __restrict ref_x, const float* __restrict ref_y, const float* __restrict ref_z, const float* __restrict s_x,
-                     const float* __restrict s_y, int32_t* __restrict ok, float* __restrict wi_x, float* __restrict wi_y, float* __restrict wi_z, float* __restrict distance, float* __restrict pdf, float* __restrict p_x, float* __restrict p_y, float* __restrict p_z, float* __restrict e_x, float* __restrict e_y, float* __restrict e_z, float* __restrict n_x, float* __restrict n_y, float* __restrict n_z, float* __restrict value_x, float* __restrict value_y, float* __restrict value_z) {
+                     int32_t row, const float* c, In ref_x, In ref_y, In ref_z, In s_x, In s_y,
+                     int32_t* __restrict ok, Out wi_x, Out wi_y, Out wi_z, Out distance, Out pdf,
+                     Out p_x, Out p_y, Out p_z, Out e_x, Out e_y, Out e_z, Out n_x, Out n_y,
+                     Out n_z, Out value_x, Out value_y, Out value_z) {
   const float ox = c[0], oy = c[1], oz = c[2], ux = c[3], uy = c[4], uz = c[5], vx = c[6];
   const float vy = c[7], vz = c[8], nx = c[9], ny = c[10], nz = c[11], area = c[12];
   const float rx = c[13], ry = c[14], rz = c[15];
   for (size_t i = 0; i < n; ++i)
     quad_lane(i, mask(kind[i] == StagedLights::kQuad) & mask(slot[i] == row), ox, oy, oz, ux, uy,
-              uz, vx, vy, vz, nx, ny, nz, area, rx, ry, rz, ref_x, ref_y, ref_z, s_x, s_y, ok,
-              wi_x, wi_y, wi_z, distance, pdf, p_x, p_y, p_z, e_x, e_y, e_z, n_x, n_y, n_z,
-              value_x, value_y, value_z);
+              uz, vx, vy, vz, nx, ny, nz, area, rx, ry, rz, ref_x, ref_y, ref_z, s_x, s_y, ok, wi_x,
+              wi_y, wi_z, distance, pdf, p_x, p_y, p_z, e_x, e_y, e_z, n_x, n_y, n_z, value_x,
+              value_y, value_z);
 }
 
 // sample_sphere (through the arithmetic it shares, shapes/sphere_sample.h) followed by
 // AreaLight::sample for lane i, whose light is this sphere if `mine`; other lanes keep what they
 // hold.
-[[gnu::always_inline]] inline void sphere_lane(
-    size_t i, Mask mine, float cx, float cy, float cz, float radius, float rad_x, float rad_y,
-    float rad_z, const float* __restrict ref_x, const float* __restrict ref_y, const float* __restrict ref_z, const float* __restrict s_x, const float* __restrict s_y, int32_t* __restrict ok, float* __restrict wi_x, float* __restrict wi_y, float* __restrict wi_z, float* __restrict distance, float* __restrict pdf, float* __restrict p_x, float* __restrict p_y, float* __restrict p_z, float* __restrict e_x, float* __restrict e_y, float* __restrict e_z, float* __restrict n_x, float* __restrict n_y, float* __restrict n_z, float* __restrict value_x, float* __restrict value_y, float* __restrict value_z) {
+[[gnu::always_inline]] inline void sphere_lane(size_t i, Mask mine, float cx, float cy, float cz,
+                                               float radius, float rad_x, float rad_y, float rad_z,
+                                               In ref_x, In ref_y, In ref_z, In s_x, In s_y,
+                                               int32_t* __restrict ok, Out wi_x, Out wi_y, Out wi_z,
+                                               Out distance, Out pdf, Out p_x, Out p_y, Out p_z,
+                                               Out e_x, Out e_y, Out e_z, Out n_x, Out n_y, Out n_z,
+                                               Out value_x, Out value_y, Out value_z) {
   float sp[3], sn[3], se[3], spdf;
-  sphere_solid_angle_sample(cx, cy, cz, radius, ref_x[i], ref_y[i], ref_z[i],
-                            s_x[i], s_y[i], sp, sn, se, &spdf);
+  sphere_solid_angle_sample(cx, cy, cz, radius, ref_x[i], ref_y[i], ref_z[i], s_x[i], s_y[i], sp,
+                            sn, se, &spdf);
   // AreaLight::sample: a finite positive density, a positive distance, the front side.
   const float wx = sp[0] - ref_x[i], wy = sp[1] - ref_y[i], wz = sp[2] - ref_z[i];
   const float dist = std::sqrt((wx * wx + wy * wy) + wz * wz);
@@ -162,9 +180,11 @@ void quad_kernel_one(size_t n, const int32_t* __restrict kind, const int32_t* __
 
 // The sphere lanes with their spheres' constants in arrays (LightRows).
 PENUMBRA_SIMD_CLONES
-void sphere_kernel(size_t n, const int32_t* __restrict kind, const float* __restrict c_x, const float* __restrict c_y, const float* __restrict c_z,
-                   const float* __restrict radius, const float* __restrict rad_x, const float* __restrict rad_y, const float* __restrict rad_z, const float* __restrict ref_x, const float* __restrict ref_y, const float* __restrict ref_z,
-                   const float* __restrict s_x, const float* __restrict s_y, int32_t* __restrict ok, float* __restrict wi_x, float* __restrict wi_y, float* __restrict wi_z, float* __restrict distance, float* __restrict pdf, float* __restrict p_x, float* __restrict p_y, float* __restrict p_z, float* __restrict e_x, float* __restrict e_y, float* __restrict e_z, float* __restrict n_x, float* __restrict n_y, float* __restrict n_z, float* __restrict value_x, float* __restrict value_y, float* __restrict value_z) {
+void sphere_kernel(size_t n, const int32_t* __restrict kind, In c_x, In c_y, In c_z, In radius,
+                   In rad_x, In rad_y, In rad_z, In ref_x, In ref_y, In ref_z, In s_x, In s_y,
+                   int32_t* __restrict ok, Out wi_x, Out wi_y, Out wi_z, Out distance, Out pdf,
+                   Out p_x, Out p_y, Out p_z, Out e_x, Out e_y, Out e_z, Out n_x, Out n_y, Out n_z,
+                   Out value_x, Out value_y, Out value_z) {
   for (size_t i = 0; i < n; ++i)
     sphere_lane(i, mask(kind[i] == StagedLights::kSphere), c_x[i], c_y[i], c_z[i], radius[i],
                 rad_x[i], rad_y[i], rad_z[i], ref_x, ref_y, ref_z, s_x, s_y, ok, wi_x, wi_y, wi_z,
@@ -175,8 +195,10 @@ void sphere_kernel(size_t n, const int32_t* __restrict kind, const float* __rest
 // The lanes of one sphere (its slot `row`), its constants as values.
 PENUMBRA_SIMD_CLONES
 void sphere_kernel_one(size_t n, const int32_t* __restrict kind, const int32_t* __restrict slot,
-                       int32_t row, const float* c, const float* __restrict ref_x, const float* __restrict ref_y, const float* __restrict ref_z, const float* __restrict s_x,
-                       const float* __restrict s_y, int32_t* __restrict ok, float* __restrict wi_x, float* __restrict wi_y, float* __restrict wi_z, float* __restrict distance, float* __restrict pdf, float* __restrict p_x, float* __restrict p_y, float* __restrict p_z, float* __restrict e_x, float* __restrict e_y, float* __restrict e_z, float* __restrict n_x, float* __restrict n_y, float* __restrict n_z, float* __restrict value_x, float* __restrict value_y, float* __restrict value_z) {
+                       int32_t row, const float* c, In ref_x, In ref_y, In ref_z, In s_x, In s_y,
+                       int32_t* __restrict ok, Out wi_x, Out wi_y, Out wi_z, Out distance, Out pdf,
+                       Out p_x, Out p_y, Out p_z, Out e_x, Out e_y, Out e_z, Out n_x, Out n_y,
+                       Out n_z, Out value_x, Out value_y, Out value_z) {
   const float cx = c[0], cy = c[1], cz = c[2], radius = c[3], rx = c[4], ry = c[5], rz = c[6];
   for (size_t i = 0; i < n; ++i)
     sphere_lane(i, mask(kind[i] == StagedLights::kSphere) & mask(slot[i] == row), cx, cy, cz,
@@ -187,8 +209,12 @@ void sphere_kernel_one(size_t n, const int32_t* __restrict kind, const int32_t* 
 // PointLight::sample for lane i, whose light is this one if `mine`; other lanes keep what they
 // hold (glm's dot and the component-wise divisions as the scalar code does them).
 [[gnu::always_inline]] inline void point_lane(size_t i, Mask mine, float sx, float sy, float sz,
-                                              float int_x, float int_y, float int_z, const float* __restrict ref_x,
-                                              const float* __restrict ref_y, const float* __restrict ref_z, int32_t* __restrict ok, float* __restrict wi_x, float* __restrict wi_y, float* __restrict wi_z, float* __restrict distance, float* __restrict pdf, float* __restrict p_x, float* __restrict p_y, float* __restrict p_z, float* __restrict e_x, float* __restrict e_y, float* __restrict e_z, float* __restrict n_x, float* __restrict n_y, float* __restrict n_z, float* __restrict value_x, float* __restrict value_y, float* __restrict value_z) {
+                                              float int_x, float int_y, float int_z, In ref_x,
+                                              In ref_y, In ref_z, int32_t* __restrict ok, Out wi_x,
+                                              Out wi_y, Out wi_z, Out distance, Out pdf, Out p_x,
+                                              Out p_y, Out p_z, Out e_x, Out e_y, Out e_z, Out n_x,
+                                              Out n_y, Out n_z, Out value_x, Out value_y,
+                                              Out value_z) {
   const float dx = sx - ref_x[i], dy = sy - ref_y[i], dz = sz - ref_z[i];
   const float dist2 = (dx * dx + dy * dy) + dz * dz;
   const float dist = std::sqrt(dist2);
@@ -214,8 +240,11 @@ void sphere_kernel_one(size_t n, const int32_t* __restrict kind, const int32_t* 
 
 // The point-light lanes with their lights' constants in arrays (LightRows).
 PENUMBRA_SIMD_CLONES
-void point_kernel(size_t n, const int32_t* __restrict kind, const float* __restrict pos_x, const float* __restrict pos_y, const float* __restrict pos_z,
-                  const float* __restrict int_x, const float* __restrict int_y, const float* __restrict int_z, const float* __restrict ref_x, const float* __restrict ref_y, const float* __restrict ref_z, int32_t* __restrict ok, float* __restrict wi_x, float* __restrict wi_y, float* __restrict wi_z, float* __restrict distance, float* __restrict pdf, float* __restrict p_x, float* __restrict p_y, float* __restrict p_z, float* __restrict e_x, float* __restrict e_y, float* __restrict e_z, float* __restrict n_x, float* __restrict n_y, float* __restrict n_z, float* __restrict value_x, float* __restrict value_y, float* __restrict value_z) {
+void point_kernel(size_t n, const int32_t* __restrict kind, In pos_x, In pos_y, In pos_z, In int_x,
+                  In int_y, In int_z, In ref_x, In ref_y, In ref_z, int32_t* __restrict ok,
+                  Out wi_x, Out wi_y, Out wi_z, Out distance, Out pdf, Out p_x, Out p_y, Out p_z,
+                  Out e_x, Out e_y, Out e_z, Out n_x, Out n_y, Out n_z, Out value_x, Out value_y,
+                  Out value_z) {
   for (size_t i = 0; i < n; ++i)
     point_lane(i, mask(kind[i] == StagedLights::kPoint), pos_x[i], pos_y[i], pos_z[i], int_x[i],
                int_y[i], int_z[i], ref_x, ref_y, ref_z, ok, wi_x, wi_y, wi_z, distance, pdf, p_x,
@@ -225,72 +254,76 @@ void point_kernel(size_t n, const int32_t* __restrict kind, const float* __restr
 // The lanes of one point light (its slot `row`), its constants as values.
 PENUMBRA_SIMD_CLONES
 void point_kernel_one(size_t n, const int32_t* __restrict kind, const int32_t* __restrict slot,
-                      int32_t row, const float* c, const float* __restrict ref_x, const float* __restrict ref_y, const float* __restrict ref_z, int32_t* __restrict ok, float* __restrict wi_x, float* __restrict wi_y, float* __restrict wi_z, float* __restrict distance, float* __restrict pdf, float* __restrict p_x, float* __restrict p_y, float* __restrict p_z, float* __restrict e_x, float* __restrict e_y, float* __restrict e_z, float* __restrict n_x, float* __restrict n_y, float* __restrict n_z, float* __restrict value_x, float* __restrict value_y, float* __restrict value_z) {
+                      int32_t row, const float* c, In ref_x, In ref_y, In ref_z,
+                      int32_t* __restrict ok, Out wi_x, Out wi_y, Out wi_z, Out distance, Out pdf,
+                      Out p_x, Out p_y, Out p_z, Out e_x, Out e_y, Out e_z, Out n_x, Out n_y,
+                      Out n_z, Out value_x, Out value_y, Out value_z) {
   const float sx = c[0], sy = c[1], sz = c[2], ix = c[3], iy = c[4], iz = c[5];
   for (size_t i = 0; i < n; ++i)
-    point_lane(i, mask(kind[i] == StagedLights::kPoint) & mask(slot[i] == row), sx, sy, sz, ix,
-               iy, iz, ref_x, ref_y, ref_z, ok, wi_x, wi_y, wi_z, distance, pdf, p_x, p_y, p_z,
-               e_x, e_y, e_z, n_x, n_y, n_z, value_x, value_y, value_z);
+    point_lane(i, mask(kind[i] == StagedLights::kPoint) & mask(slot[i] == row), sx, sy, sz, ix, iy,
+               iz, ref_x, ref_y, ref_z, ok, wi_x, wi_y, wi_z, distance, pdf, p_x, p_y, p_z, e_x,
+               e_y, e_z, n_x, n_y, n_z, value_x, value_y, value_z);
+}
+
+}  // namespace
+
+namespace {
+
+// kernel(in..., the sample's output arrays).
+template <class Kernel, class... In>
+void with_outputs(Kernel kernel, const LightSampleArrays& o, In... in) {
+  kernel(in..., o.ok, o.wi[0], o.wi[1], o.wi[2], o.distance, o.pdf, o.p[0], o.p[1], o.p[2], o.e[0],
+         o.e[1], o.e[2], o.n[0], o.n[1], o.n[2], o.value[0], o.value[1], o.value[2]);
 }
 
 }  // namespace
 
 void quad_light_samples(size_t n, const int32_t* kind, const int32_t* slot, LightRows& q,
-                        const float* ref_x, const float* ref_y, const float* ref_z,
-                        const float* s_x, const float* s_y, int32_t* ok, float* wi_x,
-                        float* wi_y, float* wi_z, float* distance, float* pdf, float* p_x,
-                        float* p_y, float* p_z, float* e_x, float* e_y, float* e_z, float* n_x,
-                        float* n_y, float* n_z, float* value_x, float* value_y, float* value_z) {
+                        const float* const* ref, const float* const* s,
+                        const LightSampleArrays& out) {
   if (q.rows() <= LightRows::kFewRows) {
     for (size_t r = 0; r < q.rows(); ++r)
-      quad_kernel_one(n, kind, slot, int32_t(r), q.row(r), ref_x, ref_y, ref_z, s_x, s_y,
-                      ok, wi_x, wi_y, wi_z, distance, pdf, p_x, p_y, p_z, e_x, e_y, e_z, n_x, n_y, n_z, value_x, value_y, value_z);
+      with_outputs(quad_kernel_one, out, n, kind, slot, int32_t(r), q.row(r), ref[0], ref[1],
+                   ref[2], s[0], s[1]);
     return;
   }
   q.fetch(n, kind, slot);
-  quad_kernel(n, kind, q[0], q[1], q[2], q[3], q[4], q[5], q[6], q[7], q[8], q[9], q[10], q[11],
-              q[12], q[13], q[14], q[15], ref_x, ref_y, ref_z, s_x, s_y, ok, wi_x, wi_y, wi_z, distance, pdf, p_x, p_y, p_z, e_x, e_y, e_z, n_x, n_y, n_z, value_x, value_y, value_z);
+  with_outputs(quad_kernel, out, n, kind, q[0], q[1], q[2], q[3], q[4], q[5], q[6], q[7], q[8],
+               q[9], q[10], q[11], q[12], q[13], q[14], q[15], ref[0], ref[1], ref[2], s[0], s[1]);
 }
 
 void sphere_light_samples(size_t n, const int32_t* kind, const int32_t* slot, LightRows& b,
-                          const float* ref_x, const float* ref_y, const float* ref_z,
-                          const float* s_x, const float* s_y, int32_t* ok, float* wi_x,
-                          float* wi_y, float* wi_z, float* distance, float* pdf, float* p_x,
-                          float* p_y, float* p_z, float* e_x, float* e_y, float* e_z, float* n_x,
-                          float* n_y, float* n_z, float* value_x, float* value_y,
-                          float* value_z) {
+                          const float* const* ref, const float* const* s,
+                          const LightSampleArrays& out) {
   if (b.rows() <= LightRows::kFewRows) {
     for (size_t r = 0; r < b.rows(); ++r)
-      sphere_kernel_one(n, kind, slot, int32_t(r), b.row(r), ref_x, ref_y, ref_z, s_x, s_y,
-                        ok, wi_x, wi_y, wi_z, distance, pdf, p_x, p_y, p_z, e_x, e_y, e_z, n_x, n_y, n_z, value_x, value_y, value_z);
+      with_outputs(sphere_kernel_one, out, n, kind, slot, int32_t(r), b.row(r), ref[0], ref[1],
+                   ref[2], s[0], s[1]);
     return;
   }
   b.fetch(n, kind, slot);
-  sphere_kernel(n, kind, b[0], b[1], b[2], b[3], b[4], b[5], b[6], ref_x, ref_y, ref_z, s_x, s_y,
-                ok, wi_x, wi_y, wi_z, distance, pdf, p_x, p_y, p_z, e_x, e_y, e_z, n_x, n_y, n_z, value_x, value_y, value_z);
+  with_outputs(sphere_kernel, out, n, kind, b[0], b[1], b[2], b[3], b[4], b[5], b[6], ref[0],
+               ref[1], ref[2], s[0], s[1]);
 }
 
 void point_light_samples(size_t n, const int32_t* kind, const int32_t* slot, LightRows& l,
-                         const float* ref_x, const float* ref_y, const float* ref_z, int32_t* ok,
-                         float* wi_x, float* wi_y, float* wi_z, float* distance, float* pdf,
-                         float* p_x, float* p_y, float* p_z, float* e_x, float* e_y, float* e_z,
-                         float* n_x, float* n_y, float* n_z, float* value_x, float* value_y,
-                         float* value_z) {
+                         const float* const* ref, const LightSampleArrays& out) {
   if (l.rows() <= LightRows::kFewRows) {
     for (size_t r = 0; r < l.rows(); ++r)
-      point_kernel_one(n, kind, slot, int32_t(r), l.row(r), ref_x, ref_y, ref_z, ok, wi_x, wi_y, wi_z, distance, pdf, p_x, p_y, p_z, e_x, e_y, e_z, n_x, n_y, n_z, value_x, value_y, value_z);
+      with_outputs(point_kernel_one, out, n, kind, slot, int32_t(r), l.row(r), ref[0], ref[1],
+                   ref[2]);
     return;
   }
   l.fetch(n, kind, slot);
-  point_kernel(n, kind, l[0], l[1], l[2], l[3], l[4], l[5], ref_x, ref_y, ref_z, ok, wi_x, wi_y, wi_z, distance, pdf, p_x, p_y, p_z, e_x, e_y, e_z, n_x, n_y, n_z, value_x, value_y, value_z);
+  with_outputs(point_kernel, out, n, kind, l[0], l[1], l[2], l[3], l[4], l[5], ref[0], ref[1],
+               ref[2]);
 }
 
 // LightSampler::choose for every entry: the first light whose cumulative probability exceeds
 // u is the number of lights whose cumulative probability does not (the table is sorted), and
 // the last light if rounding left u past them all.
 PENUMBRA_SIMD_CLONES
-void choose_lights(const float* __restrict cdf, int32_t lights, size_t n,
-                   const float* __restrict u, int32_t* __restrict light) {
+void choose_lights(In cdf, int32_t lights, size_t n, In u, int32_t* __restrict light) {
   for (size_t i = 0; i < n; ++i) light[i] = 0;
   for (int32_t l = 0; l < lights; ++l) {
     const float c = cdf[l];
@@ -371,18 +404,19 @@ StagedLights::StagedLights(const Scene& scene) {
     quads.push_back(q);
   }
   for (const QuadLight& q : quads) {
-    const float row[kQuadRow] = {q.origin[0], q.origin[1], q.origin[2], q.u[0], q.u[1], q.u[2],
-                                 q.v[0], q.v[1], q.v[2], q.n[0], q.n[1], q.n[2], q.area,
-                                 q.radiance[0], q.radiance[1], q.radiance[2]};
+    const float row[kQuadRow] = {q.origin[0], q.origin[1],   q.origin[2],   q.u[0],
+                                 q.u[1],      q.u[2],        q.v[0],        q.v[1],
+                                 q.v[2],      q.n[0],        q.n[1],        q.n[2],
+                                 q.area,      q.radiance[0], q.radiance[1], q.radiance[2]};
     quad_table.insert(quad_table.end(), row, row + kQuadRow);
   }
   for (const SphereLight& b : spheres) {
-    const float row[kSphereRow] = {b.center[0], b.center[1], b.center[2], b.radius,
+    const float row[kSphereRow] = {b.center[0],   b.center[1],   b.center[2],  b.radius,
                                    b.radiance[0], b.radiance[1], b.radiance[2]};
     sphere_table.insert(sphere_table.end(), row, row + kSphereRow);
   }
   for (const PointSource& p : points) {
-    const float row[kPointRow] = {p.position[0], p.position[1], p.position[2],
+    const float row[kPointRow] = {p.position[0],  p.position[1],  p.position[2],
                                   p.intensity[0], p.intensity[1], p.intensity[2]};
     point_table.insert(point_table.end(), row, row + kPointRow);
   }

@@ -106,31 +106,26 @@ class LightRows {
   std::vector<std::vector<float>> fields_;
 };
 
-// Quad::sample then AreaLight::sample: the quads' rows are origin, u, v, normal, area,
-// radiance.
+// Where a kernel writes each lane's sample (arrays of the stage's lanes).
+struct LightSampleArrays {
+  int32_t* ok;
+  float *wi[3], *distance, *pdf, *p[3], *e[3], *n[3], *value[3];
+};
+
+// Quad::sample then AreaLight::sample from ref (three arrays) at s (two): the quads' rows are
+// origin, u, v, normal, area, radiance.
 void quad_light_samples(size_t n, const int32_t* kind, const int32_t* slot, LightRows& quads,
-                        const float* ref_x, const float* ref_y, const float* ref_z,
-                        const float* s_x, const float* s_y, int32_t* ok, float* wi_x,
-                        float* wi_y, float* wi_z, float* distance, float* pdf, float* p_x,
-                        float* p_y, float* p_z, float* e_x, float* e_y, float* e_z, float* n_x,
-                        float* n_y, float* n_z, float* value_x, float* value_y, float* value_z);
+                        const float* const* ref, const float* const* s,
+                        const LightSampleArrays& out);
 
 // Sphere::sample (sample_sphere) then AreaLight::sample: the spheres' rows are centre, radius,
 // radiance.
 void sphere_light_samples(size_t n, const int32_t* kind, const int32_t* slot, LightRows& spheres,
-                          const float* ref_x, const float* ref_y, const float* ref_z,
-                          const float* s_x, const float* s_y, int32_t* ok, float* wi_x,
-                          float* wi_y, float* wi_z, float* distance, float* pdf, float* p_x,
-                          float* p_y, float* p_z, float* e_x, float* e_y, float* e_z, float* n_x,
-                          float* n_y, float* n_z, float* value_x, float* value_y,
-                          float* value_z);
+                          const float* const* ref, const float* const* s,
+                          const LightSampleArrays& out);
 
 // PointLight::sample (pdf 1, a delta light): the lights' rows are position, intensity.
 void point_light_samples(size_t n, const int32_t* kind, const int32_t* slot, LightRows& points,
-                         const float* ref_x, const float* ref_y, const float* ref_z, int32_t* ok,
-                         float* wi_x, float* wi_y, float* wi_z, float* distance, float* pdf,
-                         float* p_x, float* p_y, float* p_z, float* e_x, float* e_y, float* e_z,
-                         float* n_x, float* n_y, float* n_z, float* value_x, float* value_y,
-                         float* value_z);
+                         const float* const* ref, const LightSampleArrays& out);
 
 }  // namespace penumbra

@@ -838,35 +838,26 @@ void SurfaceStage::compute(const IntegratorSettings& settings, bool scene_next_e
       lane_kind_[i] = light < 0 ? -1 : lights_.kind[size_t(light)];
       lane_slot_[i] = light < 0 ? 0 : lights_.index[size_t(light)];
     }
-    float* const ref[3] = {p_[0].data(), p_[1].data(), p_[2].data()};
+    const float* const ref[3] = {p_[0].data(), p_[1].data(), p_[2].data()};
+    const float* const s[2] = {u_point_[0].data(), u_point_[1].data()};
+    LightSampleArrays out;
+    out.ok = light_ok_.data();
+    out.distance = l_distance_.data();
+    out.pdf = l_pdf_.data();
+    for (int c = 0; c < 3; ++c) {
+      out.wi[c] = l_wi_[c].data();
+      out.p[c] = l_p_[c].data();
+      out.e[c] = l_error_[c].data();
+      out.n[c] = l_n_[c].data();
+      out.value[c] = l_value_[c].data();
+    }
     // Each kind's kernel: a pass per light, or with many lights one pass over the lanes with
     // each lane's light's constants fetched into arrays (LightRows).
     const int32_t* kinds = lane_kind_.data();
     const int32_t* slots = lane_slot_.data();
-    if (quad_rows_.rows() > 0) {
-      quad_light_samples(n, kinds, slots, quad_rows_, ref[0], ref[1], ref[2], u_point_[0].data(),
-                         u_point_[1].data(), light_ok_.data(), l_wi_[0].data(), l_wi_[1].data(),
-                         l_wi_[2].data(), l_distance_.data(), l_pdf_.data(), l_p_[0].data(),
-                         l_p_[1].data(), l_p_[2].data(), l_error_[0].data(), l_error_[1].data(),
-                         l_error_[2].data(), l_n_[0].data(), l_n_[1].data(), l_n_[2].data(),
-                         l_value_[0].data(), l_value_[1].data(), l_value_[2].data());
-    }
-    if (sphere_rows_.rows() > 0) {
-      sphere_light_samples(n, kinds, slots, sphere_rows_, ref[0], ref[1], ref[2], u_point_[0].data(),
-                           u_point_[1].data(), light_ok_.data(), l_wi_[0].data(), l_wi_[1].data(),
-                           l_wi_[2].data(), l_distance_.data(), l_pdf_.data(), l_p_[0].data(),
-                           l_p_[1].data(), l_p_[2].data(), l_error_[0].data(), l_error_[1].data(),
-                           l_error_[2].data(), l_n_[0].data(), l_n_[1].data(), l_n_[2].data(),
-                           l_value_[0].data(), l_value_[1].data(), l_value_[2].data());
-    }
-    if (point_rows_.rows() > 0) {
-      point_light_samples(n, kinds, slots, point_rows_, ref[0], ref[1], ref[2], light_ok_.data(),
-                          l_wi_[0].data(), l_wi_[1].data(), l_wi_[2].data(), l_distance_.data(),
-                          l_pdf_.data(), l_p_[0].data(), l_p_[1].data(), l_p_[2].data(),
-                          l_error_[0].data(), l_error_[1].data(), l_error_[2].data(),
-                          l_n_[0].data(), l_n_[1].data(), l_n_[2].data(), l_value_[0].data(),
-                          l_value_[1].data(), l_value_[2].data());
-    }
+    if (quad_rows_.rows() > 0) quad_light_samples(n, kinds, slots, quad_rows_, ref, s, out);
+    if (sphere_rows_.rows() > 0) sphere_light_samples(n, kinds, slots, sphere_rows_, ref, s, out);
+    if (point_rows_.rows() > 0) point_light_samples(n, kinds, slots, point_rows_, ref, out);
     // What the kernels leave: the choice's probability, the delta flags, a directional light's
     // whole sample (the same everywhere). Point and directional lights are deltas: no MIS
     // weight. (No constant environment: the path integrator, the stages' only user, leaves it

@@ -20,10 +20,10 @@
 
 namespace penumbra {
 
-[[gnu::always_inline]] inline void sphere_solid_angle_sample(float cx, float cy, float cz, float radius,
-                                                             float rx, float ry, float rz, float u0,
-                                                             float u1, float* p, float* n,
-                                                             float* p_error, float* pdf) {
+[[gnu::always_inline]] inline void sphere_solid_angle_sample(float cx, float cy, float cz,
+                                                             float radius, float rx, float ry,
+                                                             float rz, float u0, float u1, float* p,
+                                                             float* n, float* p_error, float* pdf) {
   constexpr float g6 = gamma_bound(6);
   const float tx = cx - rx, ty = cy - ry, tz = cz - rz;
   const float dc2 = (tx * tx + ty * ty) + tz * tz;
@@ -55,7 +55,8 @@ namespace penumbra {
   const float sin2_max = r2 / dc2;
   const float cos_max = safe_sqrt(1.f - sin2_max);
   const bool series = sin2_max < 1e-3f;
-  const float one_minus_cos_max = series ? sin2_max * 0.5f + sin2_max * sin2_max / 8.f : 1.f - cos_max;
+  const float one_minus_cos_max =
+      series ? sin2_max * 0.5f + sin2_max * sin2_max / 8.f : 1.f - cos_max;
   const float cos_t = 1.f - u0 * one_minus_cos_max;
   const float sin2_t = std::max(0.f, 1.f - cos_t * cos_t);
   const float sin2_t_exact = u0 * one_minus_cos_max * (2.f - u0 * one_minus_cos_max);
