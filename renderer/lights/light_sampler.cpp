@@ -130,6 +130,14 @@ void LightSampler::choose_many(size_t n, const vec3* p, const vec3* normal, cons
   };
   thread_local Buffers buffers;
   auto& [group_p, group_n, group_v, walk_pmf, group_light, group_of] = buffers;
+  if (entry_light_.size() == 1 && entry_light_[0] < 0) {
+    // Every light in the tree: the points walk it as they are.
+    group_v.resize(n);
+    for (size_t k = 0; k < n; ++k) group_v[k] = group_u(0, u[k]);
+    tree_.choose_many(n, p, normal, group_v.data(), light, pmf);
+    for (size_t k = 0; k < n; ++k) pmf[k] = tree_pmf_ * pmf[k];
+    return;
+  }
   group_p.clear();
   group_n.clear();
   group_v.clear();

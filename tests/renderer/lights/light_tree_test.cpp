@@ -264,5 +264,51 @@ TEST(LightSampler, TreeGroupKeepsItsShareAndSumsToOne) {
   EXPECT_EQ(one.cdf(), flat.cdf());
 }
 
+// LightSampler::choose_many, the stages' choice for many points, is choose() point by point to
+// the bit: with every light in the tree (the points walk it as they are) and with a light outside
+// it (the group's points gathered first).
+TEST(LightSampler, ChooseManyIsChooseToTheBit) {
+  const ManyLights many;
+  std::vector<float> powers;
+  std::vector<std::optional<LightBounds>> places;
+  for (const LightBounds& b : many.lights) {
+    powers.push_back(b.phi);
+    places.push_back(b);
+  }
+  for (const bool with_environment : {false, true}) {
+    SCOPED_TRACE(with_environment ? "a light outside the tree" : "every light in the tree");
+    std::vector<float> all_powers = powers;
+    std::vector<std::optional<LightBounds>> all_places = places;
+    if (with_environment) {
+      all_powers.push_back(20.f);
+      all_places.push_back(std::nullopt);
+    }
+    const LightSampler sampler(all_powers, std::vector<bool>(all_powers.size(), true), all_places);
+    ASSERT_TRUE(sampler.spatial());
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u01(0.f, 1.f);
+    const size_t n = 700;  // (more than one of the tree's chunks of 256)
+    std::vector<vec3> p(n), normal(n);
+    std::vector<float> u(n), pmf(n);
+    std::vector<int> light(n);
+    for (size_t k = 0; k < n; ++k) {
+      p[k] = vec3(-5.f + 10.f * u01(rng), 3.f * u01(rng), -11.f + 12.f * u01(rng));
+      normal[k] = k % 5 == 0 ? kNoNormal : glm::normalize(vec3(u01(rng) - 0.5f, u01(rng), u01(rng) - 0.5f));
+      u[k] = k == 0 ? 0.99999994f : u01(rng);
+    }
+    sampler.choose_many(n, p.data(), normal.data(), u.data(), light.data(), pmf.data());
+    int outside = 0;
+    for (size_t k = 0; k < n; ++k) {
+      float one_pmf = -1.f;
+      const int one = sampler.choose(u[k], p[k], normal[k], &one_pmf);
+      EXPECT_EQ(light[k], one) << k;
+      EXPECT_EQ(pmf[k], one_pmf) << k;
+      if (one >= 0) EXPECT_EQ(pmf[k], sampler.pmf(one, p[k], normal[k])) << k;
+      outside += one == int(powers.size());
+    }
+    EXPECT_EQ(outside > 0, with_environment);
+  }
+}
+
 }  // namespace
 }  // namespace penumbra::test
