@@ -29,8 +29,10 @@ class LightSampler {
 
   // Lights with a place from which the tree chooses among them. With few lights the choice by
   // power does as well or better: all_lights (four lights with a place) had 0.94 of its direct
-  // light's error with the tree but 1.3-1.5 of its whole error, from rare bright samples
-  // (docs/performance.md, levers, session 42); with few lights the staged kernels also run.
+  // light's error with the tree but 1.3-1.5 of its whole error, from rare bright samples of its
+  // point light on its glossy sphere: the tree's importance does not see the BSDF (with the
+  // sphere made diffuse the tree has 0.75 of the variance; docs/performance.md, levers,
+  // sessions 42 and 43).
   static constexpr size_t kTreeFrom = 8;
 
   bool empty() const { return cdf_.empty(); }

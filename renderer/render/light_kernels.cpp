@@ -80,7 +80,7 @@ namespace {
   const float dist2 = (wx * wx + wy * wy) + wz * wz;
   const float cos_l = std::fabs((nx * wx + ny * wy) + nz * wz) / std::sqrt(dist2);
   const float ratio = dist2 / (cos_l * q_area);
-  const float density = (cos_l > 0.f) & (q_area > 0.f) ? ratio : 0.f;
+  const float density = ((cos_l > 0.f) & (q_area > 0.f)) ? ratio : 0.f;
   // AreaLight::sample: a finite positive density, a positive distance, the front side (&
   // rather than &&: no branches in the loop).
   const float dist = std::sqrt(dist2);

@@ -42,7 +42,7 @@ namespace penumbra {
   const float icos = std::fabs((ix * iwx + iy * iwy) + iz * iwz) / std::sqrt(idist2);
   const float iarea = 4.f * kPi * r2;
   const float iratio = idist2 / (icos * iarea);
-  const float ipdf = (icos > 0.f) & (iarea > 0.f) ? iratio : 0.f;
+  const float ipdf = ((icos > 0.f) & (iarea > 0.f)) ? iratio : 0.f;
 
   // Outside: the cone towards the centre, in the frame of wc (Duff et al. 2017's basis, as Frame).
   const float dc = std::sqrt(dc2);

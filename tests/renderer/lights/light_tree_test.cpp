@@ -161,7 +161,9 @@ TEST(LightTree, LightsNearTheEndOfTheFloatRangeAreLeftOut) {
     float pmf;
     const int id = tree.choose(vec3(0.5f, 0, 0), kNoNormal, (float(k) + 0.5f) / 100.f, &pmf);
     EXPECT_TRUE(std::isfinite(pmf));
-    if (id >= 0) EXPECT_EQ(pmf, tree.pmf(vec3(0.5f, 0, 0), kNoNormal, id));
+    if (id >= 0) {
+      EXPECT_EQ(pmf, tree.pmf(vec3(0.5f, 0, 0), kNoNormal, id));
+    }
   }
 }
 
@@ -303,7 +305,9 @@ TEST(LightSampler, ChooseManyIsChooseToTheBit) {
       const int one = sampler.choose(u[k], p[k], normal[k], &one_pmf);
       EXPECT_EQ(light[k], one) << k;
       EXPECT_EQ(pmf[k], one_pmf) << k;
-      if (one >= 0) EXPECT_EQ(pmf[k], sampler.pmf(one, p[k], normal[k])) << k;
+      if (one >= 0) {
+        EXPECT_EQ(pmf[k], sampler.pmf(one, p[k], normal[k])) << k;
+      }
       outside += one == int(powers.size());
     }
     EXPECT_EQ(outside > 0, with_environment);
