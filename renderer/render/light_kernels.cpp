@@ -21,10 +21,7 @@ namespace {
 using In = const float* __restrict;
 using Out = float* __restrict;
 
-}  // namespace
-
-namespace {
-
+// LightRows::fetch for rows of kWidth floats.
 template <int32_t kWidth>
 void gather_rows(const float* table, int32_t of_kind, size_t n, const int32_t* kind,
                  const int32_t* slot, std::vector<std::vector<float>>& fields) {
