@@ -289,8 +289,6 @@ namespace {
   return slot;
 }
 
-}  // namespace
-
 // A level of the walks of m points (LightTree::choose_many): each point at a node (at[k] >= 0)
 // takes its step; a point that reaches a light or finds nothing stops (at[k] = -1). Returns how
 // many go on. In two passes, the importances of every point's node (in this function's SIMD
@@ -324,6 +322,8 @@ size_t light_tree_walk_level(const LightTreeNode* nodes, size_t m, int32_t* __re
   }
   return walking;
 }
+
+}  // namespace
 
 int LightTree::choose(const vec3& p, const vec3& normal, float u, float* pmf) const {
   int light;
