@@ -46,7 +46,8 @@ int bucket_of(const LightBounds& b, int axis, float lo, float hi) {
 LightTreeNode::LightTreeNode() {
   for (int k = 0; k < kWide; ++k) {
     cx[k] = cy[k] = cz[k] = 0.f;
-    radius[k] = radius2[k] = d2_floor[k] = 0.f;
+    radius[k] = radius2[k] = 0.f;
+    inv_d2_floor[k] = kInfinity;
     ax[k] = ay[k] = 0.f;
     az[k] = 1.f;
     cos_o[k] = -1.f;
@@ -63,7 +64,8 @@ void LightTreeNode::set(int k, const LightBounds& b, int32_t child_or_light) {
   cx[k] = centre.x, cy[k] = centre.y, cz[k] = centre.z;
   radius2[k] = 0.25f * glm::dot(diagonal, diagonal);
   radius[k] = std::sqrt(radius2[k]);
-  d2_floor[k] = 0.5f * glm::length(diagonal);
+  // (pbrt-v4 keeps d^2 from below at half the diagonal's length; a point light's 0 -> inf.)
+  inv_d2_floor[k] = 1.f / (0.5f * glm::length(diagonal));
   ax[k] = b.normals.axis.x, ay[k] = b.normals.axis.y, az[k] = b.normals.axis.z;
   cos_o[k] = b.normals.cos_theta;
   sin_o[k] = safe_sqrt(1.f - cos_o[k] * cos_o[k]);
@@ -71,7 +73,7 @@ void LightTreeNode::set(int k, const LightBounds& b, int32_t child_or_light) {
   phi[k] = b.phi > 0.f && std::isfinite(b.phi) ? b.phi : 0.f;
   two_sided[k] = b.two_sided ? 1.f : 0.f;
   all_directions[k] = b.normals.cos_theta <= -1.f ? 1.f : 0.f;
-  one_way[k] = b.normals.cos_theta >= 1.f ? 1.f : 0.f;
+  one_way[k] = b.normals.cos_theta >= 1.f && !b.two_sided ? 1.f : 0.f;  // (two-sided: light leaves both ways)
   const float reach =
       0.5f * (std::fabs(ax[k]) * diagonal.x + std::fabs(ay[k]) * diagonal.y + std::fabs(az[k]) * diagonal.z);
   const float size = 1.f + std::max(std::fabs(centre.x), std::max(std::fabs(centre.y), std::fabs(centre.z))) +
@@ -88,37 +90,44 @@ namespace {
                                                    const vec3& normal, float* __restrict out) {
   const float px = p.x, py = p.y, pz = p.z;
   const float nx = normal.x, ny = normal.y, nz = normal.z;
-  const bool has_normal = nx != 0.f || ny != 0.f || nz != 0.f;
+  const bool has_normal = nx * nx + ny * ny + nz * nz > 0.f;  // (a normal is unit or 0)
   for (int k = 0; k < LightTreeNode::kWide; ++k) {
     const float vx = px - n.cx[k], vy = py - n.cy[k], vz = pz - n.cz[k];
     const float dist2 = vx * vx + vy * vy + vz * vz;
-    const float d2 = std::max(dist2, n.d2_floor[k]);
-    // The angle between the normals' axis and the direction to p, less the cone's own angle,
-    // less the angle the box's bounding sphere subtends from p (sin^2 = r^2 / d^2): cos(a - b)
-    // clamped at a < b to 1, as pbrt-v4's cosSubClamped and sinSubClamped.
-    const float inv_d = 1.f / std::sqrt(dist2);
-    const float dot = (n.ax[k] * vx + n.ay[k] * vy + n.az[k] * vz) * inv_d;
-    const float cos_w = n.two_sided[k] != 0.f ? std::fabs(dot) : dot;
-    const float sin_w = std::sqrt(std::max(0.f, 1.f - cos_w * cos_w));
-    const float sin_b = std::min(n.radius[k] * inv_d, 1.f);
-    const float cos_b = std::sqrt(std::max(0.f, 1.f - sin_b * sin_b));
-    const bool within_o = cos_w > n.cos_o[k];
-    const float cos_x = within_o ? 1.f : cos_w * n.cos_o[k] + sin_w * n.sin_o[k];
-    const float sin_x = within_o ? 0.f : sin_w * n.cos_o[k] - cos_w * n.sin_o[k];
-    float cos_p = cos_x > cos_b ? 1.f : cos_x * cos_b + sin_x * sin_b;
+    // 1 / d^2 with d^2 kept from below (1 / max(a, b) = min(1 / a, 1 / b)).
+    const float inv_dist2 = 1.f / dist2;
+    const float inv_d2 = std::min(inv_dist2, n.inv_d2_floor[k]);
+    // The angles as (cos, sin) x d, so that one division serves them all: the axis's angle w
+    // to the direction to p (cw, sw), the bounding sphere's half angle b (cb, sin b x d = radius).
+    const float dot = n.ax[k] * vx + n.ay[k] * vy + n.az[k] * vz;
+    const float cw = n.two_sided[k] != 0.f ? std::fabs(dot) : dot;
+    const float sw = std::sqrt(std::max(0.f, dist2 - cw * cw));
+    const float cb = std::sqrt(std::max(0.f, dist2 - n.radius2[k]));
+    // w less the cone's angle o (cos(w - o), sin(w - o)) x d; w within o where sin(w - o) < 0
+    // (both angles in [0, pi]). Then less b: cos(x - b) x d^2, clamped to 1 where x < b, as
+    // pbrt-v4's cosSubClamped and sinSubClamped.
+    const float cx = cw * n.cos_o[k] + sw * n.sin_o[k];
+    const float sx = sw * n.cos_o[k] - cw * n.sin_o[k];
     // Inside the bounding sphere, or with normals every way, every direction reaches p.
     const bool inside = dist2 <= n.radius2[k];
-    cos_p = (n.all_directions[k] != 0.f || inside) ? 1.f : cos_p;
+    const bool full = sx < 0.f || cx > cb || inside || n.all_directions[k] != 0.f;
+    // (Both sides of each select computed in every lane: with the load under the condition,
+    // GCC's AVX-512 clone made it a merge-masked load, and arithmetic on the lanes it left
+    // stale took microcode assists where they held denormals: core/flush_denormals.h.)
+    const float radius = n.radius[k];
+    const float cos_p_open = (cx * cb + sx * radius) * inv_dist2;
+    const float cos_p = full ? 1.f : cos_p_open;
     // The receiver: |cos| between its normal and the direction to the centre, less the sphere's
     // angle (1 inside it or without a normal).
-    const float cos_i = std::fabs(nx * vx + ny * vy + nz * vz) * inv_d;
-    const float sin_i = std::sqrt(std::max(0.f, 1.f - cos_i * cos_i));
-    float cos_ip = cos_i > cos_b ? 1.f : cos_i * cos_b + sin_i * sin_b;
-    cos_ip = (inside || !has_normal) ? 1.f : cos_ip;
-    const float importance = n.phi[k] * cos_p * cos_ip / d2;
+    const float ci = std::fabs(nx * vx + ny * vy + nz * vz);
+    const float si = std::sqrt(std::max(0.f, dist2 - ci * ci));
+    const bool full_i = ci > cb || inside || !has_normal;
+    const float cos_ip_open = (ci * cb + si * radius) * inv_dist2;
+    const float cos_ip = full_i ? 1.f : cos_ip_open;
+    const float importance = n.phi[k] * cos_p * cos_ip * inv_d2;
     // Behind or in the plane of every emitter of one direction (a Lambertian panel's own
     // points receive nothing from it either).
-    const bool behind = n.one_way[k] != 0.f && (n.ax[k] * vx + n.ay[k] * vy + n.az[k] * vz) <= n.behind_at[k];
+    const bool behind = n.one_way[k] != 0.f && dot <= n.behind_at[k];
     out[k] = (!behind && cos_p > n.cos_e[k] && importance > 0.f && importance < kInfinity) ? importance : 0.f;
   }
 }
@@ -264,49 +273,61 @@ int LightTree::collapse(const std::vector<Binary>& binary, int root, int parent,
 
 namespace {
 
-// One level of a walk, given the node's importances at the point: the slot u selects; u becomes
-// its place within the slot's interval, *prob is multiplied by the slot's probability, and the
-// slot is returned (-1 if nothing reaches the point).
-[[gnu::always_inline]] inline int walk_step(const float* imp, float* u, float* prob) {
-  float cum[LightTreeNode::kWide];
+// One level of the walk of point k (of m), given its node's importances imp[slot] (scratch
+// k x kWide onwards): the slot u[k] selects, the interval [cum[slot - 1], cum[slot]) of the
+// prefix sums that holds u[k] x total, found by counting the intervals that end at or below it
+// (a slot of importance 0 has an empty interval and is never the one; rounding past the last
+// interval falls to the last nonempty one). u[k] becomes its place within that interval and
+// pmf[k] is multiplied by the slot's probability. Returns the slot, -1 where nothing reaches
+// the point. Branch-free, so that a loop over the points runs in SIMD lanes: which slot it is
+// is random, and a branch on it would be mispredicted half the time.
+[[gnu::always_inline]] inline int walk_step(const float* __restrict imp, bool active, float* __restrict u,
+                                            float* __restrict pmf) {
+  constexpr int kWide = LightTreeNode::kWide;
+  float cum[kWide];
   float total = 0.f;
-  for (int k = 0; k < LightTreeNode::kWide; ++k) cum[k] = total += imp[k];
-  if (!(total > 0.f)) return -1;
-  // The slot whose interval [cum[k - 1], cum[k]) holds u x total: the number of intervals that
-  // end at or below it (counted, not searched: which one it is is random, and a branch on it
-  // would be mispredicted half the time). A slot of importance 0 has an empty interval and is
-  // never the one; rounding past the last interval falls to the last nonempty one.
+  for (int s = 0; s < kWide; ++s) cum[s] = total += imp[s];
   const float target = *u * total;
-  int slot = 0;
-  for (int k = 0; k < LightTreeNode::kWide; ++k) slot += int(cum[k] <= target);
-  if (slot >= LightTreeNode::kWide) {
-    slot = LightTreeNode::kWide - 1;
-    while (!(imp[slot] > 0.f)) --slot;
+  int count = 0, last = 0;
+  for (int s = 0; s < kWide; ++s) {
+    count += int(cum[s] <= target);
+    last = imp[s] > 0.f ? s : last;
   }
-  const float below = slot > 0 ? cum[slot - 1] : 0.f;
-  *u = std::clamp((target - below) / imp[slot], 0.f, kOneMinusEpsilon);
-  *prob *= imp[slot] / total;
-  return slot;
+  const int slot = count < kWide ? count : last;
+  float below = 0.f, chosen = imp[0];
+  for (int s = 1; s < kWide; ++s) {
+    below = s == slot ? cum[s - 1] : below;
+    chosen = s == slot ? imp[s] : chosen;
+  }
+  const bool found = total > 0.f;
+  const float next_u = std::clamp((target - below) / chosen, 0.f, kOneMinusEpsilon);
+  const float next_pmf = *pmf * (chosen / total);
+  *u = active && found ? next_u : *u;
+  *pmf = active && found ? next_pmf : *pmf;
+  return found ? slot : -1;
 }
 
 // A level of the walks of m points (LightTree::choose_many): each point at a node (at[k] >= 0)
 // takes its step; a point that reaches a light or finds nothing stops (at[k] = -1). Returns how
-// many go on. In two passes, the importances of every point's node (in this function's SIMD
-// width, without a call) into `scratch` (m x kWide floats), then the choices: each pass's work
-// per point is a short chain independent of the other points', which the core overlaps (one
-// pass per point was a chain of both, mostly waiting).
+// many go on. In three passes: the importances of every point's node (in this function's SIMD
+// width, across the node's slots) into `scratch` (m x kWide floats); every point's choice of a
+// slot (in SIMD lanes across the points) into `slots`; then the moves to the chosen children.
+// Each pass's work per point is a short chain independent of the other points', which the core
+// overlaps (one pass per point was a chain of all, mostly waiting).
 PENUMBRA_SIMD_CLONES
 size_t light_tree_walk_level(const LightTreeNode* nodes, size_t m, int32_t* __restrict at,
                              const vec3* p, const vec3* normal, float* __restrict u,
                              float* __restrict pmf, int* __restrict light,
-                             float* __restrict scratch) {
+                             float* __restrict scratch, int32_t* __restrict slots) {
   for (size_t k = 0; k < m; ++k)
     if (at[k] >= 0)
       node_importance(nodes[size_t(at[k])], p[k], normal[k], scratch + k * LightTreeNode::kWide);
+  for (size_t k = 0; k < m; ++k)
+    slots[k] = walk_step(scratch + k * LightTreeNode::kWide, at[k] >= 0, &u[k], &pmf[k]);
   size_t walking = 0;
   for (size_t k = 0; k < m; ++k) {
     if (at[k] < 0) continue;
-    const int slot = walk_step(scratch + k * LightTreeNode::kWide, &u[k], &pmf[k]);
+    const int slot = slots[k];
     const int32_t child = slot >= 0 ? nodes[size_t(at[k])].child[slot] : 0;
     if (slot < 0) {
       light[k] = -1;
@@ -342,6 +363,7 @@ void LightTree::choose_many(size_t n, const vec3* p, const vec3* normal, const f
   float walk_u[kChunk];
   int32_t at[kChunk];
   alignas(32) float scratch[kChunk * LightTreeNode::kWide];
+  int32_t slots[kChunk];
   for (size_t base = 0; base < n; base += kChunk) {
     const size_t m = std::min(kChunk, n - base);
     size_t walking = m;
@@ -352,7 +374,7 @@ void LightTree::choose_many(size_t n, const vec3* p, const vec3* normal, const f
     }
     while (walking > 0)
       walking = light_tree_walk_level(nodes_.data(), m, at, p + base, normal + base, walk_u,
-                                      pmf + base, light + base, scratch);
+                                      pmf + base, light + base, scratch, slots);
   }
 }
 

@@ -33,12 +33,12 @@ struct alignas(32) LightTreeNode {
   static constexpr int kWide = 8;
   float cx[kWide], cy[kWide], cz[kWide];
   float radius[kWide], radius2[kWide];  // the child's box's bounding sphere
-  float d2_floor[kWide];                // half its diagonal
+  float inv_d2_floor[kWide];            // 1 / half its diagonal's length
   float ax[kWide], ay[kWide], az[kWide];  // its normals' axis
   float cos_o[kWide], sin_o[kWide], cos_e[kWide];
   float phi[kWide];
   float two_sided[kWide], all_directions[kWide];  // 1 or 0
-  // Normals all one way (cos_o = 1: panels): 1, and where along the axis from the centre a point
+  // Normals all one way (cos_o = 1: panels) and one-sided: 1, and where along the axis from the centre a point
   // is behind or in every emitter's plane: at or below -(sum |axis_i| x half extent_i), plus a
   // slack of 1e-5 of the box's size and distance from the origin (hit points on a panel itself
   // lie in its plane only to their rounding). Such points are out of reach even inside the
