@@ -9,6 +9,7 @@
 #include <atomic>
 #include <chrono>
 
+#include "renderer/core/flush_denormals.h"
 #include "renderer/core/frame.h"
 #include "renderer/sampling/sampler.h"
 #include "renderer/sampling/sampling.h"
@@ -34,6 +35,7 @@ BaselineResult trace_embree_baseline(const Scene& scene, const RenderSettings& s
   arena.execute([&] {
     tbb::parallel_for(
         tbb::blocked_range2d<int>(0, settings.height, 16, 0, settings.width, 16), [&](const auto& r) {
+          const FlushDenormals flush_denormals;  // the render threads' mode (render.cpp)
           Sampler sampler(settings.seed);
           uint64_t rays = 0;
           for (int y = r.rows().begin(); y < r.rows().end(); ++y)

@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "renderer/core/flush_denormals.h"
 #include "renderer/core/frame.h"
 #include "renderer/embree/ray_access.h"
 #include "renderer/lights/area_light.h"
@@ -142,6 +143,7 @@ double trace(const Scene& source, const RaySet& set, RayForm form, tbb::task_are
   const auto start = std::chrono::steady_clock::now();
   arena.execute([&] {
     tbb::parallel_for(tbb::blocked_range<size_t>(0, chunks), [&](const tbb::blocked_range<size_t>& r) {
+      const FlushDenormals flush_denormals;  // the render threads' mode (render.cpp)
       ExactTContext context = make_context(source, set);
       RTCIntersectContext* ctx = &context.embree;
       for (size_t c = r.begin(); c != r.end(); ++c) {

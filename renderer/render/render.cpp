@@ -10,6 +10,7 @@
 #include <optional>
 #include <stdexcept>
 
+#include "renderer/core/flush_denormals.h"
 #include "renderer/render/adaptive_sampling.h"
 #include "renderer/render/film.h"
 #include "renderer/render/integrator.h"
@@ -242,6 +243,7 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
     }
     arena.execute([&] {
       tbb::parallel_for(tbb::blocked_range<size_t>(0, items.size() - 1, 1), [&](const auto& range) {
+        const FlushDenormals flush_denormals;  // (core/flush_denormals.h: why)
         for (size_t item = range.begin(); item != range.end(); ++item) {
           if (stop.load(std::memory_order_relaxed)) return;
           if (control.cancel && control.cancel->load(std::memory_order_relaxed)) {
