@@ -84,52 +84,64 @@ void LightTreeNode::set(int k, const LightBounds& b, int32_t child_or_light) {
 
 namespace {
 
-// light_tree_importance's arithmetic, inlined into it and into the walk's level kernel (the same
-// operations in the same order: the same bits).
+// The importance of slot k of node n at point (px, py, pz) with normal (nx, ny, nz) (0: none):
+// light_tree_importance's arithmetic, inlined into it and into the walk's kernels, whether their
+// SIMD lanes run across a node's slots or across points (the same operations in the same order:
+// the same bits).
+[[gnu::always_inline]] inline float slot_importance(const LightTreeNode& n, int k, float px, float py,
+                                                    float pz, float nx, float ny, float nz,
+                                                    float no_normal) {
+  // (Every field read here, unconditionally: a load under a condition becomes a masked load,
+  // which keeps GCC from running the lanes across points and, across slots, left stale lanes
+  // that cost FP assists, core/flush_denormals.h.)
+  const float one_way = n.one_way[k], behind_at = n.behind_at[k], cos_e = n.cos_e[k];
+  const float all_directions = n.all_directions[k], radius = n.radius[k];
+  const float vx = px - n.cx[k], vy = py - n.cy[k], vz = pz - n.cz[k];
+  const float dist2 = vx * vx + vy * vy + vz * vz;
+  // 1 / d^2 with d^2 kept from below (1 / max(a, b) = min(1 / a, 1 / b)).
+  const float inv_dist2 = 1.f / dist2;
+  const float inv_d2 = std::min(inv_dist2, n.inv_d2_floor[k]);
+  // The angles as (cos, sin) x d, so that one division serves them all: the axis's angle w
+  // to the direction to p (cw, sw), the bounding sphere's half angle b (cb, sin b x d = radius).
+  const float dot = n.ax[k] * vx + n.ay[k] * vy + n.az[k] * vz;
+  const float cw = n.two_sided[k] != 0.f ? std::fabs(dot) : dot;
+  const float sw = std::sqrt(std::max(0.f, dist2 - cw * cw));
+  const float cb = std::sqrt(std::max(0.f, dist2 - n.radius2[k]));
+  // w less the cone's angle o (cos(w - o), sin(w - o)) x d; w within o where sin(w - o) < 0
+  // (both angles in [0, pi]). Then less b: cos(x - b) x d^2, clamped to 1 where x < b, as
+  // pbrt-v4's cosSubClamped and sinSubClamped.
+  const float cx = cw * n.cos_o[k] + sw * n.sin_o[k];
+  const float sx = sw * n.cos_o[k] - cw * n.sin_o[k];
+  // Inside the bounding sphere, or with normals every way, every direction reaches p.
+  const bool inside = dist2 <= n.radius2[k];
+  const bool full = sx < 0.f || cx > cb || inside || all_directions != 0.f;
+  const float cos_p_open = (cx * cb + sx * radius) * inv_dist2;
+  const float cos_p = full ? 1.f : cos_p_open;
+  // The receiver: |cos| between its normal and the direction to the centre, less the sphere's
+  // angle (1 inside it or without a normal).
+  const float ci = std::fabs(nx * vx + ny * vy + nz * vz);
+  const float si = std::sqrt(std::max(0.f, dist2 - ci * ci));
+  const bool full_i = ci > cb || inside;
+  const float cos_ip_open = (ci * cb + si * radius) * inv_dist2;
+  const float cos_ip = std::max(full_i ? 1.f : cos_ip_open, no_normal);  // (no_normal: 1 or 0)
+  const float importance = n.phi[k] * cos_p * cos_ip * inv_d2;
+  // Behind or in the plane of every emitter of one direction (a Lambertian panel's own
+  // points receive nothing from it either).
+  const bool behind = one_way != 0.f && dot <= behind_at;
+  return (!behind && cos_p > cos_e && importance > 0.f && importance < kInfinity) ? importance : 0.f;
+}
+
+// 1 for a zero normal (a point in free space), else 0 (a normal is unit or 0).
+[[gnu::always_inline]] inline float no_normal(const vec3& n) {
+  return n.x * n.x + n.y * n.y + n.z * n.z > 0.f ? 0.f : 1.f;
+}
+
+// Every slot's importance at one point.
 [[gnu::always_inline]] inline void node_importance(const LightTreeNode& n, const vec3& p,
                                                    const vec3& normal, float* __restrict out) {
-  const float px = p.x, py = p.y, pz = p.z;
-  const float nx = normal.x, ny = normal.y, nz = normal.z;
-  const bool has_normal = nx * nx + ny * ny + nz * nz > 0.f;  // (a normal is unit or 0)
-  for (int k = 0; k < LightTreeNode::kWide; ++k) {
-    const float vx = px - n.cx[k], vy = py - n.cy[k], vz = pz - n.cz[k];
-    const float dist2 = vx * vx + vy * vy + vz * vz;
-    // 1 / d^2 with d^2 kept from below (1 / max(a, b) = min(1 / a, 1 / b)).
-    const float inv_dist2 = 1.f / dist2;
-    const float inv_d2 = std::min(inv_dist2, n.inv_d2_floor[k]);
-    // The angles as (cos, sin) x d, so that one division serves them all: the axis's angle w
-    // to the direction to p (cw, sw), the bounding sphere's half angle b (cb, sin b x d = radius).
-    const float dot = n.ax[k] * vx + n.ay[k] * vy + n.az[k] * vz;
-    const float cw = n.two_sided[k] != 0.f ? std::fabs(dot) : dot;
-    const float sw = std::sqrt(std::max(0.f, dist2 - cw * cw));
-    const float cb = std::sqrt(std::max(0.f, dist2 - n.radius2[k]));
-    // w less the cone's angle o (cos(w - o), sin(w - o)) x d; w within o where sin(w - o) < 0
-    // (both angles in [0, pi]). Then less b: cos(x - b) x d^2, clamped to 1 where x < b, as
-    // pbrt-v4's cosSubClamped and sinSubClamped.
-    const float cx = cw * n.cos_o[k] + sw * n.sin_o[k];
-    const float sx = sw * n.cos_o[k] - cw * n.sin_o[k];
-    // Inside the bounding sphere, or with normals every way, every direction reaches p.
-    const bool inside = dist2 <= n.radius2[k];
-    const bool full = sx < 0.f || cx > cb || inside || n.all_directions[k] != 0.f;
-    // (Both sides of each select computed in every lane: with the load under the condition,
-    // GCC's AVX-512 clone made it a merge-masked load, and arithmetic on the lanes it left
-    // stale took microcode assists where they held denormals: core/flush_denormals.h.)
-    const float radius = n.radius[k];
-    const float cos_p_open = (cx * cb + sx * radius) * inv_dist2;
-    const float cos_p = full ? 1.f : cos_p_open;
-    // The receiver: |cos| between its normal and the direction to the centre, less the sphere's
-    // angle (1 inside it or without a normal).
-    const float ci = std::fabs(nx * vx + ny * vy + nz * vz);
-    const float si = std::sqrt(std::max(0.f, dist2 - ci * ci));
-    const bool full_i = ci > cb || inside || !has_normal;
-    const float cos_ip_open = (ci * cb + si * radius) * inv_dist2;
-    const float cos_ip = full_i ? 1.f : cos_ip_open;
-    const float importance = n.phi[k] * cos_p * cos_ip * inv_d2;
-    // Behind or in the plane of every emitter of one direction (a Lambertian panel's own
-    // points receive nothing from it either).
-    const bool behind = n.one_way[k] != 0.f && dot <= n.behind_at[k];
-    out[k] = (!behind && cos_p > n.cos_e[k] && importance > 0.f && importance < kInfinity) ? importance : 0.f;
-  }
+  const float none = no_normal(normal);
+  for (int k = 0; k < LightTreeNode::kWide; ++k)
+    out[k] = slot_importance(n, k, p.x, p.y, p.z, normal.x, normal.y, normal.z, none);
 }
 
 }  // namespace
@@ -273,20 +285,23 @@ int LightTree::collapse(const std::vector<Binary>& binary, int root, int parent,
 
 namespace {
 
-// One level of the walk of point k (of m), given its node's importances imp[slot] (scratch
-// k x kWide onwards): the slot u[k] selects, the interval [cum[slot - 1], cum[slot]) of the
+// One level of the walk of point k (of m), given its node's importances imp[slot x stride]: the slot u[k] selects, the interval [cum[slot - 1], cum[slot]) of the
 // prefix sums that holds u[k] x total, found by counting the intervals that end at or below it
 // (a slot of importance 0 has an empty interval and is never the one; rounding past the last
 // interval falls to the last nonempty one). u[k] becomes its place within that interval and
 // pmf[k] is multiplied by the slot's probability. Returns the slot, -1 where nothing reaches
 // the point. Branch-free, so that a loop over the points runs in SIMD lanes: which slot it is
 // is random, and a branch on it would be mispredicted half the time.
-[[gnu::always_inline]] inline int walk_step(const float* __restrict imp, bool active, float* __restrict u,
-                                            float* __restrict pmf) {
+template <size_t kStride = 1>
+[[gnu::always_inline]] inline int walk_step(const float* __restrict in, size_t stride, bool active,
+                                            float* __restrict u, float* __restrict pmf) {
   constexpr int kWide = LightTreeNode::kWide;
-  float cum[kWide];
+  float imp[kWide], cum[kWide];
   float total = 0.f;
-  for (int s = 0; s < kWide; ++s) cum[s] = total += imp[s];
+  for (int s = 0; s < kWide; ++s) {
+    imp[s] = in[size_t(s) * (kStride ? kStride : stride)];
+    cum[s] = total += imp[s];
+  }
   const float target = *u * total;
   int count = 0, last = 0;
   for (int s = 0; s < kWide; ++s) {
@@ -307,23 +322,11 @@ namespace {
   return found ? slot : -1;
 }
 
-// A level of the walks of m points (LightTree::choose_many): each point at a node (at[k] >= 0)
-// takes its step; a point that reaches a light or finds nothing stops (at[k] = -1). Returns how
-// many go on. In three passes: the importances of every point's node (in this function's SIMD
-// width, across the node's slots) into `scratch` (m x kWide floats); every point's choice of a
-// slot (in SIMD lanes across the points) into `slots`; then the moves to the chosen children.
-// Each pass's work per point is a short chain independent of the other points', which the core
-// overlaps (one pass per point was a chain of all, mostly waiting).
-PENUMBRA_SIMD_CLONES
-size_t light_tree_walk_level(const LightTreeNode* nodes, size_t m, int32_t* __restrict at,
-                             const vec3* p, const vec3* normal, float* __restrict u,
-                             float* __restrict pmf, int* __restrict light,
-                             float* __restrict scratch, int32_t* __restrict slots) {
-  for (size_t k = 0; k < m; ++k)
-    if (at[k] >= 0)
-      node_importance(nodes[size_t(at[k])], p[k], normal[k], scratch + k * LightTreeNode::kWide);
-  for (size_t k = 0; k < m; ++k)
-    slots[k] = walk_step(scratch + k * LightTreeNode::kWide, at[k] >= 0, &u[k], &pmf[k]);
+// The moves of a level's walks to the slots chosen (slots[k]): a point that reaches a light or
+// finds nothing stops (at[k] = -1). Returns how many go on.
+[[gnu::always_inline]] inline size_t walk_moves(const LightTreeNode* nodes, size_t m, int32_t* __restrict at,
+                                                const int32_t* __restrict slots, float* __restrict pmf,
+                                                int* __restrict light) {
   size_t walking = 0;
   for (size_t k = 0; k < m; ++k) {
     if (at[k] < 0) continue;
@@ -342,6 +345,53 @@ size_t light_tree_walk_level(const LightTreeNode* nodes, size_t m, int32_t* __re
     }
   }
   return walking;
+}
+
+// A level of the walks of m points (LightTree::choose_many): each point at a node (at[k] >= 0)
+// takes its step. Returns how many go on. In three passes: the importances of every point's
+// node (in this function's SIMD width, across the node's slots) into `scratch` (m x kWide
+// floats); every point's choice of a slot (in SIMD lanes across the points) into `slots`; then
+// the moves to the chosen children. Each pass's work per point is a short chain independent of
+// the other points', which the core overlaps (one pass per point was a chain of all, mostly
+// waiting).
+PENUMBRA_SIMD_CLONES
+size_t light_tree_walk_level(const LightTreeNode* nodes, size_t m, int32_t* __restrict at,
+                             const vec3* p, const vec3* normal, float* __restrict u,
+                             float* __restrict pmf, int* __restrict light,
+                             float* __restrict scratch, int32_t* __restrict slots) {
+  for (size_t k = 0; k < m; ++k)
+    if (at[k] >= 0)
+      node_importance(nodes[size_t(at[k])], p[k], normal[k], scratch + k * LightTreeNode::kWide);
+  for (size_t k = 0; k < m; ++k)
+    slots[k] = walk_step<1>(scratch + k * LightTreeNode::kWide, 1, at[k] >= 0, &u[k], &pmf[k]);
+  return walk_moves(nodes, m, at, slots, pmf, light);
+}
+
+// The first level, where every point is at the root: the importances in SIMD lanes across the
+// points, slot by slot (the root's fields the same in every lane), into `scratch` by slot
+// (slot x m + k); then the choices and moves as light_tree_walk_level's.
+PENUMBRA_SIMD_CLONES
+size_t light_tree_walk_root(const LightTreeNode* nodes, size_t m, int32_t* __restrict at,
+                            const vec3* p, const vec3* normal, float* __restrict u,
+                            float* __restrict pmf, int* __restrict light,
+                            float* __restrict scratch, int32_t* __restrict slots) {
+  const LightTreeNode& root = nodes[0];
+  // The points by coordinate (GCC does not vectorise the vec3s' stride-3 loads).
+  constexpr size_t kMax = 256;  // LightTree::choose_many's chunk
+  float px[kMax], py[kMax], pz[kMax], nx[kMax], ny[kMax], nz[kMax];
+  float none[kMax];
+  for (size_t k = 0; k < m; ++k) {
+    px[k] = p[k].x, py[k] = p[k].y, pz[k] = p[k].z;
+    nx[k] = normal[k].x, ny[k] = normal[k].y, nz[k] = normal[k].z;
+    none[k] = no_normal(normal[k]);
+  }
+  for (int s = 0; s < LightTreeNode::kWide; ++s) {
+    float* __restrict out = scratch + size_t(s) * m;
+    for (size_t k = 0; k < m; ++k)
+      out[k] = slot_importance(root, s, px[k], py[k], pz[k], nx[k], ny[k], nz[k], none[k]);
+  }
+  for (size_t k = 0; k < m; ++k) slots[k] = walk_step<0>(scratch + k, m, true, &u[k], &pmf[k]);
+  return walk_moves(nodes, m, at, slots, pmf, light);
 }
 
 }  // namespace
@@ -372,6 +422,8 @@ void LightTree::choose_many(size_t n, const vec3* p, const vec3* normal, const f
       pmf[base + k] = 1.f;
       at[k] = 0;
     }
+    walking = light_tree_walk_root(nodes_.data(), m, at, p + base, normal + base, walk_u, pmf + base,
+                                   light + base, scratch, slots);
     while (walking > 0)
       walking = light_tree_walk_level(nodes_.data(), m, at, p + base, normal + base, walk_u,
                                       pmf + base, light + base, scratch, slots);
