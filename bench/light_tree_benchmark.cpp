@@ -10,6 +10,7 @@
 #include <random>
 #include <vector>
 
+#include "renderer/core/flush_denormals.h"
 #include "renderer/lights/light_tree.h"
 
 namespace {
@@ -74,6 +75,7 @@ void BM_ChooseMany(benchmark::State& state) {
   std::vector<int> light(total);
   std::vector<float> pmf(total);
   size_t at = 0;
+  const penumbra::FlushDenormals flush_denormals;  // as the render threads run
   for (auto _ : state) {
     tree.choose_many(chunk, p.data() + at, normal.data() + at, u.data() + at, light.data() + at,
                      pmf.data() + at);
