@@ -293,8 +293,8 @@ namespace {
 // the point. Branch-free, so that a loop over the points runs in SIMD lanes: which slot it is
 // is random, and a branch on it would be mispredicted half the time.
 template <size_t kStride = 1>
-[[gnu::always_inline]] inline int walk_step(const float* __restrict in, size_t stride, bool active,
-                                            float* __restrict u, float* __restrict pmf) {
+[[gnu::always_inline]] inline int walk_step(const float* __restrict in, size_t stride, float* __restrict u,
+                                            float* __restrict pmf) {
   constexpr int kWide = LightTreeNode::kWide;
   float imp[kWide], cum[kWide];
   float total = 0.f;
@@ -317,64 +317,65 @@ template <size_t kStride = 1>
   const bool found = total > 0.f;
   const float next_u = std::clamp((target - below) / chosen, 0.f, kOneMinusEpsilon);
   const float next_pmf = *pmf * (chosen / total);
-  *u = active && found ? next_u : *u;
-  *pmf = active && found ? next_pmf : *pmf;
+  *u = found ? next_u : *u;
+  *pmf = found ? next_pmf : *pmf;
   return found ? slot : -1;
 }
 
-// The moves of a level's walks to the slots chosen (slots[k]): a point that reaches a light or
-// finds nothing stops (at[k] = -1). Returns how many go on.
-[[gnu::always_inline]] inline size_t walk_moves(const LightTreeNode* nodes, size_t m, int32_t* __restrict at,
-                                                const int32_t* __restrict slots, float* __restrict pmf,
-                                                int* __restrict light) {
+// The moves of a level's a walking points (place j: point index[j] at node at[j], its u and
+// probability u[j], prob[j]) to the slots chosen (slots[j]): a point that reaches a light or
+// finds nothing stops (light and pmf by its index); the others, at their child, are packed to
+// the front in order. Returns how many go on.
+[[gnu::always_inline]] inline size_t walk_moves(const LightTreeNode* nodes, size_t a, int32_t* __restrict at,
+                                                int32_t* __restrict index, float* __restrict u,
+                                                float* __restrict prob, const int32_t* __restrict slots,
+                                                float* __restrict pmf, int* __restrict light) {
   size_t walking = 0;
-  for (size_t k = 0; k < m; ++k) {
-    if (at[k] < 0) continue;
-    const int slot = slots[k];
-    const int32_t child = slot >= 0 ? nodes[size_t(at[k])].child[slot] : 0;
+  for (size_t j = 0; j < a; ++j) {
+    const int slot = slots[j];
+    const size_t k = size_t(index[j]);
+    const int32_t child = slot >= 0 ? nodes[size_t(at[j])].child[slot] : 0;
     if (slot < 0) {
       light[k] = -1;
       pmf[k] = 0.f;
-      at[k] = -1;
     } else if (child < 0) {
       light[k] = -1 - child;
-      at[k] = -1;
+      pmf[k] = prob[j];
     } else {
-      at[k] = child;
+      at[walking] = child, index[walking] = int32_t(k), u[walking] = u[j], prob[walking] = prob[j];
       ++walking;
     }
   }
   return walking;
 }
 
-// A level of the walks of m points (LightTree::choose_many): each point at a node (at[k] >= 0)
-// takes its step. Returns how many go on. In three passes: the importances of every point's
-// node (in this function's SIMD width, across the node's slots) into `scratch` (m x kWide
-// floats); every point's choice of a slot (in SIMD lanes across the points) into `slots`; then
-// the moves to the chosen children. Each pass's work per point is a short chain independent of
-// the other points', which the core overlaps (one pass per point was a chain of all, mostly
-// waiting).
+// A level of the walks of the a points still walking (LightTree::choose_many; packed as
+// walk_moves leaves them): each takes its step. Returns how many go on. In three passes: the
+// importances of every point's node (in this function's SIMD width, across the node's slots)
+// into `scratch` (a x kWide floats); every point's choice of a slot (in SIMD lanes across the
+// points) into `slots`; then the moves to the chosen children. Each pass's work per point is a
+// short chain independent of the other points', which the core overlaps (one pass per point
+// was a chain of all, mostly waiting).
 PENUMBRA_SIMD_CLONES
-size_t light_tree_walk_level(const LightTreeNode* nodes, size_t m, int32_t* __restrict at,
-                             const vec3* p, const vec3* normal, float* __restrict u,
-                             float* __restrict pmf, int* __restrict light,
-                             float* __restrict scratch, int32_t* __restrict slots) {
-  for (size_t k = 0; k < m; ++k)
-    if (at[k] >= 0)
-      node_importance(nodes[size_t(at[k])], p[k], normal[k], scratch + k * LightTreeNode::kWide);
-  for (size_t k = 0; k < m; ++k)
-    slots[k] = walk_step<1>(scratch + k * LightTreeNode::kWide, 1, at[k] >= 0, &u[k], &pmf[k]);
-  return walk_moves(nodes, m, at, slots, pmf, light);
+size_t light_tree_walk_level(const LightTreeNode* nodes, size_t a, int32_t* __restrict at,
+                             int32_t* __restrict index, const vec3* p, const vec3* normal,
+                             float* __restrict u, float* __restrict prob, float* __restrict pmf,
+                             int* __restrict light, float* __restrict scratch, int32_t* __restrict slots) {
+  for (size_t j = 0; j < a; ++j)
+    node_importance(nodes[size_t(at[j])], p[index[j]], normal[index[j]], scratch + j * LightTreeNode::kWide);
+  for (size_t j = 0; j < a; ++j) slots[j] = walk_step<1>(scratch + j * LightTreeNode::kWide, 1, &u[j], &prob[j]);
+  return walk_moves(nodes, a, at, index, u, prob, slots, pmf, light);
 }
 
-// The first level, where every point is at the root: the importances in SIMD lanes across the
-// points, slot by slot (the root's fields the same in every lane), into `scratch` by slot
-// (slot x m + k); then the choices and moves as light_tree_walk_level's.
+// The first level, where all m points are at the root (at[k] = 0, index[k] = k): the
+// importances in SIMD lanes across the points, slot by slot (the root's fields the same in
+// every lane), into `scratch` by slot (slot x m + k); then the choices and moves as
+// light_tree_walk_level's.
 PENUMBRA_SIMD_CLONES
 size_t light_tree_walk_root(const LightTreeNode* nodes, size_t m, int32_t* __restrict at,
-                            const vec3* p, const vec3* normal, float* __restrict u,
-                            float* __restrict pmf, int* __restrict light,
-                            float* __restrict scratch, int32_t* __restrict slots) {
+                            int32_t* __restrict index, const vec3* p, const vec3* normal,
+                            float* __restrict u, float* __restrict prob, float* __restrict pmf,
+                            int* __restrict light, float* __restrict scratch, int32_t* __restrict slots) {
   const LightTreeNode& root = nodes[0];
   // The points by coordinate (GCC does not vectorise the vec3s' stride-3 loads).
   constexpr size_t kMax = 256;  // LightTree::choose_many's chunk
@@ -390,8 +391,8 @@ size_t light_tree_walk_root(const LightTreeNode* nodes, size_t m, int32_t* __res
     for (size_t k = 0; k < m; ++k)
       out[k] = slot_importance(root, s, px[k], py[k], pz[k], nx[k], ny[k], nz[k], none[k]);
   }
-  for (size_t k = 0; k < m; ++k) slots[k] = walk_step<0>(scratch + k, m, true, &u[k], &pmf[k]);
-  return walk_moves(nodes, m, at, slots, pmf, light);
+  for (size_t k = 0; k < m; ++k) slots[k] = walk_step<0>(scratch + k, m, &u[k], &prob[k]);
+  return walk_moves(nodes, m, at, index, u, prob, slots, pmf, light);
 }
 
 }  // namespace
@@ -408,25 +409,25 @@ void LightTree::choose_many(size_t n, const vec3* p, const vec3* normal, const f
     for (size_t k = 0; k < n; ++k) light[k] = -1, pmf[k] = 0.f;
     return;
   }
-  // Per point: its node (light[k] while walking), its u (in a buffer) and its probability.
+  // The walking points packed to the front: each one's node, index, u and probability.
   constexpr size_t kChunk = 256;
-  float walk_u[kChunk];
-  int32_t at[kChunk];
+  float walk_u[kChunk], walk_prob[kChunk];
+  int32_t at[kChunk], index[kChunk];
   alignas(32) float scratch[kChunk * LightTreeNode::kWide];
   int32_t slots[kChunk];
   for (size_t base = 0; base < n; base += kChunk) {
     const size_t m = std::min(kChunk, n - base);
-    size_t walking = m;
     for (size_t k = 0; k < m; ++k) {
       walk_u[k] = u[base + k];
-      pmf[base + k] = 1.f;
+      walk_prob[k] = 1.f;
       at[k] = 0;
+      index[k] = int32_t(k);
     }
-    walking = light_tree_walk_root(nodes_.data(), m, at, p + base, normal + base, walk_u, pmf + base,
-                                   light + base, scratch, slots);
+    size_t walking = light_tree_walk_root(nodes_.data(), m, at, index, p + base, normal + base, walk_u,
+                                          walk_prob, pmf + base, light + base, scratch, slots);
     while (walking > 0)
-      walking = light_tree_walk_level(nodes_.data(), m, at, p + base, normal + base, walk_u,
-                                      pmf + base, light + base, scratch, slots);
+      walking = light_tree_walk_level(nodes_.data(), walking, at, index, p + base, normal + base, walk_u,
+                                      walk_prob, pmf + base, light + base, scratch, slots);
   }
 }
 
