@@ -285,13 +285,17 @@ int LightTree::collapse(const std::vector<Binary>& binary, int root, int parent,
 
 namespace {
 
-// One level of the walk of point k (of m), given its node's importances imp[slot x stride]: the slot u[k] selects, the interval [cum[slot - 1], cum[slot]) of the
-// prefix sums that holds u[k] x total, found by counting the intervals that end at or below it
-// (a slot of importance 0 has an empty interval and is never the one; rounding past the last
-// interval falls to the last nonempty one). u[k] becomes its place within that interval and
-// pmf[k] is multiplied by the slot's probability. Returns the slot, -1 where nothing reaches
-// the point. Branch-free, so that a loop over the points runs in SIMD lanes: which slot it is
-// is random, and a branch on it would be mispredicted half the time.
+// choose_many walks up to this many points at once (its buffers are on the stack).
+constexpr size_t kWalkChunk = 256;
+
+// One level of a point's walk, given its node's importances in[slot x stride] (stride kStride,
+// or `stride` where kStride is 0): the slot *u selects, the interval [cum[slot - 1], cum[slot])
+// of the prefix sums that holds *u x total, found by counting the intervals that end at or
+// below it (a slot of importance 0 has an empty interval and is never the one; rounding past
+// the last interval falls to the last nonempty one). *u becomes its place within that interval
+// and *pmf is multiplied by the slot's probability. Returns the slot, -1 where nothing reaches
+// the point (*u and *pmf then as they were). Branch-free, so that a loop over the points runs in
+// SIMD lanes: which slot it is is random, and a branch on it would be mispredicted half the time.
 template <size_t kStride = 1>
 [[gnu::always_inline]] inline int walk_step(const float* __restrict in, size_t stride, float* __restrict u,
                                             float* __restrict pmf) {
@@ -378,7 +382,7 @@ size_t light_tree_walk_root(const LightTreeNode* nodes, size_t m, int32_t* __res
                             int* __restrict light, float* __restrict scratch, int32_t* __restrict slots) {
   const LightTreeNode& root = nodes[0];
   // The points by coordinate (GCC does not vectorise the vec3s' stride-3 loads).
-  constexpr size_t kMax = 256;  // LightTree::choose_many's chunk
+  constexpr size_t kMax = kWalkChunk;  // m's bound (choose_many's chunks)
   float px[kMax], py[kMax], pz[kMax], nx[kMax], ny[kMax], nz[kMax];
   float none[kMax];
   for (size_t k = 0; k < m; ++k) {
@@ -410,7 +414,7 @@ void LightTree::choose_many(size_t n, const vec3* p, const vec3* normal, const f
     return;
   }
   // The walking points packed to the front: each one's node, index, u and probability.
-  constexpr size_t kChunk = 256;
+  constexpr size_t kChunk = kWalkChunk;
   float walk_u[kChunk], walk_prob[kChunk];
   int32_t at[kChunk], index[kChunk];
   alignas(32) float scratch[kChunk * LightTreeNode::kWide];
