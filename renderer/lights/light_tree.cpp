@@ -288,22 +288,21 @@ namespace {
 // choose_many walks up to this many points at once (its buffers are on the stack).
 constexpr size_t kWalkChunk = 256;
 
-// One level of a point's walk, given its node's importances in[slot x stride] (stride kStride,
-// or `stride` where kStride is 0): the slot *u selects, the interval [cum[slot - 1], cum[slot])
-// of the prefix sums that holds *u x total, found by counting the intervals that end at or
-// below it (a slot of importance 0 has an empty interval and is never the one; rounding past
-// the last interval falls to the last nonempty one). *u becomes its place within that interval
-// and *pmf is multiplied by the slot's probability. Returns the slot, -1 where nothing reaches
-// the point (*u and *pmf then as they were). Branch-free, so that a loop over the points runs in
-// SIMD lanes: which slot it is is random, and a branch on it would be mispredicted half the time.
-template <size_t kStride = 1>
+// One level of a point's walk, given its node's importances in[slot x stride]: the slot *u
+// selects, the interval [cum[slot - 1], cum[slot]) of the prefix sums that holds *u x total,
+// found by counting the intervals that end at or below it (a slot of importance 0 has an empty
+// interval and is never the one; rounding past the last interval falls to the last nonempty
+// one). *u becomes its place within that interval and *pmf is multiplied by the slot's
+// probability. Returns the slot, -1 where nothing reaches the point (*u and *pmf then as they
+// were). Branch-free, so that a loop over the points runs in SIMD lanes: which slot it is is
+// random, and a branch on it would be mispredicted half the time.
 [[gnu::always_inline]] inline int walk_step(const float* __restrict in, size_t stride, float* __restrict u,
                                             float* __restrict pmf) {
   constexpr int kWide = LightTreeNode::kWide;
   float imp[kWide], cum[kWide];
   float total = 0.f;
   for (int s = 0; s < kWide; ++s) {
-    imp[s] = in[size_t(s) * (kStride ? kStride : stride)];
+    imp[s] = in[size_t(s) * stride];
     cum[s] = total += imp[s];
   }
   const float target = *u * total;
@@ -367,7 +366,7 @@ size_t light_tree_walk_level(const LightTreeNode* nodes, size_t a, int32_t* __re
                              int* __restrict light, float* __restrict scratch, int32_t* __restrict slots) {
   for (size_t j = 0; j < a; ++j)
     node_importance(nodes[size_t(at[j])], p[index[j]], normal[index[j]], scratch + j * LightTreeNode::kWide);
-  for (size_t j = 0; j < a; ++j) slots[j] = walk_step<1>(scratch + j * LightTreeNode::kWide, 1, &u[j], &prob[j]);
+  for (size_t j = 0; j < a; ++j) slots[j] = walk_step(scratch + j * LightTreeNode::kWide, 1, &u[j], &prob[j]);
   return walk_moves(nodes, a, at, index, u, prob, slots, pmf, light);
 }
 
@@ -395,7 +394,7 @@ size_t light_tree_walk_root(const LightTreeNode* nodes, size_t m, int32_t* __res
     for (size_t k = 0; k < m; ++k)
       out[k] = slot_importance(root, s, px[k], py[k], pz[k], nx[k], ny[k], nz[k], none[k]);
   }
-  for (size_t k = 0; k < m; ++k) slots[k] = walk_step<0>(scratch + k, m, &u[k], &prob[k]);
+  for (size_t k = 0; k < m; ++k) slots[k] = walk_step(scratch + k, m, &u[k], &prob[k]);
   return walk_moves(nodes, m, at, index, u, prob, slots, pmf, light);
 }
 

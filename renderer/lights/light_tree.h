@@ -38,11 +38,12 @@ struct alignas(32) LightTreeNode {
   float cos_o[kWide], sin_o[kWide], cos_e[kWide];
   float phi[kWide];
   float two_sided[kWide], all_directions[kWide];  // 1 or 0
-  // Normals all one way (cos_o = 1: panels) and one-sided: 1, and where along the axis from the centre a point
-  // is behind or in every emitter's plane: at or below -(sum |axis_i| x half extent_i), plus a
-  // slack of 1e-5 of the box's size and distance from the origin (hit points on a panel itself
-  // lie in its plane only to their rounding). Such points are out of reach even inside the
-  // bounding sphere. (Gaps that thin are below any renderer's ray offset, Mitsuba's is 1e-4.)
+  // Normals all one way (cos_o = 1: panels) and one-sided: 1, and where along the axis from the
+  // centre a point is behind or in every emitter's plane: at or below -(sum |axis_i| x half
+  // extent_i), plus a slack of 1e-5 of the box's size and distance from the origin (hit points
+  // on a panel itself lie in its plane only to their rounding). Such points are out of reach
+  // even inside the bounding sphere. (Gaps that thin are below any renderer's ray offset,
+  // Mitsuba's is 1e-4.)
   float one_way[kWide], behind_at[kWide];
   int32_t child[kWide];  // >= 0: a node; < 0: the light -1 - child
   int32_t parent = -1, parent_slot = -1;
