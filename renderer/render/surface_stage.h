@@ -95,6 +95,9 @@ class SurfaceStage {
                    uint8_t* goes_on, uint8_t* has_shadow, ShadowQuery* shadows,
                    std::vector<uint32_t>* unstaged) const;
   uint32_t slot(size_t lane) const { return slot_[lane]; }
+  // Whether the step reads a bounce's Russian roulette value at the lobe pair's first dimension
+  // (its lobes are all Dirac: path_scatter takes lobe and direction at the light pair's place).
+  bool roulette_at_lobe_dimension() const { return !estimates_light(true); }
 
  private:
   // Whether path_scatter estimates direct light at this model's surfaces (given lights): not

@@ -39,6 +39,7 @@ void make_stages(const Scene& scene, PathBatch& b) {
   b.stages_.clear();
   b.stage_of_.assign(scene.object_count(), -1);
   b.lobe_choices_ = false;
+  b.roulette_at_lobe_ = false;
   for (StageModel model : kStageModels) {
     auto stage = std::make_unique<SurfaceStage>(scene, model);
     bool used = false;
@@ -49,13 +50,19 @@ void make_stages(const Scene& scene, PathBatch& b) {
     }
     if (used) {
       b.lobe_choices_ = b.lobe_choices_ || stage->needs_lobe_choice();
+      b.roulette_at_lobe_ = b.roulette_at_lobe_ || stage->roulette_at_lobe_dimension();
       b.stages_.push_back(std::move(stage));
     }
   }
   b.queues_.resize(b.stages_.size());
   for (PathBatch::StageQueue& q : b.queues_) q.reserve(b.capacity_);
   // Surfaces no stage takes step through path_scatter, which may pick a lobe.
-  for (uint32_t o = 0; o < scene.object_count(); ++o) b.lobe_choices_ = b.lobe_choices_ || b.stage_of_[o] < 0;
+  // (Their Dirac surfaces read the roulette value where the lobe pair starts: through
+  // PrefetchedSampler, which has it from the sampler when it was not computed, at a cost.)
+  for (uint32_t o = 0; o < scene.object_count(); ++o) {
+    b.lobe_choices_ = b.lobe_choices_ || b.stage_of_[o] < 0;
+    b.roulette_at_lobe_ = b.roulette_at_lobe_ || b.stage_of_[o] < 0;
+  }
   b.staged_scene_ = &scene;
 }
 
@@ -113,13 +120,16 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
       // Dirac (it estimates no light: a smooth dielectric picks reflection or refraction there).
       const LightSampler& lights = next_event_lights<kDistributed>(scene);
       const bool light_pairs = lights.cdf().size() > 1 || lights.spatial();
+      // The stages read the pairs' first dimensions only as the pairs' 1D values, but for the
+      // roulette of Dirac surfaces at the lobe's (SurfaceStage::add_many).
+      const uint32_t unread_x = kStages ? (b.roulette_at_lobe_ ? 0b00001u : 0b00101u) : 0u;
       samples.start(hit_count, BounceSamples::kBounce, BounceSamples::kBouncePairs,
                     (light_pairs || lobe_pairs ? 0b00001u : 0u) | (lobe_pairs ? 0b00100u : 0u),
-                    BounceSamples::kBounceTwoD);
+                    BounceSamples::kBounceTwoD, unread_x);
     } else {
       samples.start(hit_count, BounceSamples::kBounceWithoutLight,
                     BounceSamples::kBounceWithoutLightPairs, lobe_pairs ? 0b001u : 0u,
-                    BounceSamples::kBounceWithoutLightTwoD);
+                    BounceSamples::kBounceWithoutLightTwoD, kStages ? 0b001u : 0u);
     }
     for (size_t j = 0; j < hit_count; ++j) {
       const uint32_t p = live[hit_slots[j]];

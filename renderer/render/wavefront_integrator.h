@@ -83,6 +83,7 @@ class PathBatch {
   using StageQueue = std::vector<uint32_t>;
   std::vector<StageQueue> queues_;
   bool lobe_choices_ = true;      // whether a surface of the scene may pick among lobes
+  bool roulette_at_lobe_ = true;  // whether a step may read a bounce's lobe dimension as a 1D value
   std::vector<uint8_t> goes_on_, has_shadow_;  // per live path of the bounce
   std::vector<uint32_t> hit_of_;               // per live path: its index among the hits
   std::vector<uint32_t> hit_slots_, miss_slots_;  // the live paths' slots with a hit, without

@@ -95,16 +95,21 @@ inline uint32_t cmj_y(uint32_t cell, uint32_t bits, uint32_t seed_y) {
 // plastics and 0.95-0.99 on the furnace, where the lobe choice matters, 0.50-0.80 on
 // all_lights; a simpler split of the value by blocks of neighbouring cells lost to it on
 // motion_blur (1.15 at 256 spp) and the furnace (1.05).
-inline uint32_t cmj_z(uint32_t cell, uint32_t bits, uint32_t seed_z) {
+// cmj_z given its rows' seed, cmj_z_rows_seed(seed_z): the batch kernels take that once per
+// pixel and dimension instead of once per sample.
+inline uint32_t cmj_z_rows_seed(uint32_t seed_z) { return cmj_hash(seed_z, kCmjRowSeed); }
+inline uint32_t cmj_z_with_rows(uint32_t cell, uint32_t bits, uint32_t seed_z, uint32_t seed_rows) {
   const uint32_t a = cmj_column_bits(bits), c = bits - a;
   const uint32_t column = cell & ((1u << a) - 1u), row = cell >> a;
-  const uint32_t seed_rows = cmj_hash(seed_z, kCmjRowSeed);
   const uint32_t pi_column = cmj_permute(column, (1u << a) - 1u, seed_z);
   const uint32_t f = (pi_column << (c - a)) ^ cmj_permute(row, (1u << c) - 1u, seed_rows);
   // The fine stratum: the column's place in pi_m offset by a random number (a permutation of
   // the columns too).
   const uint32_t fine = (pi_column + (seed_rows >> 16)) & ((1u << a) - 1u);
   return cmj_fixed((f << a) | fine, cmj_hash(cell, seed_z), bits);
+}
+inline uint32_t cmj_z(uint32_t cell, uint32_t bits, uint32_t seed_z) {
+  return cmj_z_with_rows(cell, bits, seed_z, cmj_z_rows_seed(seed_z));
 }
 
 // Whether a render of spp samples per pixel can take CMJ points: spp a power of two (a prefix of

@@ -39,7 +39,10 @@ void scrambled_sobol_z_batch_portable(size_t n, const uint32_t* index, const uin
 void cmj_cells_x_batch(size_t n, uint32_t bits, const uint32_t* index, const uint32_t* seed_index,
                        const uint32_t* seed_x, uint32_t* cell, float* x);
 void cmj_y_batch(size_t n, uint32_t bits, const uint32_t* cell, const uint32_t* seed_y, float* y);
-void cmj_z_batch(size_t n, uint32_t bits, const uint32_t* cell, const uint32_t* seed_z, float* z);
+// (cmj_z_batch takes each entry's seed_rows[i] = cmj_z_rows_seed(seed_z[i]), which is the same
+// for a run of one pixel's samples.)
+void cmj_z_batch(size_t n, uint32_t bits, const uint32_t* cell, const uint32_t* seed_z, const uint32_t* seed_rows,
+                 float* z);
 
 // How many pairs start below dimension j: the bits of `pairs` under bit j. Shifts and adds
 // rather than std::popcount, which a baseline x86-64 build (no POPCNT) makes a call into
@@ -86,17 +89,22 @@ class BounceSamples {
   // (and the pairs' second ones), their get_2d values. A path reading a 2D value elsewhere takes
   // it from its sampler (PrefetchedSampler): the second coordinate of a correlated
   // multi-jittered point costs about what the first does, and a bounce reads two of five.
+  // `unread_x`: first dimensions of pairs whose get_1d value the caller's stages do not read
+  // (CMJ points leave their cells and x out; a path that asks for one anyway gets it from its
+  // sampler, PrefetchedSampler).
   void start(size_t paths, int per_path = kBounce, uint32_t pairs = 0, uint32_t computed = 0,
-             uint32_t two_d = ~0u) {
+             uint32_t two_d = ~0u, uint32_t unread_x = 0u) {
     per_path_ = per_path;
     stride_ = paths;
     // A pair needs its 2D dimension among the prefetched ones.
     pairs_ = per_path > 1 ? pairs & ((uint32_t(1) << (per_path - 1)) - 1u) : 0u;
     computed_ = computed & pairs_;
     two_d_ = two_d | (pairs_ << 1);
+    unread_x_ = unread_x & pairs_ & ~two_d_;
     const size_t nz = paths * size_t(std::popcount(pairs_));
     if (z_seed_index_.size() < nz) {
       z_seed_index_.resize(nz);
+      z_seed_rows_.resize(nz);
       z_seed_.resize(nz);
       z_.resize(nz);
     }
@@ -139,10 +147,12 @@ class BounceSamples {
   void compute() {
     // Each run's seeds over its entries: dimension j's (x and y) and, for a computed pair
     // starting at j, its 2D dimension's index shuffle and its own dimension's x seed (z).
+    const uint32_t one_d = this->one_d();
     for (size_t r = 0; r < runs_.size(); ++r) {
       const Run& run = runs_[r];
       const size_t seeds = r * size_t(per_path_);
       for (int j = 0; j < per_path_; ++j) {
+        if (!((one_d >> j) & 1u)) continue;
         const size_t e = size_t(j) * stride_ + run.first;
         std::fill_n(seed_index_.data() + e, run.count, run_seed_index_[seeds + size_t(j)]);
         std::fill_n(seed_x_.data() + e, run.count, run_seed_x_[seeds + size_t(j)]);
@@ -152,14 +162,18 @@ class BounceSamples {
         const int j = std::countr_zero(bits);
         const size_t q = size_t(pair_index(j)) * stride_ + run.first;
         // (CMJ points take a pair's 1D value from its 2D dimension's cells, not its shuffle.)
-        if (!cmj_bits_)
+        const uint32_t seed_z = run_seed_x_[seeds + size_t(j)];
+        if (cmj_bits_)
+          std::fill_n(z_seed_rows_.data() + q, run.count, cmj_z_rows_seed(seed_z));
+        else
           std::fill_n(z_seed_index_.data() + q, run.count, run_seed_index_[seeds + size_t(j) + 1]);
-        std::fill_n(z_seed_.data() + q, run.count, run_seed_x_[seeds + size_t(j)]);
+        std::fill_n(z_seed_.data() + q, run.count, seed_z);
       }
     }
     // data() + e, not &v[e]: a step with no paths has empty vectors (e = 0).
     if (cmj_bits_) {
       for (int j = 0; j < per_path_; ++j) {
+        if (!((one_d >> j) & 1u)) continue;
         const size_t e = size_t(j) * stride_;
         cmj_cells_x_batch(paths_, cmj_bits_, path_index_.data(), seed_index_.data() + e, seed_x_.data() + e,
                           cell_.data() + e, x_.data() + e);
@@ -169,7 +183,8 @@ class BounceSamples {
       for (uint32_t bits = computed_; bits; bits &= bits - 1) {
         const int j = std::countr_zero(bits);
         const size_t q = size_t(pair_index(j)) * stride_;
-        cmj_z_batch(paths_, cmj_bits_, cell_.data() + size_t(j + 1) * stride_, z_seed_.data() + q, z_.data() + q);
+        cmj_z_batch(paths_, cmj_bits_, cell_.data() + size_t(j + 1) * stride_, z_seed_.data() + q,
+                    z_seed_rows_.data() + q, z_.data() + q);
       }
       return;
     }
@@ -198,6 +213,11 @@ class BounceSamples {
   uint32_t pairs() const { return pairs_; }
   // The dimensions whose 2D values were computed (Sobol points: all of them).
   uint32_t two_d() const { return cmj_bits_ ? two_d_ : ~0u; }
+  // The dimensions whose x (get_1d) values were computed: with CMJ points all but start's
+  // `unread_x` (a bounce's light choice and lobe are read as their pairs' z where anyone reads
+  // them: their own cells and x would be two of a bounce's five cell permutations, unread); with
+  // Sobol points all (its kernel makes x and y together, and costs a fraction of CMJ's).
+  uint32_t one_d() const { return cmj_bits_ ? ~unread_x_ : ~0u; }
   uint32_t computed_pairs() const { return computed_; }
   // Which pair starts at dimension j (j a bit of pairs).
   int pair_index(int j) const { return pairs_below(pairs_, j); }
@@ -225,14 +245,14 @@ class BounceSamples {
     size_t first, count;
   };
   int per_path_ = kBounce;
-  uint32_t pairs_ = 0, computed_ = 0, two_d_ = ~0u, cmj_bits_ = 0;
+  uint32_t pairs_ = 0, computed_ = 0, two_d_ = ~0u, unread_x_ = 0, cmj_bits_ = 0;
   size_t paths_ = 0, stride_ = 0;
   std::vector<Run> runs_;
   std::vector<uint32_t> run_seed_index_, run_seed_x_, run_seed_y_;  // per_path per run
   std::vector<uint32_t> seed_index_, seed_x_, seed_y_;
   std::vector<float> x_, y_;
   std::vector<uint32_t> cell_;  // CMJ points: each entry's cell (cmj_cell)
-  std::vector<uint32_t> path_index_, z_seed_index_, z_seed_;
+  std::vector<uint32_t> path_index_, z_seed_index_, z_seed_, z_seed_rows_;
   std::vector<float> z_;
 };
 
@@ -251,12 +271,13 @@ class PrefetchedSampler {
         count_(samples.per_path()),
         pairs_(samples.pairs()),
         computed_(samples.computed_pairs()),
-        two_d_(samples.two_d()) {}
+        two_d_(samples.two_d()),
+        one_d_(samples.one_d()) {}
 
   // The prefetched values inline, the rare rest out of line: inlined whole, the fallback's
   // sampler code made GCC call these from the bounce step instead.
   [[gnu::always_inline]] float get_1d() {
-    if (used_ < count_) {
+    if (used_ < count_ && ((one_d_ >> used_) & 1u)) {
       ++cursor_.dimension;
       return x_[size_t(used_++) * stride_];
     }
@@ -296,6 +317,7 @@ class PrefetchedSampler {
     sampler_.resume(cursor_);
     const float u = sampler_.get_1d();
     cursor_ = sampler_.cursor();
+    ++used_;  // (a prefetched dimension whose x was not computed: the next stays aligned)
     return u;
   }
   [[gnu::noinline]] vec2 fallback_2d() {
@@ -313,7 +335,7 @@ class PrefetchedSampler {
   const float* z_;
   size_t stride_;
   int count_;
-  uint32_t pairs_, computed_, two_d_;
+  uint32_t pairs_, computed_, two_d_, one_d_;
   int used_ = 0;
 };
 

@@ -107,7 +107,9 @@ TEST(SobolBatch, CmjKernelsAreTheDefinitionsToTheBit) {
       std::vector<uint32_t> cells(n + 16, 7u);
       cmj_cells_x_batch(n, bits, index.data(), si.data(), sx.data(), cells.data(), x.data());
       cmj_y_batch(n, bits, cells.data(), sy.data(), y.data());
-      cmj_z_batch(n, bits, cells.data(), sx.data(), z.data());
+      std::vector<uint32_t> rows(n);
+      for (size_t i = 0; i < n; ++i) rows[i] = cmj_z_rows_seed(sx[i]);
+      cmj_z_batch(n, bits, cells.data(), sx.data(), rows.data(), z.data());
       for (size_t i = 0; i < n; ++i) {
         const uint32_t cell = cmj_cell(index[i], bits, si[i]);
         ASSERT_EQ(cells[i], cell) << bits << " " << i;
@@ -261,39 +263,43 @@ TEST(SobolBatch, RunsOfSamplesSeeTheirSamplers) {
 // roulette's plain 1D value at 2, where the layout has the lobe pair), a pair where none was
 // laid out (dimension 1), with every subset of the pairs computed, 2D values computed only where
 // a bounce reads them (2D values at dimensions 0 and 4 come from the sampler, and the values
-// after them from the prefetched ones again): the values a Sampler
-// gives, with the Sobol points and with CMJ's (32 samples).
+// after them from the prefetched ones again), the pairs' own x left out or not (1D values read
+// there come from the sampler): the values a Sampler gives, with the Sobol points and with
+// CMJ's (32 samples).
 TEST(SobolBatch, PrefetchedPairsSeeTheSamplersSequence) {
   constexpr int kPaths = 5;
   const int patterns[4][4] = {{3, 3, 1, 0}, {3, 1, 1, 2}, {1, 3, 2, 1}, {2, 2, 1, 1}};
   const int takes[4] = {3, 4, 4, 4};
   for (uint32_t computed = 0; computed < 16; ++computed) {
     for (int which = 0; which < 4; ++which) {
-      const uint32_t cmj_bits = computed >= 8 ? 5u : 0u;
-      SCOPED_TRACE(testing::Message() << "computed " << computed % 8 << ", pattern " << which << ", cmj " << cmj_bits);
-      Sampler shared(9, cmj_bits), alone(9, cmj_bits);
-      std::vector<Sampler::Cursor> cursors;
-      for (int p = 0; p < kPaths; ++p) {
-        shared.start_pixel_sample(4, 1, uint32_t(p * 7 + 1));
-        for (int d = 0; d < p; ++d) shared.get_1d();  // paths at different dimensions
-        cursors.push_back(shared.cursor());
-      }
-      BounceSamples samples;
-      samples.start(kPaths, BounceSamples::kBounce, BounceSamples::kBouncePairs, computed % 8,
-                    BounceSamples::kBounceTwoD);
-      for (int p = 0; p < kPaths; ++p) samples.add(shared, cursors[p]);
-      samples.compute();
-      for (int p = 0; p < kPaths; ++p) {
-        std::vector<float> got, expected;
-        PrefetchedSampler s(shared, cursors[p], samples, size_t(p));
-        take(s, patterns[which], takes[which], &got);
-        alone.start_pixel_sample(4, 1, uint32_t(p * 7 + 1));
-        for (int d = 0; d < p; ++d) alone.get_1d();
-        take(alone, patterns[which], takes[which], &expected);
-        EXPECT_EQ(s.cursor().dimension, alone.cursor().dimension);
-        ASSERT_EQ(got.size(), expected.size());
-        for (size_t i = 0; i < got.size(); ++i)
-          ASSERT_EQ(float_bits(got[i]), float_bits(expected[i])) << "path " << p << " value " << i;
+      for (uint32_t unread_x : {0u, 0b00001u, 0b00100u, 0b00101u}) {
+        const uint32_t cmj_bits = computed >= 8 ? 5u : 0u;
+        SCOPED_TRACE(testing::Message() << "computed " << computed % 8 << ", pattern " << which << ", cmj " << cmj_bits
+                                        << ", unread x " << unread_x);
+        Sampler shared(9, cmj_bits), alone(9, cmj_bits);
+        std::vector<Sampler::Cursor> cursors;
+        for (int p = 0; p < kPaths; ++p) {
+          shared.start_pixel_sample(4, 1, uint32_t(p * 7 + 1));
+          for (int d = 0; d < p; ++d) shared.get_1d();  // paths at different dimensions
+          cursors.push_back(shared.cursor());
+        }
+        BounceSamples samples;
+        samples.start(kPaths, BounceSamples::kBounce, BounceSamples::kBouncePairs, computed % 8,
+                      BounceSamples::kBounceTwoD, unread_x);
+        for (int p = 0; p < kPaths; ++p) samples.add(shared, cursors[p]);
+        samples.compute();
+        for (int p = 0; p < kPaths; ++p) {
+          std::vector<float> got, expected;
+          PrefetchedSampler s(shared, cursors[p], samples, size_t(p));
+          take(s, patterns[which], takes[which], &got);
+          alone.start_pixel_sample(4, 1, uint32_t(p * 7 + 1));
+          for (int d = 0; d < p; ++d) alone.get_1d();
+          take(alone, patterns[which], takes[which], &expected);
+          EXPECT_EQ(s.cursor().dimension, alone.cursor().dimension);
+          ASSERT_EQ(got.size(), expected.size());
+          for (size_t i = 0; i < got.size(); ++i)
+            ASSERT_EQ(float_bits(got[i]), float_bits(expected[i])) << "path " << p << " value " << i;
+        }
       }
     }
   }
