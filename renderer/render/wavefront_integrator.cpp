@@ -115,21 +115,27 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
     constexpr bool kStages = !kDistributed;
     if (kStages && b.staged_scene_ != &scene) make_stages(scene, b);
     const bool lobe_pairs = !kStages || b.lobe_choices_;
+    // Whether a path of this bounce plays Russian roulette (a batch's paths move in step, so
+    // at every depth all or none).
+    bool roulette = false;
+    for (size_t j = 0; j < hit_count; ++j) roulette |= b.states_[live[hit_slots[j]]].depth >= settings.rr_depth;
     if (next_event) {
       // Dimensions 0 and 1 are also the lobe and direction of a surface whose lobes are all
       // Dirac (it estimates no light: a smooth dielectric picks reflection or refraction there).
       const LightSampler& lights = next_event_lights<kDistributed>(scene);
       const bool light_pairs = lights.cdf().size() > 1 || lights.spatial();
       // The stages read the pairs' first dimensions only as the pairs' 1D values, but for the
-      // roulette of Dirac surfaces at the lobe's (SurfaceStage::add_many).
-      const uint32_t unread_x = kStages ? (b.roulette_at_lobe_ ? 0b00001u : 0b00101u) : 0u;
+      // roulette of Dirac surfaces at the lobe's (SurfaceStage::add_many), and the roulette
+      // value (dimension 4, or 2 at Dirac surfaces) only at a depth that plays it.
+      const uint32_t unread_x =
+          !kStages ? 0u : 0b00001u | (!roulette ? 0b10100u : b.roulette_at_lobe_ ? 0u : 0b00100u);
       samples.start(hit_count, BounceSamples::kBounce, BounceSamples::kBouncePairs,
                     (light_pairs || lobe_pairs ? 0b00001u : 0u) | (lobe_pairs ? 0b00100u : 0u),
                     BounceSamples::kBounceTwoD, unread_x);
     } else {
       samples.start(hit_count, BounceSamples::kBounceWithoutLight,
                     BounceSamples::kBounceWithoutLightPairs, lobe_pairs ? 0b001u : 0u,
-                    BounceSamples::kBounceWithoutLightTwoD, kStages ? 0b001u : 0u);
+                    BounceSamples::kBounceWithoutLightTwoD, !kStages ? 0u : roulette ? 0b001u : 0b101u);
     }
     for (size_t j = 0; j < hit_count; ++j) {
       const uint32_t p = live[hit_slots[j]];

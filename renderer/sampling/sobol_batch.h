@@ -89,9 +89,10 @@ class BounceSamples {
   // (and the pairs' second ones), their get_2d values. A path reading a 2D value elsewhere takes
   // it from its sampler (PrefetchedSampler): the second coordinate of a correlated
   // multi-jittered point costs about what the first does, and a bounce reads two of five.
-  // `unread_x`: first dimensions of pairs whose get_1d value the caller's stages do not read
-  // (CMJ points leave their cells and x out; a path that asks for one anyway gets it from its
-  // sampler, PrefetchedSampler).
+  // `unread_x`: dimensions whose get_1d value the caller's stages do not read (CMJ points leave
+  // their cells and x out; a path that asks for one anyway gets it from its sampler,
+  // PrefetchedSampler); dimensions whose 2D value is computed, or whose cells a pair's 1D value
+  // takes, keep theirs.
   void start(size_t paths, int per_path = kBounce, uint32_t pairs = 0, uint32_t computed = 0,
              uint32_t two_d = ~0u, uint32_t unread_x = 0u) {
     per_path_ = per_path;
@@ -100,7 +101,7 @@ class BounceSamples {
     pairs_ = per_path > 1 ? pairs & ((uint32_t(1) << (per_path - 1)) - 1u) : 0u;
     computed_ = computed & pairs_;
     two_d_ = two_d | (pairs_ << 1);
-    unread_x_ = unread_x & pairs_ & ~two_d_;
+    unread_x_ = unread_x & ~two_d_;
     const size_t nz = paths * size_t(std::popcount(pairs_));
     if (z_seed_index_.size() < nz) {
       z_seed_index_.resize(nz);
@@ -215,8 +216,9 @@ class BounceSamples {
   uint32_t two_d() const { return cmj_bits_ ? two_d_ : ~0u; }
   // The dimensions whose x (get_1d) values were computed: with CMJ points all but start's
   // `unread_x` (a bounce's light choice and lobe are read as their pairs' z where anyone reads
-  // them: their own cells and x would be two of a bounce's five cell permutations, unread); with
-  // Sobol points all (its kernel makes x and y together, and costs a fraction of CMJ's).
+  // them, its roulette value only from depth rr_depth on: their cells and x would be up to three
+  // of a bounce's five cell permutations, unread); with Sobol points all (its kernel makes x and
+  // y together, and costs a fraction of CMJ's).
   uint32_t one_d() const { return cmj_bits_ ? ~unread_x_ : ~0u; }
   uint32_t computed_pairs() const { return computed_; }
   // Which pair starts at dimension j (j a bit of pairs).

@@ -263,16 +263,16 @@ TEST(SobolBatch, RunsOfSamplesSeeTheirSamplers) {
 // roulette's plain 1D value at 2, where the layout has the lobe pair), a pair where none was
 // laid out (dimension 1), with every subset of the pairs computed, 2D values computed only where
 // a bounce reads them (2D values at dimensions 0 and 4 come from the sampler, and the values
-// after them from the prefetched ones again), the pairs' own x left out or not (1D values read
-// there come from the sampler): the values a Sampler gives, with the Sobol points and with
-// CMJ's (32 samples).
+// after them from the prefetched ones again), 1D values left out or not (the pairs' first
+// dimensions, the roulette's, all that may be: 1D values read there come from the sampler): the
+// values a Sampler gives, with the Sobol points and with CMJ's (32 samples).
 TEST(SobolBatch, PrefetchedPairsSeeTheSamplersSequence) {
   constexpr int kPaths = 5;
   const int patterns[4][4] = {{3, 3, 1, 0}, {3, 1, 1, 2}, {1, 3, 2, 1}, {2, 2, 1, 1}};
   const int takes[4] = {3, 4, 4, 4};
   for (uint32_t computed = 0; computed < 16; ++computed) {
     for (int which = 0; which < 4; ++which) {
-      for (uint32_t unread_x : {0u, 0b00001u, 0b00100u, 0b00101u}) {
+      for (uint32_t unread_x : {0u, 0b00001u, 0b00100u, 0b00101u, 0b10000u, 0b11111u}) {
         const uint32_t cmj_bits = computed >= 8 ? 5u : 0u;
         SCOPED_TRACE(testing::Message() << "computed " << computed % 8 << ", pattern " << which << ", cmj " << cmj_bits
                                         << ", unread x " << unread_x);
