@@ -2,11 +2,13 @@
 
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <new>
 #include <sstream>
 
 #include "api/diagnostics.h"
 #include "api/gltf_scene.h"
+#include "renderer/io/file_bytes.h"
 #include "renderer/io/gltf_file.h"
 #include "api/json_document.h"
 #include "api/render_overrides.h"
@@ -54,20 +56,37 @@ LoadResult load_scene_file(const std::string& path, const Limits& limits,
                            std::span<const RenderOverride> overrides) {
   // A glTF asset renders as the scene gltf_scene.h builds around it.
   if (is_gltf_file_name(path)) return load_gltf_scene_file(path, limits, overrides);
-  std::error_code ec;
-  std::ifstream file;
-  if (!std::filesystem::is_directory(path, ec)) file.open(path, std::ios::binary);
-  std::ostringstream text;
-  if (file.is_open()) text << file.rdbuf();
-  if (!file.is_open() || file.bad()) {
+  // Mapped, not copied (renderer/io/file_bytes.h): a scene with meshes inline is megabytes of
+  // JSON, and a copy through a stream cost a fresh page per 4 KB, several times over as it grew.
+  const auto cannot_read = [&path](const std::string& why) {
     LoadResult result;
     result.kind = LoadErrorKind::kInvalid;
-    result.errors.push_back({"", "cannot read file '" + path + "'"});
+    result.errors.push_back({"", "cannot read file '" + path + "'" + (why.empty() ? "" : ": " + why)});
     return result;
+  };
+  FileBytes file;
+  std::error_code ec;
+  if (std::filesystem::is_regular_file(path, ec)) {
+    try {
+      file = FileBytes::map(path, std::numeric_limits<int64_t>::max());
+    } catch (const FileBytesError&) {
+      return cannot_read("");
+    }
+  } else if (!std::filesystem::is_directory(path, ec)) {
+    // A pipe (`penumbra render <(make_scene) ...`) or device: read through as a stream.
+    std::ifstream stream(path, std::ios::binary);
+    std::ostringstream text;
+    if (stream.is_open()) text << stream.rdbuf();
+    if (!stream.is_open() || stream.bad()) return cannot_read("");
+    file = FileBytes(std::move(text).str());
+  } else {
+    return cannot_read("");
   }
   AssetFolder assets;
   assets.root = std::filesystem::absolute(std::filesystem::path(path)).parent_path();
-  return load_scene(text.str(), limits, overrides, assets);
+  LoadResult result = load_scene(file.view(), limits, overrides, assets);
+  if (!file.intact()) return cannot_read("the file changed while it was read (or a part of it could not be read)");
+  return result;
 }
 
 }  // namespace penumbra::api
