@@ -52,9 +52,9 @@ TEST(ExampleScenes, SceneThroughAPipeLoadsAsTheFile) {
   const std::filesystem::path scene = std::filesystem::path(PENUMBRA_SOURCE_DIR) / "scenes" / "cornell_box.json";
   std::ostringstream text;
   text << std::ifstream(scene).rdbuf();
-  char dir[] = "/tmp/penumbra_pipe_XXXXXX";
-  ASSERT_NE(mkdtemp(dir), nullptr);
-  const std::string fifo = std::string(dir) + "/scene.json";
+  std::string dir = (std::filesystem::temp_directory_path() / "penumbra_pipe_XXXXXX").string();
+  ASSERT_NE(mkdtemp(dir.data()), nullptr);
+  const std::string fifo = dir + "/scene.json";
   ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
   // The writer waits at most two seconds for a reader (a loader that never opens the pipe must
   // fail this test, not hang it) and ignores a reader that leaves early (SIGPIPE).
