@@ -61,7 +61,8 @@ LoadResult load_scene_file(const std::string& path, const Limits& limits,
   const auto cannot_read = [&path](const std::string& why) {
     LoadResult result;
     result.kind = LoadErrorKind::kInvalid;
-    result.errors.push_back({"", "cannot read file '" + path + "'" + (why.empty() ? "" : ": " + why)});
+    result.errors.push_back(
+        {"", "cannot read file '" + path + "'" + (why.empty() ? "" : ": " + why)});
     return result;
   };
   FileBytes file;
@@ -85,7 +86,8 @@ LoadResult load_scene_file(const std::string& path, const Limits& limits,
   AssetFolder assets;
   assets.root = std::filesystem::absolute(std::filesystem::path(path)).parent_path();
   LoadResult result = load_scene(file.view(), limits, overrides, assets);
-  if (!file.intact()) return cannot_read("the file changed while it was read (or a part of it could not be read)");
+  if (!file.intact())
+    return cannot_read("the file changed while it was read (or a part of it could not be read)");
   return result;
 }
 

@@ -118,7 +118,8 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
     // Whether a path of this bounce plays Russian roulette (a batch's paths move in step, so
     // at every depth all or none).
     bool roulette = false;
-    for (size_t j = 0; j < hit_count; ++j) roulette |= b.states_[live[hit_slots[j]]].depth >= settings.rr_depth;
+    for (size_t j = 0; j < hit_count; ++j)
+      roulette |= b.states_[live[hit_slots[j]]].depth >= settings.rr_depth;
     if (next_event) {
       // Dimensions 0 and 1 are also the lobe and direction of a surface whose lobes are all
       // Dirac (it estimates no light: a smooth dielectric picks reflection or refraction there).
@@ -135,7 +136,8 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
     } else {
       samples.start(hit_count, BounceSamples::kBounceWithoutLight,
                     BounceSamples::kBounceWithoutLightPairs, lobe_pairs ? 0b001u : 0u,
-                    BounceSamples::kBounceWithoutLightTwoD, !kStages ? 0u : roulette ? 0b001u : 0b101u);
+                    BounceSamples::kBounceWithoutLightTwoD,
+                    !kStages ? 0u : roulette ? 0b001u : 0b101u);
     }
     for (size_t j = 0; j < hit_count; ++j) {
       const uint32_t p = live[hit_slots[j]];

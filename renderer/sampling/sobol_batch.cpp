@@ -49,7 +49,8 @@ void cmj_y_kernel(size_t n, uint32_t bits, const uint32_t* __restrict cell, cons
 PENUMBRA_SIMD_CLONES
 void cmj_z_kernel(size_t n, uint32_t bits, const uint32_t* __restrict cell, const uint32_t* __restrict seed_z,
                   const uint32_t* __restrict seed_rows, float* __restrict z) {
-  for (size_t i = 0; i < n; ++i) z[i] = fixed_to_unit_float(cmj_z_with_rows(cell[i], bits, seed_z[i], seed_rows[i]));
+  for (size_t i = 0; i < n; ++i)
+    z[i] = fixed_to_unit_float(cmj_z_with_rows(cell[i], bits, seed_z[i], seed_rows[i]));
 }
 
 }  // namespace
@@ -63,8 +64,8 @@ void cmj_y_batch(size_t n, uint32_t bits, const uint32_t* cell, const uint32_t* 
   cmj_y_kernel(n, bits, cell, seed_y, y);
 }
 
-void cmj_z_batch(size_t n, uint32_t bits, const uint32_t* cell, const uint32_t* seed_z, const uint32_t* seed_rows,
-                 float* z) {
+void cmj_z_batch(size_t n, uint32_t bits, const uint32_t* cell, const uint32_t* seed_z,
+                 const uint32_t* seed_rows, float* z) {
   cmj_z_kernel(n, bits, cell, seed_z, seed_rows, z);
 }
 

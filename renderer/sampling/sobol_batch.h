@@ -41,8 +41,8 @@ void cmj_cells_x_batch(size_t n, uint32_t bits, const uint32_t* index, const uin
 void cmj_y_batch(size_t n, uint32_t bits, const uint32_t* cell, const uint32_t* seed_y, float* y);
 // (cmj_z_batch takes each entry's seed_rows[i] = cmj_z_rows_seed(seed_z[i]), which is the same
 // for a run of one pixel's samples.)
-void cmj_z_batch(size_t n, uint32_t bits, const uint32_t* cell, const uint32_t* seed_z, const uint32_t* seed_rows,
-                 float* z);
+void cmj_z_batch(size_t n, uint32_t bits, const uint32_t* cell, const uint32_t* seed_z,
+                 const uint32_t* seed_rows, float* z);
 
 // How many pairs start below dimension j: the bits of `pairs` under bit j. Shifts and adds
 // rather than std::popcount, which a baseline x86-64 build (no POPCNT) makes a call into

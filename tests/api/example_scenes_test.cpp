@@ -49,7 +49,8 @@ TEST(ExampleScenes, MissingFileIsAnErrorOnTheRoot) {
 // A scene file is mapped where it is a regular file and read as a stream where it is not: a
 // pipe (`penumbra render <(make_scene) ...`) loads as the same scene.
 TEST(ExampleScenes, SceneThroughAPipeLoadsAsTheFile) {
-  const std::filesystem::path scene = std::filesystem::path(PENUMBRA_SOURCE_DIR) / "scenes" / "cornell_box.json";
+  const std::filesystem::path scene =
+      std::filesystem::path(PENUMBRA_SOURCE_DIR) / "scenes" / "cornell_box.json";
   std::ostringstream text;
   text << std::ifstream(scene).rdbuf();
   std::string dir = (std::filesystem::temp_directory_path() / "penumbra_pipe_XXXXXX").string();

@@ -274,8 +274,8 @@ TEST(SobolBatch, PrefetchedPairsSeeTheSamplersSequence) {
     for (int which = 0; which < 4; ++which) {
       for (uint32_t unread_x : {0u, 0b00001u, 0b00100u, 0b00101u, 0b10000u, 0b11111u}) {
         const uint32_t cmj_bits = computed >= 8 ? 5u : 0u;
-        SCOPED_TRACE(testing::Message() << "computed " << computed % 8 << ", pattern " << which << ", cmj " << cmj_bits
-                                        << ", unread x " << unread_x);
+        SCOPED_TRACE(testing::Message() << "computed " << computed % 8 << ", pattern " << which
+                                        << ", cmj " << cmj_bits << ", unread x " << unread_x);
         Sampler shared(9, cmj_bits), alone(9, cmj_bits);
         std::vector<Sampler::Cursor> cursors;
         for (int p = 0; p < kPaths; ++p) {
