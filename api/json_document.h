@@ -17,6 +17,20 @@ struct JsonDocument {
 
 // Syntax errors are reported on pointer "" with the byte offset in the message; duplicate keys
 // are ordinary (kInvalid) errors on the duplicated member's pointer.
+// Two parsers behind one result: simdjson's (parse_json_fast) for documents it vouches for, and
+// nlohmann's (the reference) for everything else, so every diagnostic is nlohmann's and the
+// reference's. The fuzz target json_document checks that the two build equal values.
 JsonDocument parse_json_document(std::string_view text, int max_depth, Diagnostics& diag);
+
+// The value nlohmann's parser would build, or nullopt where this path defers to it: anything
+// simdjson rejects (malformed JSON, numbers out of range, integers beyond 64 bits, nesting past
+// its 1024 levels), a duplicate key, nesting at max_depth, a string that unescapes to invalid
+// UTF-8. Numbers: negative integers are number_integer, others number_unsigned, the rest float
+// (nlohmann keeps "-0" as number_integer 0, this path as number_unsigned 0).
+std::optional<Json> parse_json_fast(std::string_view text, int max_depth);
+
+// nlohmann's parser alone, with the depth cap and duplicate keys tracked: the reference.
+JsonDocument parse_json_document_reference(std::string_view text, int max_depth,
+                                           Diagnostics& diag);
 
 }  // namespace penumbra::api

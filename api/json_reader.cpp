@@ -95,7 +95,9 @@ std::optional<uint64_t> read_unsigned(const Json& value, const std::string& poin
                                       Diagnostics& diag) {
   if (value.is_number_unsigned()) return value.get<uint64_t>();
   if (value.is_number_integer()) {
-    diag.error(pointer, "must be >= 0");  // number_integer is only used for negatives here
+    // number_integer holds negatives, and nlohmann's "-0" (which is 0).
+    if (value.get<int64_t>() == 0) return 0;
+    diag.error(pointer, "must be >= 0");
     return std::nullopt;
   }
   if (value.is_number_float()) {

@@ -2,6 +2,8 @@
 # Fuzz every libFuzzer target under AddressSanitizer + UndefinedBehaviorSanitizer for a bounded
 # total time, shared equally between the targets:
 #   scene_loader  api::load_scene (plus Scene::build and a 4x4 render of valid scenes)
+#   json_document the scene text's two JSON parsers (simdjson's fast path, nlohmann's) against
+#                 each other: same value, or the fast path defers to nlohmann
 #   ply_reader    renderer/io/ply_reader (our own PLY parser)
 #   obj_reader    renderer/io/obj_reader (our own OBJ statement reader)
 #   gltf_reader   renderer/io/gltf_file (GLB checks + tinygltf + accessors, hierarchy)
@@ -18,7 +20,7 @@ set -euo pipefail
 seconds="${1:-60}"
 shift || true
 targets=("$@")
-if [ ${#targets[@]} -eq 0 ]; then targets=(scene_loader ply_reader obj_reader gltf_reader exr_window image_asset http_head multipart); fi
+if [ ${#targets[@]} -eq 0 ]; then targets=(scene_loader json_document ply_reader obj_reader gltf_reader exr_window image_asset http_head multipart); fi
 root="$(cd "$(dirname "$0")/.." && pwd)"
 build="$root/build-fuzz"
 jobs="${JOBS:-2}"

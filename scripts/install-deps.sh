@@ -23,7 +23,7 @@ if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
 PKGS=(
   build-essential cmake ninja-build pkg-config git ca-certificates curl
   libembree-dev libopenimageio-dev openimageio-tools libglm-dev
-  libcpp-httplib-dev nlohmann-json3-dev libtbb-dev libsqlite3-dev
+  libcpp-httplib-dev nlohmann-json3-dev libsimdjson-dev libtbb-dev libsqlite3-dev
   libgtest-dev libgmock-dev libbenchmark-dev libtinygltf-dev libpng-dev
   libopenexr-dev libjpeg62-turbo-dev libssl-dev
   libpq-dev
