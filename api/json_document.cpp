@@ -175,7 +175,25 @@ class FastConverter {
   int max_depth_;
 };
 
+void release_containers(Json& value) {
+  if (value.is_array()) {
+    auto& items = value.get_ref<Json::array_t&>();
+    for (Json& item : items)
+      if (item.is_structured()) release_containers(item);
+    items.clear();
+  } else if (value.is_object()) {
+    auto& members = value.get_ref<Json::object_t&>();
+    for (auto& member : members)
+      if (member.second.is_structured()) release_containers(member.second);
+    members.clear();
+  }
+}
+
 }  // namespace
+
+JsonDocument::~JsonDocument() {
+  if (value) release_containers(*value);
+}
 
 std::optional<Json> parse_json_fast(std::string_view text, int max_depth) {
   simdjson::dom::parser parser;

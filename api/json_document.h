@@ -13,6 +13,16 @@ namespace penumbra::api {
 struct JsonDocument {
   std::optional<Json> value;      // set unless there was a syntax error
   bool syntax_error = false;      // kSyntax: malformed, or nested deeper than the cap
+
+  JsonDocument() = default;
+  JsonDocument(JsonDocument&&) = default;
+  JsonDocument& operator=(JsonDocument&&) = default;
+  JsonDocument(const JsonDocument&) = default;
+  JsonDocument& operator=(const JsonDocument&) = default;
+  // Empties the value's containers from the leaves up before it is destroyed: nlohmann 3.11's
+  // destructor (its guard against deep recursion) first moves every array's elements into a
+  // second vector, for an inline mesh's arrays a copy of megabytes. The depth is the parse's cap.
+  ~JsonDocument();
 };
 
 // Syntax errors are reported on pointer "" with the byte offset in the message; duplicate keys
