@@ -7,7 +7,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include "api/diagnostics.h"
 #include "api/job_submission.h"
+#include "api/json_document.h"
 #include "server/storage/job_record.h"
 
 namespace penumbra::server {
@@ -60,8 +62,11 @@ JobShape read_job_shape(const std::string& scene_json, int max_json_depth) {
   const api::JobSubmission submission = api::parse_job_submission(
       scene_json, max_json_depth, api::ManifestLimits{.max_files = 1 << 30});
   if (!submission.ok()) return shape;
-  const nlohmann::json scene = nlohmann::json::parse(submission.scene_text, nullptr, false);
-  if (!scene.is_object()) return shape;
+  api::Diagnostics diag;
+  const api::JsonDocument document =
+      api::parse_json_document(submission.scene_text, max_json_depth, diag);
+  if (!document.value || !document.value->is_object()) return shape;
+  const nlohmann::json& scene = *document.value;
   // The scene was validated by the loader before this: the members have their checked types.
   if (const auto a = scene.find("animation"); a != scene.end() && a->is_object()) {
     const auto frames = a->find("frames");
