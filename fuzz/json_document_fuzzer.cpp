@@ -9,28 +9,18 @@
 #include <cstdlib>
 #include <string>
 #include <string_view>
-#include <vector>
 
 #include "api/json_document.h"
 #include "fuzz/json_same_value.h"
 
 namespace {
 
-using penumbra::api::Diagnostic;
 using penumbra::api::Diagnostics;
 using penumbra::api::JsonDocument;
 
 [[noreturn]] void disagree(const std::string& what) {
   std::fprintf(stderr, "json_document: the two parsers disagree: %s\n", what.c_str());
   std::abort();
-}
-
-bool same_errors(Diagnostics a, Diagnostics b) {
-  const std::vector<Diagnostic> x = a.take_errors(), y = b.take_errors();
-  if (x.size() != y.size()) return false;
-  for (std::size_t i = 0; i < x.size(); ++i)
-    if (x[i].pointer != y[i].pointer || x[i].message != y[i].message) return false;
-  return true;
 }
 
 }  // namespace
@@ -58,8 +48,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
   if (!fast) {
     if (combined.value && *combined.value != *reference.value)
       disagree("a deferred text's value is not the reference's");
-    if (!same_errors(combined_diag, reference_diag))
-      disagree("a deferred text's diagnostics are not the reference's");
+    std::string where;
+    if (!penumbra::api::json_same_errors(combined_diag, reference_diag, where))
+      disagree("a deferred text's diagnostics are not the reference's: " + where);
   }
   return 0;
 }

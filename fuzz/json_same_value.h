@@ -4,7 +4,9 @@
 #include <cmath>
 #include <cstdint>
 #include <string>
+#include <vector>
 
+#include "api/diagnostics.h"
 #include "api/json_reader.h"
 
 namespace penumbra::api {
@@ -44,6 +46,24 @@ inline bool json_same_value(const Json& a, const Json& b, std::string& where,
     default:
       return a == b || zeros ? true : fail("values differ");
   }
+}
+
+// The same errors in the same order, pointer and message alike (where a deferred text's
+// diagnostics must be the reference's); on a difference, `where` says which.
+inline bool json_same_errors(Diagnostics a, Diagnostics b, std::string& where) {
+  const std::vector<Diagnostic> x = a.take_errors(), y = b.take_errors();
+  if (x.size() != y.size()) {
+    where = std::to_string(x.size()) + " errors against " + std::to_string(y.size());
+    return false;
+  }
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    if (x[i].pointer != y[i].pointer || x[i].message != y[i].message) {
+      where = "error " + std::to_string(i) + ": " + x[i].pointer + " " + x[i].message +
+              " against " + y[i].pointer + " " + y[i].message;
+      return false;
+    }
+  }
+  return true;
 }
 
 }  // namespace penumbra::api
