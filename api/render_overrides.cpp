@@ -17,7 +17,7 @@ struct RenderFlag {
   bool numbers = false;     // with list: the items are numbers, read as JSON scalars
 };
 
-constexpr std::array<RenderFlag, 14> kRenderFlags = {{
+constexpr std::array<RenderFlag, 15> kRenderFlags = {{
     {"--width", "width", false},
     {"--height", "height", false},
     {"--spp", "spp", false},
@@ -25,6 +25,7 @@ constexpr std::array<RenderFlag, 14> kRenderFlags = {{
     {"--rr-depth", "rr_depth", false},
     {"--integrator", "integrator", true},
     {"--sampler", "sampler", true},
+    {"--path-reuse", "path_reuse", false},
     {"--seed", "seed", false},
     {"--noise-threshold", "noise_threshold", false},
     {"--time-limit", "time_limit", false},

@@ -95,6 +95,12 @@ void parse_render(const Json* value, const Limits& limits, RenderSettings& setti
                                 "; expected \"path\" or \"distributed\"");
   }
   if (auto seed = r.unsigned_integer("seed")) settings.seed = *seed;
+  if (auto reuse = r.integer("path_reuse")) {
+    if (*reuse < 1 || *reuse > 4)
+      r.error("path_reuse", "must be 1 (off) to 4 (blocks of 4 x 4 pixels share their paths)");
+    else
+      settings.path_reuse = int(*reuse);
+  }
   if (auto t = r.number("noise_threshold", Range::at_least(0))) settings.noise_threshold = float(*t);
   if (auto t = r.number("time_limit", Range::at_least(0))) {
     if (*t > limits.max_time_limit)

@@ -38,6 +38,8 @@ const char* kUsage =
     "  --sampler NAME           auto | cmj | sobol: correlated multi-jittered points for\n"
     "                           uniform renders of a power-of-two spp (auto's choice), Sobol\n"
     "                           points otherwise (docs/scene-format.md)\n"
+    "  --path-reuse N           blocks of N x N pixels share their paths' second vertices\n"
+    "                           (1 = off, up to 4; docs/scene-format.md)\n"
     "  --time-limit SECONDS     stop at this budget with a correct (less converged) image\n"
     "  --noise-threshold X      adaptive sampling: aim for this relative RMS error (0.05 = 5%);\n"
     "                           samples go where the noise is, spp is the per-pixel cap\n"

@@ -6,6 +6,7 @@
 #include <tbb/task_arena.h>
 
 #include <chrono>
+#include <numeric>
 #include <mutex>
 #include <optional>
 #include <stdexcept>
@@ -17,6 +18,7 @@
 #include "renderer/denoise/denoise_result.h"
 #include "renderer/render/output_layers.h"
 #include "renderer/render/pass_plan.h"
+#include "renderer/render/path_reuse.h"
 #include "renderer/render/camera_sample.h"
 #include "renderer/render/camera_stage.h"
 #include "renderer/render/thin_lens_camera.h"
@@ -44,13 +46,18 @@ struct PixelOrder {
   std::vector<size_t> tile_starts;  // one per tile, plus the end
 };
 
-PixelOrder make_pixel_order(int width, int height, int size) {
+// With path reuse (block > 1) a tile's pixels go block by block (row-major inside each
+// block), so a reuse group's pixels are consecutive.
+PixelOrder make_pixel_order(int width, int height, int size, int block) {
   PixelOrder o;
   for (int y0 = 0; y0 < height; y0 += size)
     for (int x0 = 0; x0 < width; x0 += size) {
       o.tile_starts.push_back(o.pixels.size());
-      for (int y = y0; y < std::min(y0 + size, height); ++y)
-        for (int x = x0; x < std::min(x0 + size, width); ++x) o.pixels.push_back(uint32_t(y * width + x));
+      const int y1 = std::min(y0 + size, height), x1 = std::min(x0 + size, width);
+      for (int by = y0; by < y1; by += block)
+        for (int bx = x0; bx < x1; bx += block)
+          for (int y = by; y < std::min(by + block, y1); ++y)
+            for (int x = bx; x < std::min(bx + block, x1); ++x) o.pixels.push_back(uint32_t(y * width + x));
     }
   o.tile_starts.push_back(o.pixels.size());
   return o;
@@ -96,6 +103,10 @@ struct WavefrontScratch {
   CameraStage camera_stage;
   std::vector<Sampler> samplers;
   std::vector<uint32_t> batch_pixels;
+  // With path reuse: per path its group's key (block, sample index), and the grouping.
+  std::vector<uint64_t> batch_keys;
+  std::vector<uint32_t> grouped;
+  std::vector<size_t> group_starts;
   WavefrontScratch(const ThinLensCamera& camera, bool sample_lens, bool sample_time, bool first_hits)
       : batch(kWavefrontBatch, first_hits),
         camera_stage(camera, sample_lens, sample_time, kWavefrontBatch) {
@@ -178,7 +189,13 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
       settings.outputs | (settings.denoise ? uint32_t(kOutputAlbedo | kOutputNormal) : 0u);
   if (film_outputs)
     layer_film.emplace(width, height, film_outputs, camera.position(), camera.forward());
-  const PixelOrder order = make_pixel_order(width, height, std::max(1, settings.tile_size));
+  // Path reuse among the pixels of reuse_block x reuse_block blocks (path_reuse.h).
+  int reuse_block = std::clamp(settings.path_reuse, 1, 4);
+  if (!settings.wavefront || settings.integrator != IntegratorKind::kPath ||
+      !path_reuse_applies(scene, isettings))
+    reuse_block = 1;
+  const bool reuse = reuse_block > 1;
+  const PixelOrder order = make_pixel_order(width, height, std::max(1, settings.tile_size), reuse_block);
   const int spp = std::max(1, settings.spp);
   // Per pixel: samples taken so far and the most it may take. Uniform sampling keeps every limit
   // at spp; adaptive sampling (render.noise_threshold) re-estimates the limits after each pass
@@ -288,9 +305,26 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
             CameraStage& camera_stage = local.camera_stage;
             std::vector<Sampler>& samplers = local.samplers;
             std::vector<uint32_t>& batch_pixels = local.batch_pixels;
+            std::vector<uint64_t>& batch_keys = local.batch_keys;
+            batch.set_reuse(reuse);
             auto flush = [&] {
               camera_stage.generate(batch);
               integrate_batch(scene, isettings, batch, counters);
+              if (reuse) {
+                // The batch's paths grouped by (block, sample index), each group reused.
+                std::vector<uint32_t>& grouped = local.grouped;
+                std::vector<size_t>& starts = local.group_starts;
+                grouped.resize(batch.size());
+                std::iota(grouped.begin(), grouped.end(), 0u);
+                std::stable_sort(grouped.begin(), grouped.end(),
+                                 [&](uint32_t a, uint32_t b) { return batch_keys[a] < batch_keys[b]; });
+                starts.clear();
+                for (size_t i = 0; i < grouped.size(); ++i)
+                  if (i == 0 || batch_keys[grouped[i]] != batch_keys[grouped[i - 1]]) starts.push_back(i);
+                starts.push_back(grouped.size());
+                counters.rays += reuse_paths(scene, batch.reuse_records(), batch.states(),
+                                             grouped.data(), starts);
+              }
               // Each run of one pixel's samples at once (the batch holds them consecutively).
               for (size_t i = 0; i < batch.size();) {
                 const uint32_t pi = batch_pixels[i];
@@ -308,7 +342,49 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
               batch.clear();
               samplers.clear();
               batch_pixels.clear();
+              batch_keys.clear();
             };
+            if (reuse) {
+              // A block's pixels' runs interleaved in chunks, so each batch holds the block's
+              // pixels at the same sample indices.
+              struct Run { uint32_t pi; int fx, fy; uint32_t n0, n1; };
+              std::vector<Run> runs;
+              for_each_run([&](uint32_t pi, int fx, int fy, uint32_t n0, uint32_t n1) {
+                runs.push_back(Run{pi, fx, fy, n0, n1});
+              });
+              const int blocks_x = (width + reuse_block - 1) / reuse_block;
+              auto block_of = [&](const Run& r) {
+                return uint64_t(r.fy / reuse_block) * uint64_t(blocks_x) + uint64_t(r.fx / reuse_block);
+              };
+              for (size_t g0 = 0; g0 < runs.size();) {
+                size_t g1 = g0 + 1;
+                while (g1 < runs.size() && block_of(runs[g1]) == block_of(runs[g0])) ++g1;
+                const uint64_t block = block_of(runs[g0]);
+                const uint32_t members = uint32_t(g1 - g0);
+                const uint32_t chunk = std::max<uint32_t>(1, uint32_t(capacity) / members);
+                uint32_t longest = 0;
+                for (size_t r = g0; r < g1; ++r) longest = std::max(longest, runs[r].n1 - runs[r].n0);
+                for (uint32_t off = 0; off < longest; off += chunk) {
+                  size_t need = 0;
+                  for (size_t r = g0; r < g1; ++r)
+                    if (runs[r].n0 + off < runs[r].n1) need += std::min(chunk, runs[r].n1 - runs[r].n0 - off);
+                  if (batch_pixels.size() + need > capacity) flush();
+                  for (size_t r = g0; r < g1; ++r) {
+                    const Run& run = runs[r];
+                    if (run.n0 + off >= run.n1) continue;
+                    const uint32_t s = run.n0 + off, count = std::min(chunk, run.n1 - s);
+                    const int x = window.x0 + run.fx, y = window.y0 + run.fy;
+                    samplers.emplace_back(settings.seed, cmj_bits);
+                    samplers.back().start_pixel_sample(x, y, s);
+                    camera_stage.add_run(&samplers.back(), x, y, s, count);
+                    batch_pixels.insert(batch_pixels.end(), count, run.pi);
+                    for (uint32_t j = 0; j < count; ++j) batch_keys.push_back((block << 32) | (s + j));
+                  }
+                }
+                g0 = g1;
+              }
+              if (!batch_pixels.empty()) flush();
+            } else
             // A pixel's run of samples queued at once, up to the batch's end (a call and two
             // push_backs per sample were 3% of the furnace's profile).
             for_each_run([&](uint32_t pi, int fx, int fy, uint32_t n0, uint32_t n1) {
@@ -325,7 +401,7 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
                 s += run;
               }
             });
-            if (!batch_pixels.empty()) flush();
+            if (!reuse && !batch_pixels.empty()) flush();
           } else {
             Sampler sampler(settings.seed, cmj_bits);
             for_each_run([&](uint32_t, int fx, int fy, uint32_t n0, uint32_t n1) {

@@ -24,6 +24,7 @@ void PathBatch::size_arrays() {
   samplers_.resize(capacity_);
   cursors_.resize(capacity_);
   if (record_first_hits_) firsts_.resize(capacity_);
+  if (reuse_on_) reuse_.resize(capacity_);
   live_.reserve(capacity_);
   hits_.resize(capacity_);
   found_.resize(capacity_);
@@ -79,7 +80,14 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
   std::vector<uint32_t>& live = b.live_;
   live.resize(b.size());
   std::iota(live.begin(), live.end(), 0u);
-  for (bool camera_rays = true; !live.empty(); camera_rays = false) {
+  const bool reuse = !kDistributed && b.reuse_on_;
+  if (reuse)
+    for (size_t p = 0; p < b.size(); ++p) {
+      b.reuse_[p].has_x1 = false;
+      b.reuse_[p].has_x2 = false;
+    }
+  int bounce = 0;
+  for (bool camera_rays = true; !live.empty(); camera_rays = false, ++bounce) {
     // Trace: the live paths' rays, in packets of consecutive live paths.
     std::array<Ray, kPacket> rays;
     std::array<bool, kPacket> found;
@@ -101,6 +109,25 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
       miss_slots[miss_count] = uint32_t(k);
       hit_count += b.found_[k];
       miss_count += 1 - b.found_[k];
+    }
+    // Path reuse records the camera rays' hits and the second ones with the throughput they
+    // arrive with (path_reuse.h).
+    if (reuse && bounce < 2) {
+      for (size_t j = 0; j < hit_count; ++j) {
+        const size_t k = hit_slots[j];
+        const uint32_t p = live[k];
+        ReuseRecord& r = b.reuse_[p];
+        if (bounce == 0) {
+          r.x1 = b.hits_[k];
+          r.wi1 = -b.states_[p].ray.direction;
+          r.time = b.states_[p].ray.time;
+          r.has_x1 = true;
+        } else {
+          r.x2 = b.hits_[k];
+          r.beta1 = b.states_[p].beta;
+          r.has_x2 = true;
+        }
+      }
     }
 
     // The sampler values the paths that hit something will take, for all of them at once (no
@@ -241,6 +268,12 @@ void integrate_batch(const Scene& scene, const IntegratorSettings& settings, Pat
         }
       }
     }
+    // The radiance with the second hits' emission and before their next-event estimates.
+    if (reuse && bounce == 1)
+      for (size_t j = 0; j < hit_count; ++j) {
+        const uint32_t p = live[hit_slots[j]];
+        b.reuse_[p].radiance_at_x2 = b.states_[p].radiance;
+      }
     // The shadow queries stay in their slots (copying 44-byte queries into a compact array
     // stalled on store forwarding); their slots and paths are listed in path order. Written
     // whatever the flags, the next entry's place advanced by them: the flags are random and

@@ -11,6 +11,7 @@
 #include <memory>
 #include <vector>
 
+#include "renderer/render/path_reuse.h"
 #include "renderer/render/surface_stage.h"
 #include "renderer/render/path_step.h"
 #include "renderer/sampling/sobol_batch.h"
@@ -51,6 +52,15 @@ class PathBatch {
   // After integrate: the path's radiance and, if recorded, its camera ray's first hit.
   const Spectrum& radiance(size_t i) const { return states_[i].radiance; }
   const FirstHit& first_hit(size_t i) const { return firsts_[i]; }
+  // Path reuse (path_reuse.h): whether integrate records each path's first two vertices, and,
+  // after integrate, their records and the paths' states to reuse them in place.
+  void set_reuse(bool on) {
+    reuse_on_ = on;
+    if (on) reuse_.resize(capacity_);
+  }
+  bool reuse() const { return reuse_on_; }
+  const ReuseRecord* reuse_records() const { return reuse_.data(); }
+  PathState* states() { return states_.data(); }
 
   template <bool, uint32_t>
   friend void integrate_batch(const Scene&, const IntegratorSettings&, PathBatch&, PathCounters&);
@@ -67,6 +77,8 @@ class PathBatch {
   std::vector<Sampler*> samplers_;
   std::vector<Sampler::Cursor> cursors_;
   std::vector<FirstHit> firsts_;
+  bool reuse_on_ = false;
+  std::vector<ReuseRecord> reuse_;  // per path, when reuse_on_
   // Scratch of one bounce: the live paths, their hits, and the shadow queries with their paths.
   std::vector<uint32_t> live_;
   std::vector<SurfaceHit> hits_;

@@ -163,6 +163,10 @@ struct RenderSettings {
   // (renderer/render/wavefront_integrator.h), or one path at a time, one ray at a time
   // (integrator.h, the reference). Both give the same image.
   bool wavefront = true;
+  // Path reuse (renderer/render/path_reuse.h): the paths of each path_reuse x path_reuse block
+  // of pixels share their second vertices, one sample index at a time. 1 = off. The path
+  // integrator's wavefront driver only, and not with motion blur, rr_depth 1 or max_depth 2.
+  int path_reuse = 1;
 };
 
 }  // namespace penumbra
