@@ -352,9 +352,11 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
               for_each_run([&](uint32_t pi, int fx, int fy, uint32_t n0, uint32_t n1) {
                 runs.push_back(Run{pi, fx, fy, n0, n1});
               });
-              const int blocks_x = (width + reuse_block - 1) / reuse_block;
+              // A block as make_pixel_order cuts it inside its tile, named by its first pixel.
+              const int tile = std::max(1, settings.tile_size);
               auto block_of = [&](const Run& r) {
-                return uint64_t(r.fy / reuse_block) * uint64_t(blocks_x) + uint64_t(r.fx / reuse_block);
+                const int bx = r.fx - (r.fx % tile) % reuse_block, by = r.fy - (r.fy % tile) % reuse_block;
+                return uint64_t(by) * uint64_t(width) + uint64_t(bx);
               };
               for (size_t g0 = 0; g0 < runs.size();) {
                 size_t g1 = g0 + 1;
