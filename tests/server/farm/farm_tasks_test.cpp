@@ -94,6 +94,8 @@ TEST(FarmTiles, TheSubmissionDecidesFramesOrTiles) {
   EXPECT_FALSE(read_job_shape(R"({"render": {"window": [0, 0, 8, 8]}})", 64).splittable);
   EXPECT_FALSE(read_job_shape(R"({"render": {"time_limit": 5}})", 64).splittable);
   EXPECT_TRUE(read_job_shape(R"({"render": {"time_limit": 0}})", 64).splittable);
+  EXPECT_FALSE(read_job_shape(R"({"render": {"path_reuse": 2}})", 64).splittable);
+  EXPECT_TRUE(read_job_shape(R"({"render": {"path_reuse": 1}})", 64).splittable);
 }
 
 TEST(FarmConfigTiles, TilePixelsFlagAndEnvironment) {
