@@ -4,14 +4,15 @@
     .venv-mitsuba/bin/python tools/bench_accuracy.py --penumbra build/app/penumbra \
         [--spp 4,16,64,256] [--seeds 3] [--heavy-seeds 8] \
         [--mitsuba llvm_ad_rgb,llvm_ad_rgb:ldsampler,llvm_ad_rgb:multijitter] [--only cornell] \
-        [--adaptive 0.1,0.05,0.03] [--adaptive-cap 1024] \
+        [--adaptive 0.1,0.05,0.03] [--adaptive-cap 1024] [--path-reuse 4] \
         [--cycles /usr/bin/blender [--cycles-sphere-mesh 512] [--cycles-rough-glass] \
         [--cycles-reference-spp 4096]]
 
 For each scene of tests/accuracy/scenes/, each renderer and each sample count of the ladder, over
 several seeds, it records the render's seconds, spp, RMSE, relMSE and mean FLIP against the
 Mitsuba reference (and "penumbra adaptive": one point per render.noise_threshold of
-``--adaptive``, with ``--adaptive-cap`` as spp) (tests/accuracy/references/<scene>.exr, see docs/accuracy.md), and writes
+``--adaptive``, with ``--adaptive-cap`` as spp; and with ``--path-reuse N`` "penumbra reuse": the
+ladder with ``render.path_reuse`` N) (tests/accuracy/references/<scene>.exr, see docs/accuracy.md), and writes
 
 * ``<out>/bench.csv``   one row per render;
 * ``<out>/bench.png``   relMSE against seconds, log-log, one panel per scene, one line per renderer;
@@ -134,7 +135,7 @@ def read_exr(mi, path: str) -> np.ndarray:
 
 
 def run_penumbra(binary: str, scene_path: str, spp: int, seed: int, mi,
-                 noise_threshold: float = 0.0) -> tuple[np.ndarray, float]:
+                 noise_threshold: float = 0.0, path_reuse: int = 1) -> tuple[np.ndarray, float]:
     """Render with the penumbra CLI (adaptive sampling when ``noise_threshold`` > 0, with ``spp``
     as the per-pixel cap); returns the image and build + render seconds."""
     with tempfile.TemporaryDirectory() as tmp:
@@ -142,6 +143,8 @@ def run_penumbra(binary: str, scene_path: str, spp: int, seed: int, mi,
         cmd = [binary, "render", scene_path, "-o", out, "--spp", str(spp), "--seed", str(seed), "-q"]
         if noise_threshold > 0:
             cmd += ["--noise-threshold", str(noise_threshold)]
+        if path_reuse > 1:
+            cmd += ["--path-reuse", str(path_reuse)]
         proc = subprocess.run(cmd, capture_output=True, text=True, check=True)
         match = SUMMARY.search(proc.stdout + proc.stderr)
         if not match:
@@ -270,11 +273,13 @@ def summarise(rows: list[dict], scenes: list[str], renderers: list[str], key: st
     penumbra / fastest Mitsuba (and penumbra / Cycles when Cycles ran)."""
     cycles = "cycles" in renderers
     adaptive = "penumbra adaptive" in renderers
+    reuse = "penumbra reuse" in renderers
     label = "relMSE" if key == "relmse" else "trimmed relMSE"
     lines = [f"| scene | target {label} | " + " | ".join(f"{r} (s)" for r in renderers) + " | penumbra / fastest Mitsuba |"
-             + (" adaptive / fastest Mitsuba |" if adaptive else "") + (" penumbra / cycles |" if cycles else ""),
+             + (" adaptive / fastest Mitsuba |" if adaptive else "") + (" reuse / fastest Mitsuba |" if reuse else "")
+             + (" penumbra / cycles |" if cycles else ""),
              "| --- | ---: | " + " | ".join("---:" for _ in renderers) + " | ---: |" + (" ---: |" if adaptive else "")
-             + (" ---: |" if cycles else "")]
+             + (" ---: |" if reuse else "") + (" ---: |" if cycles else "")]
     for scene in scenes:
         target = penumbra_target(rows, scene, key)
         if math.isnan(target):
@@ -288,6 +293,7 @@ def summarise(rows: list[dict], scenes: list[str], renderers: list[str], key: st
         mitsuba = [v for k, v in secs.items() if k.startswith("mitsuba") and not math.isnan(v)]
         ratio = secs["penumbra"] / min(mitsuba) if mitsuba else math.nan
         adaptive_ratio = secs["penumbra adaptive"] / min(mitsuba) if mitsuba and adaptive else math.nan
+        reuse_ratio = secs["penumbra reuse"] / min(mitsuba) if mitsuba and reuse else math.nan
         moving = any(r["instants"] > 1 for r in rows if r["scene"] == scene)
         own = {r["reference"] for r in rows if r["scene"] == scene and r["renderer"] == "cycles"
                and r.get("reference", "mitsuba") != "mitsuba"}
@@ -297,6 +303,7 @@ def summarise(rows: list[dict], scenes: list[str], renderers: list[str], key: st
                      + " | ".join("–" if math.isnan(secs[n]) else f"{mark[n]}{secs[n]:.2f}" for n in renderers)
                      + f" | {ratio:.2f} |"
                      + (f" {adaptive_ratio:.2f} |" if adaptive else "")
+                     + (f" {reuse_ratio:.2f} |" if reuse else "")
                      + (f" {secs['penumbra'] / secs['cycles']:.2f} |" if cycles and not math.isnan(secs["cycles"])
                         else " – |" if cycles else ""))
     return lines
@@ -355,6 +362,7 @@ class RunContext:
     instants: int
     mi: object
     reference: np.ndarray
+    path_reuse: int = 1
 
 
 class Curve:
@@ -365,6 +373,7 @@ class Curve:
         self.renderer = renderer
         self.is_penumbra = renderer.startswith("penumbra")
         self.adaptive = renderer == "penumbra adaptive"
+        self.reuse = renderer == "penumbra reuse"
         self.variant, self.sampler = ("", "") if self.is_penumbra else mitsuba_config(renderer)
         self.points = [(cap, t) for t in thresholds] if self.adaptive else [(s, 0.0) for s in ladder]
         self.errors: list[float] = []  # seed-mean relMSE per measured point
@@ -374,7 +383,8 @@ class Curve:
     def render(self, ctx: RunContext, spp: int, threshold: float, seed: int) -> tuple[np.ndarray, float, int, int]:
         """Image, seconds, spp taken and shutter instants of one render."""
         if self.is_penumbra:
-            image, seconds = run_penumbra(ctx.penumbra, ctx.scene_path, spp, seed, ctx.mi, threshold)
+            image, seconds = run_penumbra(ctx.penumbra, ctx.scene_path, spp, seed, ctx.mi, threshold,
+                                          ctx.path_reuse if self.reuse else 1)
             return image, seconds, spp, 1
         image, seconds, used = run_mitsuba(self.variant, ctx.scene, max(spp, ctx.instants), seed,
                                            ctx.instants, ctx.assets, self.sampler)
@@ -476,6 +486,8 @@ def main(argv: list[str]) -> int:
     ap.add_argument("--adaptive", default="0.1,0.05,0.03",
                     help="render.noise_threshold values for the 'penumbra adaptive' curve ('' to skip)")
     ap.add_argument("--adaptive-cap", type=int, default=1024, help="spp cap of the adaptive renders")
+    ap.add_argument("--path-reuse", type=int, default=1, metavar="N",
+                    help="also a 'penumbra reuse' curve: the ladder with render.path_reuse N (1 = none)")
     ap.add_argument("--extend", type=int, default=4,
                     help="at most this many extra points (spp doubled, or threshold / sqrt 2) for a "
                          "curve that has not reached penumbra's error yet")
@@ -513,7 +525,8 @@ def main(argv: list[str]) -> int:
 
     rows: list[dict] = []
     thresholds = [float(t) for t in args.adaptive.split(",") if t]
-    renderers = ["penumbra"] + (["penumbra adaptive"] if thresholds else []) + [f"mitsuba {v.replace(':', ' ')}" for v in variants]
+    renderers = ["penumbra"] + (["penumbra adaptive"] if thresholds else []) \
+        + (["penumbra reuse"] if args.path_reuse > 1 else []) + [f"mitsuba {v.replace(':', ' ')}" for v in variants]
     if args.cycles:
         renderers.append("cycles")
     for scene_name in scenes:
@@ -528,7 +541,8 @@ def main(argv: list[str]) -> int:
         with open(scene_path, encoding="utf-8") as f:
             refused = p2c.refusals(json.load(f), args.cycles_sphere_mesh, args.cycles_rough_glass)
         curves = [Curve(r, ladder, thresholds, args.adaptive_cap) for r in renderers if r != "cycles"]
-        ctx = RunContext(args.penumbra, scene_name, scene_path, scene, assets, instants, mi, reference)
+        ctx = RunContext(args.penumbra, scene_name, scene_path, scene, assets, instants, mi, reference,
+                         args.path_reuse)
         # One discarded warm-up render each: Dr.Jit compiles its kernels on first use, and the
         # first penumbra run pays for reading the scene file from a cold cache.
         for c in curves:

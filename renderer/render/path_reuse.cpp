@@ -81,8 +81,17 @@ struct Pair {
 }  // namespace
 
 bool path_reuse_applies(const Scene& scene, const IntegratorSettings& settings) {
-  return !scene.features().motion && settings.rr_depth >= 2 &&
-         (settings.max_depth < 0 || settings.max_depth > 2);
+  if (scene.features().motion || settings.rr_depth < 2 ||
+      (settings.max_depth >= 0 && settings.max_depth <= 2))
+    return false;
+  // Some surface must be able to share its points (a scene of glossy, glass and normal-mapped
+  // surfaces would pay for the records and the grouping and share nothing).
+  for (uint32_t o = 0; o < scene.object_count(); ++o) {
+    const Material& material = scene.material(scene.object(o).material);
+    if (!material.normal_mapped() && std::holds_alternative<DiffuseBsdf>(material.bsdf().model()))
+      return true;
+  }
+  return false;
 }
 
 uint64_t reuse_paths(const Scene& scene, const ReuseRecord* records, PathState* states,
@@ -102,6 +111,13 @@ uint64_t reuse_paths(const Scene& scene, const ReuseRecord* records, PathState* 
       const size_t n = std::min(kMaxGroup, group_starts[g + 1] - start);
       const uint32_t* member = paths + start;
       if (n < 2) continue;
+      // Nothing to do unless some member's second vertex can be shared.
+      bool any_offer = false;
+      for (size_t m = 0; m < n && !any_offer; ++m) {
+        const ReuseRecord& r = records[member[m]];
+        any_offer = r.has_x1 && r.has_x2 && lambertian_without_normal_map(scene, r.x2);
+      }
+      if (!any_offer) continue;
       size_t techniques = 0;
       for (size_t m = 0; m < n; ++m) techniques += mem[m].set(scene, records[member[m]]);
       if (techniques < 2) continue;

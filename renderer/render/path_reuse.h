@@ -50,7 +50,8 @@ struct ReuseRecord {
   bool has_x2 = false;
 };
 
-// Whether a render may reuse paths at all (the conditions above that are the render's).
+// Whether a render may reuse paths at all: the conditions above that are the render's, and
+// some surface of the scene a plain Lambertian one without a normal map.
 bool path_reuse_applies(const Scene& scene, const IntegratorSettings& settings);
 
 // Reuses the paths of each group: `group_starts` delimits runs of `paths` (indices into
