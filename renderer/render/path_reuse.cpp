@@ -35,7 +35,10 @@ struct Member {
 };
 
 // Which side of x2 a direction leaving it lies on, against its geometric and its shading
-// normal: L_r(x2) is the same for every direction of one class of a Lambertian surface.
+// normal: L_r(x2) is the same for every direction of one class of a Lambertian surface. (The
+// geometric side is also what the shadow ray decides, its end being offset to the sample's side:
+// a first vertex on the other side of a thin surface sees it blocked. The shading side is what
+// only the class tells, where interpolated normals lean.)
 int direction_class(const SurfaceHit& x2, const vec3& w) {
   return (glm::dot(w, x2.ng) > 0.f ? 1 : 0) | (glm::dot(w, x2.ns) > 0.f ? 2 : 0);
 }
