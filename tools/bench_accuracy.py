@@ -267,6 +267,11 @@ def time_to_reach(rows: list[dict], target: float, key: str = "relmse") -> tuple
     return float(math.exp((math.log(target) - intercept) / slope)), False
 
 
+def fmt_ratio(ratio: float) -> str:
+    """A table's ratio, or "–" where a curve has no time (it never reached the error)."""
+    return "–" if math.isnan(ratio) else f"{ratio:.2f}"
+
+
 def summarise(rows: list[dict], scenes: list[str], renderers: list[str], key: str = "relmse") -> list[str]:
     """Markdown table: per scene, seconds to the error (the rows' ``key``: relMSE, or relMSE
     without each image's worst pixels) penumbra reaches at its largest spp, for each renderer, and
@@ -301,9 +306,9 @@ def summarise(rows: list[dict], scenes: list[str], renderers: list[str], key: st
                 [f"Cycles against its own {ref.removeprefix('cycles ')}" for ref in sorted(own)]
         lines.append(f"| {scene}{' (' + '; '.join(notes) + ')' if notes else ''} | {target:.2e} | "
                      + " | ".join("–" if math.isnan(secs[n]) else f"{mark[n]}{secs[n]:.2f}" for n in renderers)
-                     + f" | {ratio:.2f} |"
-                     + (f" {adaptive_ratio:.2f} |" if adaptive else "")
-                     + (f" {reuse_ratio:.2f} |" if reuse else "")
+                     + f" | {fmt_ratio(ratio)} |"
+                     + (f" {fmt_ratio(adaptive_ratio)} |" if adaptive else "")
+                     + (f" {fmt_ratio(reuse_ratio)} |" if reuse else "")
                      + (f" {secs['penumbra'] / secs['cycles']:.2f} |" if cycles and not math.isnan(secs["cycles"])
                         else " – |" if cycles else ""))
     return lines
