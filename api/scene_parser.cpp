@@ -96,7 +96,7 @@ void parse_render(const Json* value, const Limits& limits, RenderSettings& setti
   }
   if (auto seed = r.unsigned_integer("seed")) settings.seed = *seed;
   if (auto reuse = r.integer("path_reuse")) {
-    if (*reuse < 1 || *reuse > 4)
+    if (*reuse < 1 || *reuse > RenderSettings::kMaxPathReuse)
       r.error("path_reuse", "must be 1 (off) to 4 (blocks of 4 x 4 pixels share their paths)");
     else
       settings.path_reuse = int(*reuse);

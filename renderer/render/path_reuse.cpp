@@ -7,12 +7,14 @@
 
 #include "renderer/core/simd_clones.h"
 #include "renderer/materials/diffuse.h"
+#include "renderer/scene/scene_input.h"
 
 namespace penumbra {
 namespace {
 
-// The largest group reuse_paths takes at once (a 4 x 4 block of pixels); larger runs are split.
-constexpr size_t kMaxGroup = 16;
+// The largest group reuse_paths takes at once (the largest block of pixels); larger runs are
+// split.
+constexpr size_t kMaxGroup = size_t(RenderSettings::kMaxPathReuse * RenderSettings::kMaxPathReuse);
 
 // A member's first vertex as a sampling technique: its BSDF and frame as path_scatter built
 // them, and whether it offers its second vertex. A plain Lambertian first vertex (the common
@@ -43,10 +45,14 @@ int direction_class(const SurfaceHit& x2, const vec3& w) {
   return (glm::dot(w, x2.ng) > 0.f ? 1 : 0) | (glm::dot(w, x2.ns) > 0.f ? 2 : 0);
 }
 
-bool lambertian_without_normal_map(const Scene& scene, const SurfaceHit& hit) {
-  const Material& material = scene.material(scene.object(hit.object).material);
+// Whether a surface's points can be shared: a plain Lambertian model without a normal map.
+bool shares_points(const Material& material) {
   return !material.normal_mapped() &&
          std::holds_alternative<DiffuseBsdf>(material.bsdf().model());
+}
+
+bool lambertian_without_normal_map(const Scene& scene, const SurfaceHit& hit) {
+  return shares_points(scene.material(scene.object(hit.object).material));
 }
 
 bool Member::set(const Scene& scene, const ReuseRecord& r) {
@@ -56,9 +62,11 @@ bool Member::set(const Scene& scene, const ReuseRecord& r) {
   const Material& material = scene.material(scene.object(hit.object).material);
   textured.reset();
   bsdf = &material.bsdf();
-  if (material.varies()) bsdf = &textured.emplace(material.bsdf_at(TextureQuery{hit.p, hit.uv, r.time}));
+  if (material.varies())
+    bsdf = &textured.emplace(material.bsdf_at(TextureQuery{hit.p, hit.uv, r.time}));
   if (bsdf->lobes() & kLobeDelta) return false;
-  frame = material.normal_mapped() ? path_step_detail::tangent_frame(scene, r.time, &hit) : Frame(hit.ns);
+  frame = material.normal_mapped() ? path_step_detail::tangent_frame(scene, r.time, &hit)
+                                   : Frame(hit.ns);
   wi_local = frame.to_local(r.wi1);
   in_s = true;
   offers = r.has_x2 && lambertian_without_normal_map(scene, r.x2);
@@ -142,11 +150,8 @@ bool path_reuse_applies(const Scene& scene, const IntegratorSettings& settings) 
     return false;
   // Some surface must be able to share its points (a scene of glossy, glass and normal-mapped
   // surfaces would pay for the records and the grouping and share nothing).
-  for (uint32_t o = 0; o < scene.object_count(); ++o) {
-    const Material& material = scene.material(scene.object(o).material);
-    if (!material.normal_mapped() && std::holds_alternative<DiffuseBsdf>(material.bsdf().model()))
-      return true;
-  }
+  for (uint32_t o = 0; o < scene.object_count(); ++o)
+    if (shares_points(scene.material(scene.object(o).material))) return true;
   return false;
 }
 
@@ -296,10 +301,10 @@ uint64_t reuse_paths(const Scene& scene, const ReuseRecord* records, PathState* 
       }
       for (size_t k = 0; k < n; ++k) {
         if (!mem[k].in_s) continue;
-        const ReuseRecord& rk = records[member[k]];
+        // A member that offered its second vertex drops its own tail (its share is in added).
         Spectrum& L = states[member[k]].radiance;
-        const Spectrum own_tail = mem[k].offers ? L - rk.radiance_at_x2 : Spectrum(0.f);
-        const Spectrum reused = L - own_tail + added[k];
+        const Spectrum reused =
+            (mem[k].offers ? records[member[k]].radiance_at_x2 : L) + added[k];
         if (is_finite(reused)) L = reused;
       }
     }

@@ -190,12 +190,13 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
   if (film_outputs)
     layer_film.emplace(width, height, film_outputs, camera.position(), camera.forward());
   // Path reuse among the pixels of reuse_block x reuse_block blocks (path_reuse.h).
-  int reuse_block = std::clamp(settings.path_reuse, 1, 4);
+  int reuse_block = std::clamp(settings.path_reuse, 1, RenderSettings::kMaxPathReuse);
   if (!settings.wavefront || settings.integrator != IntegratorKind::kPath ||
       !path_reuse_applies(scene, isettings))
     reuse_block = 1;
   const bool reuse = reuse_block > 1;
-  const PixelOrder order = make_pixel_order(width, height, std::max(1, settings.tile_size), reuse_block);
+  const PixelOrder order =
+      make_pixel_order(width, height, std::max(1, settings.tile_size), reuse_block);
   const int spp = std::max(1, settings.spp);
   // Per pixel: samples taken so far and the most it may take. Uniform sampling keeps every limit
   // at spp; adaptive sampling (render.noise_threshold) re-estimates the limits after each pass
@@ -355,7 +356,8 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
               // A block as make_pixel_order cuts it inside its tile, named by its first pixel.
               const int tile = std::max(1, settings.tile_size);
               auto block_of = [&](const Run& r) {
-                const int bx = r.fx - (r.fx % tile) % reuse_block, by = r.fy - (r.fy % tile) % reuse_block;
+                const int bx = r.fx - (r.fx % tile) % reuse_block;
+                const int by = r.fy - (r.fy % tile) % reuse_block;
                 return uint64_t(by) * uint64_t(width) + uint64_t(bx);
               };
               for (size_t g0 = 0; g0 < runs.size();) {
@@ -369,7 +371,8 @@ RenderResult render(const Scene& scene, const RenderSettings& settings,
                 for (uint32_t off = 0; off < longest; off += chunk) {
                   size_t need = 0;
                   for (size_t r = g0; r < g1; ++r)
-                    if (runs[r].n0 + off < runs[r].n1) need += std::min(chunk, runs[r].n1 - runs[r].n0 - off);
+                    if (runs[r].n0 + off < runs[r].n1)
+                      need += std::min(chunk, runs[r].n1 - runs[r].n0 - off);
                   if (batch_pixels.size() + need > capacity) flush();
                   for (size_t r = g0; r < g1; ++r) {
                     const Run& run = runs[r];

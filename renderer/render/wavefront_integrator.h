@@ -58,7 +58,6 @@ class PathBatch {
     reuse_on_ = on;
     if (on) reuse_.resize(capacity_);
   }
-  bool reuse() const { return reuse_on_; }
   const ReuseRecord* reuse_records() const { return reuse_.data(); }
   PathState* states() { return states_.data(); }
 

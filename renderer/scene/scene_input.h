@@ -166,7 +166,9 @@ struct RenderSettings {
   // Path reuse (renderer/render/path_reuse.h): the paths of each path_reuse x path_reuse block
   // of pixels share their second vertices, one sample index at a time. 1 = off. The path
   // integrator's wavefront driver only, and not with motion blur, rr_depth 1 or max_depth 2.
+  // At most kMaxPathReuse (api/ checks it).
   int path_reuse = 1;
+  static constexpr int kMaxPathReuse = 4;
 };
 
 }  // namespace penumbra

@@ -80,7 +80,8 @@ JobShape read_job_shape(const std::string& scene_json, int max_json_depth) {
       shape.splittable = false;
     // Path reuse mixes a pixel's paths with its block's (renderer/render/path_reuse.h): a window
     // cut through a block would give its pixels other values than the whole frame's.
-    if (const auto p = r->find("path_reuse"); p != r->end() && p->is_number_integer() && p->get<int64_t>() > 1)
+    if (const auto p = r->find("path_reuse");
+        p != r->end() && p->is_number_integer() && p->get<int64_t>() > 1)
       shape.splittable = false;
   }
   return shape;
